@@ -1,0 +1,40 @@
+"""Exceptions raised by granular.
+
+The C core returns status codes; the binding (``granular._core``) turns each into one of
+these classes, with the particles and the time involved as attributes so that a script can
+react to, say, an inelastic collapse without parsing the message.
+"""
+
+
+class GranularError(Exception):
+    """Base class of every error granular raises on its own account."""
+
+    def __init__(self, message, *, particles=(), time=None, value=None):
+        super().__init__(message)
+        self.particles = tuple(int(p) for p in particles)
+        self.time = time
+        self.value = value
+
+
+class OverlapError(GranularError, ValueError):
+    """Two particles overlap (``.particles`` names the pair, ``.value`` the depth)."""
+
+
+class OutsideBoxError(GranularError, ValueError):
+    """A particle lies outside the box (``.particles`` names it)."""
+
+
+class InelasticCollapseError(GranularError, RuntimeError):
+    """Inelastic collapse: collisions pile up at one instant.
+
+    ``.particles`` names the particles involved and ``.time`` when it was detected.  Turn on
+    the TC model (``Scene(..., contact_duration=t_c)``) to let such a run continue.
+    """
+
+
+class NonFiniteError(GranularError, FloatingPointError):
+    """A NaN or infinity appeared in the state."""
+
+
+class UnstableStepError(GranularError, ValueError):
+    """An integrator step is at or past its stability limit (``.value`` is gamma*dt)."""

@@ -1,0 +1,27 @@
+"""Build the one C extension, granular._core, from csrc/.
+
+Portable flags only: -O3 and C99; no -march=native or -ffast-math (the collision
+arithmetic relies on IEEE rounding being the same on every machine)."""
+import glob
+import os
+
+import numpy
+from setuptools import Extension, setup
+
+extra = ["-O3", "-std=c99", "-Wall", "-Wextra", "-Wno-unused-parameter"]
+if os.environ.get("GRANULAR_ASAN"):
+    extra += ["-fsanitize=address", "-fno-omit-frame-pointer", "-O1", "-g"]
+
+setup(
+    ext_modules=[
+        Extension(
+            "granular._core",
+            sources=sorted(glob.glob("csrc/*.c")),
+            include_dirs=[numpy.get_include(), "csrc"],
+            define_macros=[("NPY_NO_DEPRECATED_API", "NPY_2_0_API_VERSION")],
+            extra_compile_args=extra,
+            extra_link_args=["-fsanitize=address"] if os.environ.get("GRANULAR_ASAN") else [],
+            depends=sorted(glob.glob("csrc/*.h")),
+        )
+    ]
+)
