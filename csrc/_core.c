@@ -110,6 +110,236 @@ static PyArrayObject *as_f64(PyObject *obj, const char *name, int ndim, const np
 }
 
 /* ==== EDMD binding begin ============================================================ */
+
+typedef struct {
+    PyObject_HEAD
+    gr_edmd *sim;
+    int dim;
+    npy_intp n;
+    int busy; /* a thread is inside advance() with the GIL released */
+} EDMDObject;
+
+static void EDMD_dealloc(EDMDObject *self)
+{
+    gr_edmd_free(self->sim);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static int EDMD_init(EDMDObject *self, PyObject *args, PyObject *kw)
+{
+    static char *names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
+                            "periodic", "wall_restitution", "restitution",
+                            "contact_duration", "cell_factor", NULL};
+    PyObject *opos, *ovel, *orad, *omass, *olo, *ohi;
+    int periodic;
+    double wall_e, xi, tc, cell_factor;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpdddd", names, &opos, &ovel, &orad,
+                                     &omass, &olo, &ohi, &periodic, &wall_e, &xi, &tc,
+                                     &cell_factor))
+        return -1;
+    if (self->sim) {
+        PyErr_SetString(PyExc_RuntimeError, "EDMD is already initialised");
+        return -1;
+    }
+    npy_intp any2[2] = {-1, -1};
+    PyArrayObject *pos = as_f64(opos, "positions", 2, any2);
+    if (!pos) return -1;
+    npy_intp n = PyArray_DIM(pos, 0), d = PyArray_DIM(pos, 1);
+    npy_intp shp[2] = {n, d}, shn[1] = {n}, shd[1] = {d};
+    PyArrayObject *vel = NULL, *rad = NULL, *mass = NULL, *lo = NULL, *hi = NULL;
+    int ok = 0;
+    if (d != 2 && d != 3) {
+        PyErr_Format(PyExc_ValueError, "positions must have shape (N, 2) or (N, 3), got (N, %zd)",
+                     (Py_ssize_t)d);
+        goto done;
+    }
+    if (!(vel = as_f64(ovel, "velocities", 2, shp)) || !(rad = as_f64(orad, "radii", 1, shn)) ||
+        !(mass = as_f64(omass, "masses", 1, shn)) || !(lo = as_f64(olo, "lower", 1, shd)) ||
+        !(hi = as_f64(ohi, "upper", 1, shd)))
+        goto done;
+    gr_edmd_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.dim = (int)d;
+    cfg.n = n;
+    for (int a = 0; a < d; a++) {
+        cfg.lo[a] = ((double *)PyArray_DATA(lo))[a];
+        cfg.hi[a] = ((double *)PyArray_DATA(hi))[a];
+    }
+    cfg.periodic = periodic;
+    cfg.wall_restitution = wall_e;
+    cfg.restitution = xi;
+    cfg.contact_duration = tc;
+    cfg.cell_factor = cell_factor;
+    gr_error err = {0, -1, -1, NAN, NAN, NULL};
+    int status;
+    Py_BEGIN_ALLOW_THREADS
+    status = gr_edmd_new(&self->sim, &cfg, PyArray_DATA(pos), PyArray_DATA(vel),
+                         PyArray_DATA(rad), PyArray_DATA(mass), &err);
+    Py_END_ALLOW_THREADS
+    if (status != GR_OK) {
+        raise_status(status, &err);
+        goto done;
+    }
+    self->dim = (int)d;
+    self->n = n;
+    ok = 1;
+done:
+    Py_XDECREF(pos);
+    Py_XDECREF(vel);
+    Py_XDECREF(rad);
+    Py_XDECREF(mass);
+    Py_XDECREF(lo);
+    Py_XDECREF(hi);
+    return ok ? 0 : -1;
+}
+
+static int check_ready(EDMDObject *self)
+{
+    if (!self->sim) {
+        PyErr_SetString(PyExc_RuntimeError, "EDMD was not initialised");
+        return 0;
+    }
+    if (self->busy) {
+        PyErr_SetString(PyExc_RuntimeError, "this simulation is running in another thread");
+        return 0;
+    }
+    return 1;
+}
+
+/* An output buffer: None, or a writeable C-contiguous array of the given dtype and size. */
+static int out_buffer(PyObject *obj, const char *name, int type, npy_intp size, void **data)
+{
+    *data = NULL;
+    if (obj == Py_None) return 1;
+    if (!PyArray_Check(obj) || PyArray_TYPE((PyArrayObject *)obj) != type ||
+        !PyArray_IS_C_CONTIGUOUS((PyArrayObject *)obj) ||
+        !PyArray_ISWRITEABLE((PyArrayObject *)obj) ||
+        PyArray_SIZE((PyArrayObject *)obj) != size) {
+        PyErr_Format(PyExc_ValueError, "%s must be a writeable C-contiguous %s array of %zd elements",
+                     name, type == NPY_FLOAT64 ? "float64" : "int64", (Py_ssize_t)size);
+        return 0;
+    }
+    *data = PyArray_DATA((PyArrayObject *)obj);
+    return 1;
+}
+
+static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
+{
+    static char *names[] = {"t_stop", "collisions_per_particle", "kinetic_energy",
+                            "max_events", "sample_times", "next", "positions", "velocities",
+                            "kinetic", "momentum", "pair", "wall", "virial", "wall_impulse",
+                            NULL};
+    gr_edmd_stop stop;
+    long long max_events, next;
+    PyObject *otimes, *opos, *ovel, *okin, *omom, *opair, *owall, *ovir, *oimp;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "dddLOLOOOOOOOO", names, &stop.t_stop,
+                                     &stop.collisions_per_particle, &stop.kinetic_energy,
+                                     &max_events, &otimes, &next, &opos, &ovel, &okin, &omom,
+                                     &opair, &owall, &ovir, &oimp))
+        return NULL;
+    if (!check_ready(self)) return NULL;
+    if (max_events <= 0) {
+        PyErr_SetString(PyExc_ValueError, "max_events must be positive");
+        return NULL;
+    }
+    if (stop.t_stop != stop.t_stop) {
+        PyErr_SetString(PyExc_ValueError, "t_stop must not be NaN");
+        return NULL;
+    }
+    stop.max_events = max_events;
+    npy_intp any1[1] = {-1};
+    PyArrayObject *times = as_f64(otimes, "sample_times", 1, any1);
+    if (!times) return NULL;
+    npy_intp T = PyArray_DIM(times, 0);
+    gr_edmd_samples smp;
+    memset(&smp, 0, sizeof smp);
+    smp.count = T;
+    smp.times = PyArray_DATA(times);
+    smp.next = next;
+    if (next < 0 || next > T) {
+        PyErr_SetString(PyExc_ValueError, "next must lie in [0, len(sample_times)]");
+        Py_DECREF(times);
+        return NULL;
+    }
+    npy_intp nd = T * self->n * self->dim;
+    if (!out_buffer(opos, "positions", NPY_FLOAT64, nd, (void **)&smp.pos) ||
+        !out_buffer(ovel, "velocities", NPY_FLOAT64, nd, (void **)&smp.vel) ||
+        !out_buffer(okin, "kinetic", NPY_FLOAT64, T, (void **)&smp.kinetic) ||
+        !out_buffer(omom, "momentum", NPY_FLOAT64, T * self->dim, (void **)&smp.momentum) ||
+        !out_buffer(opair, "pair", NPY_INT64, T, (void **)&smp.pair) ||
+        !out_buffer(owall, "wall", NPY_INT64, T, (void **)&smp.wall) ||
+        !out_buffer(ovir, "virial", NPY_FLOAT64, T, (void **)&smp.virial) ||
+        !out_buffer(oimp, "wall_impulse", NPY_FLOAT64, T, (void **)&smp.wall_impulse)) {
+        Py_DECREF(times);
+        return NULL;
+    }
+    gr_error err = {0, -1, -1, NAN, NAN, NULL};
+    int status;
+    self->busy = 1;
+    Py_BEGIN_ALLOW_THREADS
+    status = gr_edmd_advance(self->sim, &stop, &smp, &err);
+    Py_END_ALLOW_THREADS
+    self->busy = 0;
+    Py_DECREF(times);
+    if (status < 0) return raise_status(status, &err);
+    return Py_BuildValue("(iL)", status, (long long)smp.next);
+}
+
+static PyObject *EDMD_state(EDMDObject *self, PyObject *Py_UNUSED(ignored))
+{
+    if (!check_ready(self)) return NULL;
+    npy_intp shp[2] = {self->n, self->dim};
+    PyObject *pos = PyArray_SimpleNew(2, shp, NPY_FLOAT64);
+    PyObject *vel = PyArray_SimpleNew(2, shp, NPY_FLOAT64);
+    PyObject *img = PyArray_SimpleNew(2, shp, NPY_INT64);
+    if (!pos || !vel || !img) {
+        Py_XDECREF(pos);
+        Py_XDECREF(vel);
+        Py_XDECREF(img);
+        return NULL;
+    }
+    gr_edmd_state(self->sim, PyArray_DATA((PyArrayObject *)pos),
+                  PyArray_DATA((PyArrayObject *)vel), PyArray_DATA((PyArrayObject *)img));
+    return Py_BuildValue("(NNN)", pos, vel, img);
+}
+
+static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
+{
+    if (!check_ready(self)) return NULL;
+    gr_edmd_counters c;
+    gr_edmd_get_counters(self->sim, &c);
+    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:(iii)}", "time", c.t,
+                         "events", (long long)c.events, "pair_collisions", (long long)c.pair,
+                         "wall_collisions", (long long)c.wall, "cell_crossings",
+                         (long long)c.crossings, "stale_events", (long long)c.invalid,
+                         "tc_elastic_collisions", (long long)c.elastic_tc, "virial", c.virial,
+                         "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic, "cells",
+                         c.ncell[0], c.ncell[1], c.ncell[2]);
+}
+
+static PyMethodDef EDMD_methods[] = {
+    {"advance", (PyCFunction)(void (*)(void))EDMD_advance, METH_VARARGS | METH_KEYWORDS,
+     "advance(t_stop, collisions_per_particle, kinetic_energy, max_events, sample_times, next,"
+     " positions, velocities, kinetic, momentum, pair, wall, virial, wall_impulse)"
+     " -> (reason, next).  Process events, writing samples into the given arrays."},
+    {"state", (PyCFunction)EDMD_state, METH_NOARGS,
+     "state() -> (positions wrapped in the box, velocities, image counters) at the current time"},
+    {"counters", (PyCFunction)EDMD_counters, METH_NOARGS, "counters() -> dict"},
+    {NULL, NULL, 0, NULL}
+};
+
+static PyTypeObject EDMDType = {
+    PyVarObject_HEAD_INIT(NULL, 0)
+    .tp_name = "granular._core.EDMD",
+    .tp_basicsize = sizeof(EDMDObject),
+    .tp_dealloc = (destructor)EDMD_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "Event-driven MD engine (internal: use granular.Simulation).",
+    .tp_methods = EDMD_methods,
+    .tp_init = (initproc)EDMD_init,
+    .tp_new = PyType_GenericNew,
+};
+
 /* ==== EDMD binding end ============================================================== */
 
 
@@ -133,7 +363,7 @@ static PyMethodDef core_methods[] = {
 static struct PyModuleDef core_module = {
     PyModuleDef_HEAD_INIT, "granular._core",
     "The C core of granular: event-driven MD and SDE integrators (internal; use granular).",
-    -1, core_methods
+    -1, core_methods, NULL, NULL, NULL, NULL
 };
 
 PyMODINIT_FUNC PyInit__core(void)
@@ -144,5 +374,14 @@ PyMODINIT_FUNC PyInit__core(void)
     PyObject *m = PyModule_Create(&core_module);
     if (!m) return NULL;
     /* ==== EDMD type registration ==== */
+    if (PyType_Ready(&EDMDType) < 0 || PyModule_AddObjectRef(m, "EDMD", (PyObject *)&EDMDType) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    PyModule_AddIntConstant(m, "STOP_TIME", GR_STOP_TIME);
+    PyModule_AddIntConstant(m, "STOP_BUDGET", GR_STOP_BUDGET);
+    PyModule_AddIntConstant(m, "STOP_COLLISIONS", GR_STOP_COLLISIONS);
+    PyModule_AddIntConstant(m, "STOP_ENERGY", GR_STOP_ENERGY);
+    PyModule_AddIntConstant(m, "STOP_IDLE", GR_STOP_IDLE);
     return m;
 }

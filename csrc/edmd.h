@@ -1,0 +1,97 @@
+/* edmd.h -- the event-driven molecular dynamics engine for hard disks (2D) and hard
+ * spheres (3D): public interface.
+ *
+ * A gr_edmd holds one system: particle states with their own clocks, the cell grid, the
+ * event queue and the counters.  gr_edmd_advance() processes events until a stop
+ * criterion or the caller's event budget is met, writing samples into caller-owned
+ * buffers on the way; a run can be continued by calling it again.  Nothing here
+ * allocates output for the caller, prints or exits.
+ *
+ * Status codes (common.h): GR_OK or a GR_STOP_* reason (positive) on success, GR_ERR_*
+ * (negative) on failure, with a gr_error filled in. */
+#ifndef GR_EDMD_H
+#define GR_EDMD_H
+
+#include <stdint.h>
+
+#include "common.h"
+
+/* Why gr_edmd_advance returned (all are successes). */
+enum {
+    GR_STOP_TIME = 1,       /* reached stop->t_stop */
+    GR_STOP_BUDGET = 2,     /* processed stop->max_events events; call again to go on */
+    GR_STOP_COLLISIONS = 3, /* mean collisions per particle reached the target */
+    GR_STOP_ENERGY = 4,     /* mean kinetic energy fell to the target */
+    GR_STOP_IDLE = 5        /* no event will ever happen again and t_stop is infinite */
+};
+
+typedef struct {
+    int dim;                  /* 2 or 3 */
+    int64_t n;                /* number of particles, >= 1 */
+    double lo[3], hi[3];      /* box corners, per axis (only the first dim used) */
+    int periodic;             /* 1: periodic on every axis; 0: reflecting walls */
+    double wall_restitution;  /* walls: v' = e_w * (v reflected) (thesis 2.22); > 0 */
+    double restitution;       /* xi in [0, 1] for pair collisions */
+    double contact_duration;  /* TC model t_c >= 0; 0 turns it off */
+    double cell_factor;       /* cell width / largest diameter, >= 1 (speed knob) */
+} gr_edmd_config;
+
+typedef struct {
+    double t_stop;                 /* absolute time; +inf for none */
+    double collisions_per_particle;/* stop when (2*pair + wall)/N >= this; +inf for none */
+    double kinetic_energy;         /* stop when mean kinetic energy <= this; -1 for none */
+    int64_t max_events;            /* events this call may process (> 0) */
+} gr_edmd_stop;
+
+/* Caller-owned sample buffers.  Sample k is the state at times[k]; `next` is the index
+ * of the first sample not yet written and is advanced by gr_edmd_advance.  pos/vel may
+ * be NULL when the caller wants only the statistics. */
+typedef struct {
+    int64_t count;
+    const double *times;  /* increasing */
+    int64_t next;
+    double *pos;          /* count x n x dim, unwrapped positions, or NULL */
+    double *vel;          /* count x n x dim, or NULL */
+    double *kinetic;      /* count: total kinetic energy */
+    double *momentum;     /* count x dim: total momentum */
+    int64_t *pair;        /* count: cumulative pair collisions */
+    int64_t *wall;        /* count: cumulative wall collisions */
+    double *virial;       /* count: cumulative pair virial sum over collisions of r_ij . dp_j */
+    double *wall_impulse; /* count: cumulative normal momentum given to the walls */
+} gr_edmd_samples;
+
+typedef struct {
+    double t;               /* current time of the system */
+    int64_t events;         /* all events processed, cell crossings included */
+    int64_t pair;           /* pair collisions */
+    int64_t wall;           /* wall collisions */
+    int64_t crossings;      /* cell crossings */
+    int64_t invalid;        /* events found stale on pop (partner collided since) */
+    int64_t elastic_tc;     /* pair collisions made elastic by the TC model */
+    double virial;          /* sum over pair collisions of r_ij . dp_j */
+    double wall_impulse;    /* sum over wall collisions of |dp_normal| */
+    double kinetic;         /* total kinetic energy now */
+    int ncell[3];           /* cells per axis */
+} gr_edmd_counters;
+
+typedef struct gr_edmd gr_edmd;
+
+/* Build a system from arrays (pos, vel: n x dim; radius, mass: n).  The arrays are
+ * copied.  Checks that particles lie in the box, do not overlap, and that a periodic
+ * box is more than two largest diameters wide.  Returns GR_OK, GR_ERR_VALUE,
+ * GR_ERR_OUTSIDE, GR_ERR_OVERLAP, GR_ERR_NONFINITE or GR_ERR_NOMEM. */
+int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
+                const double *vel, const double *radius, const double *mass, gr_error *err);
+void gr_edmd_free(gr_edmd *s);
+
+/* Process events.  Returns a GR_STOP_* reason, or GR_ERR_COLLAPSE / GR_ERR_NONFINITE
+ * (the state stays consistent and inspectable after an error). */
+int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err);
+
+/* The state at the current time: positions wrapped into the box (pos), velocities, and
+ * image counters (unwrapped = pos + image * box length).  Any pointer may be NULL.
+ * Does not change the system. */
+void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image);
+void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c);
+
+#endif

@@ -1,0 +1,361 @@
+/* edmd.c -- construction, validation and inspection of an event-driven system, and the
+ * dispatch to the kernels specialised for 2D and 3D (edmd_dim.h, included twice).
+ *
+ * How the engine keeps its per-event cost independent of N:
+ *  - every particle carries its own clock: its record holds the position at time t_i
+ *    and is advanced only when an event touches it;
+ *  - the box is cut into cells at least one largest diameter wide; a particle looks for
+ *    partners in its own and the adjacent cells only, and crossing into a new cell is an
+ *    event that scans just the newly adjacent layer of cells;
+ *  - each particle keeps one predicted collision (pair or wall) and one cell crossing; the
+ *    queue holds the earlier of the two.  A predicted pair collision remembers the
+ *    partner's collision counter and is found stale when popped if the partner collided
+ *    since (lazy invalidation) -- then only that particle is rescanned.
+ * Invariant: for every pair of particles in adjacent cells, the earliest collision on
+ * their current straight lines is no earlier than the queue key of one of the two. */
+#define _POSIX_C_SOURCE 200112L /* posix_memalign */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "collide.h"
+#include "edmd.h"
+#include "heap.h"
+
+typedef struct {
+    double t_coll;   /* predicted pair or wall collision, +inf if none */
+    double t_cross;  /* next cell crossing, +inf if none */
+    int64_t pcount;  /* partner's collision counter when predicted */
+    int32_t partner; /* >= 0: particle; -1: none; <= -2: wall -(2 + 2*axis + side) */
+    int32_t cross;   /* 2*axis + (1 if moving up) */
+    double t_last;   /* time of this particle's last collision (TC model, collapse) */
+    int32_t streak;  /* consecutive collisions each within eps_t of the previous one */
+} gr_event;
+
+struct gr_edmd {
+    gr_edmd_config cfg;
+    int dim, stride;  /* stride = doubles per particle record: x[dim] v[dim] t r */
+    int32_t n;
+    double L[3];
+    double *P;        /* n * stride, 64-byte aligned */
+    double *mass;
+    int64_t *count;   /* collisions (pair and wall) per particle */
+    int64_t *image;   /* n * dim periodic image counters */
+    gr_event *ev;
+    gr_heap heap;
+
+    /* cell grid */
+    int nc[3];
+    double w[3];
+    int32_t ncells;
+    int32_t *cc;          /* n * dim cell coordinates */
+    int32_t *head, *next, *prev;
+    int32_t *nb_cell[3];  /* [axis][3*c + d+1]: neighbouring coordinate or -1 */
+    double *nb_shift[3];  /* [axis][3*c + d+1]: image shift in box lengths' units */
+
+    /* time and counters */
+    double t, eps_t;
+    double t_prev_event;
+    int64_t same_instant;
+    int64_t events, pair, wall, crossings, invalid, elastic_tc;
+    double virial, wall_impulse, kinetic;
+};
+
+/* Consecutive collisions of one particle, each within eps_t of the previous, that are
+ * taken as inelastic collapse.  A gas never comes near this by chance (each such
+ * collision has a probability of order 1e-9). */
+#define GR_COLLAPSE_STREAK 1000
+
+static inline double *rec(const gr_edmd *s, int32_t i) { return s->P + (size_t)i * s->stride; }
+
+static inline void cell_insert(gr_edmd *s, int32_t i, int32_t c)
+{
+    s->prev[i] = -1;
+    s->next[i] = s->head[c];
+    if (s->head[c] >= 0) s->prev[s->head[c]] = i;
+    s->head[c] = i;
+}
+
+static inline void cell_remove(gr_edmd *s, int32_t i, int32_t c)
+{
+    if (s->prev[i] >= 0) s->next[s->prev[i]] = s->next[i];
+    else s->head[c] = s->next[i];
+    if (s->next[i] >= 0) s->prev[s->next[i]] = s->prev[i];
+}
+
+#define DIM 2
+#define FN(name) name##_2d
+#include "edmd_dim.h"
+#undef DIM
+#undef FN
+#define DIM 3
+#define FN(name) name##_3d
+#include "edmd_dim.h"
+#undef DIM
+#undef FN
+
+void gr_edmd_free(gr_edmd *s)
+{
+    if (!s) return;
+    free(s->P);
+    free(s->mass);
+    free(s->count);
+    free(s->image);
+    free(s->ev);
+    gr_heap_free(&s->heap);
+    free(s->cc);
+    free(s->head);
+    free(s->next);
+    free(s->prev);
+    for (int a = 0; a < 3; a++) {
+        free(s->nb_cell[a]);
+        free(s->nb_shift[a]);
+    }
+    free(s);
+}
+
+/* Choose the cell grid: cells at least cell_factor largest diameters wide, and not more
+ * cells than a few per particle (a dilute gas in a big box must not allocate a huge
+ * empty grid; wider cells are always correct, only slower to scan). */
+static int build_grid(gr_edmd *s, double sigma_max)
+{
+    const int d = s->dim;
+    double wmin = sigma_max * s->cfg.cell_factor;
+    double cap = 8.0 * (double)s->n + 64.0;
+    for (int iter = 0; iter < 64; iter++) {
+        double total = 1.0;
+        for (int a = 0; a < d; a++) {
+            double k = floor(s->L[a] / wmin);
+            if (!(k >= 1.0)) k = 1.0;
+            if (k > 1e6) k = 1e6;
+            s->nc[a] = (int)k;
+            total *= k;
+        }
+        if (total <= cap) break;
+        wmin *= pow(total / cap, 1.0 / d) * 1.0001;
+    }
+    s->ncells = 1;
+    for (int a = 0; a < 3; a++) {
+        if (a >= d) { s->nc[a] = 1; s->w[a] = 1.0; continue; }
+        s->w[a] = s->L[a] / s->nc[a];
+        s->ncells *= s->nc[a];
+    }
+    s->head = malloc((size_t)s->ncells * sizeof *s->head);
+    if (!s->head) return GR_ERR_NOMEM;
+    for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;
+    for (int a = 0; a < d; a++) {
+        int m = s->nc[a];
+        s->nb_cell[a] = malloc((size_t)3 * m * sizeof(int32_t));
+        s->nb_shift[a] = malloc((size_t)3 * m * sizeof(double));
+        if (!s->nb_cell[a] || !s->nb_shift[a]) return GR_ERR_NOMEM;
+        for (int c = 0; c < m; c++) {
+            for (int dd = -1; dd <= 1; dd++) {
+                int q = c + dd;
+                double shift = 0.0;
+                if (q < 0 || q >= m) {
+                    if (!s->cfg.periodic) { q = -1; }
+                    else if (q < 0) { q += m; shift = -s->L[a]; }
+                    else { q -= m; shift = s->L[a]; }
+                }
+                s->nb_cell[a][3 * c + dd + 1] = q;
+                s->nb_shift[a][3 * c + dd + 1] = shift;
+            }
+        }
+    }
+    return GR_OK;
+}
+
+int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
+                const double *vel, const double *radius, const double *mass, gr_error *err)
+{
+    *out = NULL;
+    const int d = cfg->dim;
+    if (d != 2 && d != 3) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, d, "dim must be 2 or 3");
+        return GR_ERR_VALUE;
+    }
+    if (cfg->n < 1 || cfg->n > INT32_MAX / 2) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, (double)cfg->n,
+                     "number of particles must be between 1 and 2^30");
+        return GR_ERR_VALUE;
+    }
+    if (!(cfg->restitution >= 0.0 && cfg->restitution <= 1.0)) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->restitution,
+                     "restitution must lie in [0, 1]");
+        return GR_ERR_VALUE;
+    }
+    if (!(cfg->wall_restitution > 0.0 && isfinite(cfg->wall_restitution))) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->wall_restitution,
+                     "wall restitution must be positive and finite");
+        return GR_ERR_VALUE;
+    }
+    if (!(cfg->contact_duration >= 0.0 && isfinite(cfg->contact_duration))) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->contact_duration,
+                     "contact duration must be finite and >= 0");
+        return GR_ERR_VALUE;
+    }
+    if (!(cfg->cell_factor >= 1.0 && isfinite(cfg->cell_factor))) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->cell_factor,
+                     "cell_factor must be >= 1");
+        return GR_ERR_VALUE;
+    }
+    const int32_t n = (int32_t)cfg->n;
+    double sigma_max = 0.0, sigma_min = INFINITY;
+    for (int32_t i = 0; i < n; i++) {
+        if (!(radius[i] > 0.0 && isfinite(radius[i]))) {
+            gr_error_set(err, GR_ERR_VALUE, i, -1, NAN, radius[i], "radii must be positive and finite");
+            return GR_ERR_VALUE;
+        }
+        if (!(mass[i] > 0.0 && isfinite(mass[i]))) {
+            gr_error_set(err, GR_ERR_VALUE, i, -1, NAN, mass[i], "masses must be positive and finite");
+            return GR_ERR_VALUE;
+        }
+        for (int a = 0; a < d; a++) {
+            if (!isfinite(pos[i * d + a]) || !isfinite(vel[i * d + a])) {
+                gr_error_set(err, GR_ERR_NONFINITE, i, -1, NAN, NAN, "in the initial positions or velocities");
+                return GR_ERR_NONFINITE;
+            }
+        }
+        if (2.0 * radius[i] > sigma_max) sigma_max = 2.0 * radius[i];
+        if (2.0 * radius[i] < sigma_min) sigma_min = 2.0 * radius[i];
+    }
+    for (int a = 0; a < d; a++) {
+        double L = cfg->hi[a] - cfg->lo[a];
+        if (!(L > 0.0 && isfinite(L) && isfinite(cfg->lo[a]))) {
+            gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, L, "the box needs lower < upper, finite, on every axis");
+            return GR_ERR_VALUE;
+        }
+        if (cfg->periodic && !(L > 2.0 * sigma_max)) {
+            gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, L,
+                         "a periodic box must be more than two largest diameters wide on every axis");
+            return GR_ERR_VALUE;
+        }
+        if (!cfg->periodic && !(L >= sigma_max)) {
+            gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, L,
+                         "the box is narrower than the largest particle");
+            return GR_ERR_VALUE;
+        }
+    }
+    for (int32_t i = 0; i < n; i++) {
+        for (int a = 0; a < d; a++) {
+            double x = pos[i * d + a];
+            double lo = cfg->lo[a], hi = cfg->hi[a];
+            /* walls: the whole disk inside (a relative 1e-12 of slack for rounding);
+             * periodic: the centre inside. */
+            double slack = 1e-12 * (hi - lo);
+            int out = cfg->periodic ? (x < lo || x > hi)
+                                    : (x - radius[i] < lo - slack || x + radius[i] > hi + slack);
+            if (out) {
+                gr_error_set(err, GR_ERR_OUTSIDE, i, -1, NAN, x,
+                             cfg->periodic ? "its centre is outside [lower, upper]"
+                                           : "it crosses a wall");
+                return GR_ERR_OUTSIDE;
+            }
+        }
+    }
+
+    gr_edmd *s = calloc(1, sizeof *s);
+    if (!s) return GR_ERR_NOMEM;
+    s->cfg = *cfg;
+    s->dim = d;
+    s->stride = 2 * d + 2;
+    s->n = n;
+    for (int a = 0; a < 3; a++) s->L[a] = a < d ? cfg->hi[a] - cfg->lo[a] : 1.0;
+    size_t bytes = ((size_t)n * s->stride * sizeof(double) + 63) / 64 * 64;
+    void *mem = NULL; /* records on cache-line boundaries: a 3D record is one line */
+    s->P = posix_memalign(&mem, 64, bytes) == 0 ? mem : NULL;
+    s->mass = malloc((size_t)n * sizeof *s->mass);
+    s->count = calloc((size_t)n, sizeof *s->count);
+    s->image = calloc((size_t)n * d, sizeof *s->image);
+    s->ev = malloc((size_t)n * sizeof *s->ev);
+    s->cc = malloc((size_t)n * d * sizeof *s->cc);
+    s->next = malloc((size_t)n * sizeof *s->next);
+    s->prev = malloc((size_t)n * sizeof *s->prev);
+    int status = GR_OK;
+    if (!s->P || !s->mass || !s->count || !s->image || !s->ev || !s->cc || !s->next || !s->prev)
+        status = GR_ERR_NOMEM;
+    if (status == GR_OK) status = gr_heap_init(&s->heap, n);
+    if (status == GR_OK) status = build_grid(s, sigma_max);
+    if (status != GR_OK) {
+        gr_edmd_free(s);
+        return status;
+    }
+
+    double v2m = 0.0, msum = 0.0;
+    for (int32_t i = 0; i < n; i++) {
+        double *p = rec(s, i);
+        for (int a = 0; a < d; a++) {
+            p[a] = pos[i * d + a];
+            p[d + a] = vel[i * d + a];
+            v2m += mass[i] * vel[i * d + a] * vel[i * d + a];
+        }
+        p[2 * d] = 0.0;
+        p[2 * d + 1] = radius[i];
+        s->mass[i] = mass[i];
+        msum += mass[i];
+        s->ev[i].t_last = -INFINITY;
+        s->ev[i].streak = 0;
+    }
+    s->kinetic = 0.5 * v2m;
+    /* The collapse test's notion of "one instant": a billionth of the time a particle
+     * of typical speed needs to cross the smallest diameter. */
+    double vrms = sqrt(v2m / msum);
+    s->eps_t = vrms > 0.0 ? 1e-9 * sigma_min / vrms : 0.0;
+    s->t_prev_event = -INFINITY;
+
+    status = d == 2 ? setup_2d(s, err) : setup_3d(s, err);
+    if (status != GR_OK) {
+        gr_edmd_free(s);
+        return status;
+    }
+    *out = s;
+    return GR_OK;
+}
+
+int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
+{
+    return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
+}
+
+void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image)
+{
+    const int d = s->dim;
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *p = rec(s, i);
+        double dt = s->t - p[2 * d];
+        for (int a = 0; a < d; a++) {
+            double x = p[a] + p[d + a] * dt;
+            int64_t img = s->image[(size_t)i * d + a];
+            if (s->cfg.periodic) {
+                /* a crossing due exactly now may not have been processed yet */
+                if (x >= s->cfg.hi[a]) { x -= s->L[a]; img++; }
+                else if (x < s->cfg.lo[a]) { x += s->L[a]; img--; }
+            }
+            if (pos) pos[(size_t)i * d + a] = x;
+            if (vel) vel[(size_t)i * d + a] = p[d + a];
+            if (image) image[(size_t)i * d + a] = img;
+        }
+    }
+}
+
+void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
+{
+    c->t = s->t;
+    c->events = s->events;
+    c->pair = s->pair;
+    c->wall = s->wall;
+    c->crossings = s->crossings;
+    c->invalid = s->invalid;
+    c->elastic_tc = s->elastic_tc;
+    c->virial = s->virial;
+    c->wall_impulse = s->wall_impulse;
+    double k = 0.0;
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *p = rec(s, i);
+        double v2 = 0.0;
+        for (int a = 0; a < s->dim; a++) v2 += p[s->dim + a] * p[s->dim + a];
+        k += 0.5 * s->mass[i] * v2;
+    }
+    c->kinetic = k;
+    for (int a = 0; a < 3; a++) c->ncell[a] = s->nc[a];
+}

@@ -1,0 +1,439 @@
+/* edmd_dim.h -- the event-driven loop, specialised for one dimension.
+ *
+ * Included twice by edmd.c, with DIM = 2 and DIM = 3 and FN(name) appending _2d / _3d,
+ * so that a 2D scene never pays for a third dimension and every loop over axes has a
+ * constant trip count.  Reading order: neighbours -> predict -> events -> advance.
+ *
+ * A particle record is P[i*stride ...] = x[DIM] v[DIM] t r: position at the particle's own
+ * time t, velocity, radius.  Times are absolute. */
+
+#define X(p) (p)
+#define V(p) ((p) + DIM)
+#define T(p) ((p)[2 * DIM])
+#define R(p) ((p)[2 * DIM + 1])
+
+typedef struct {
+    int32_t cell;
+    double shift[DIM];
+} FN(nbr);
+
+/* The cells adjacent to cell coordinates c (itself included), with the image shift to add
+ * to positions found there.  With axis >= 0 only the layer at offset dir along that axis
+ * (the cells that become adjacent when crossing in that direction).  Returns the count. */
+static inline int FN(neighbours)(const gr_edmd *s, const int32_t *c, int axis, int dir,
+                                 FN(nbr) *out)
+{
+    int k = 0;
+#if DIM == 3
+    for (int d2 = -1; d2 <= 1; d2++) {
+        if (axis == 2 && d2 != dir) continue;
+        int32_t q2 = s->nb_cell[2][3 * c[2] + d2 + 1];
+        if (q2 < 0) continue;
+        double sh2 = s->nb_shift[2][3 * c[2] + d2 + 1];
+#else
+    {
+        const int32_t q2 = 0;
+#endif
+        for (int d1 = -1; d1 <= 1; d1++) {
+            if (axis == 1 && d1 != dir) continue;
+            int32_t q1 = s->nb_cell[1][3 * c[1] + d1 + 1];
+            if (q1 < 0) continue;
+            double sh1 = s->nb_shift[1][3 * c[1] + d1 + 1];
+            for (int d0 = -1; d0 <= 1; d0++) {
+                if (axis == 0 && d0 != dir) continue;
+                int32_t q0 = s->nb_cell[0][3 * c[0] + d0 + 1];
+                if (q0 < 0) continue;
+                out[k].cell = (q2 * s->nc[1] + q1) * s->nc[0] + q0;
+                out[k].shift[0] = s->nb_shift[0][3 * c[0] + d0 + 1];
+                out[k].shift[1] = sh1;
+#if DIM == 3
+                out[k].shift[2] = sh2;
+#endif
+                k++;
+            }
+        }
+    }
+    return k;
+}
+
+static inline int32_t FN(cell_of)(const gr_edmd *s, const int32_t *c)
+{
+#if DIM == 3
+    return (c[2] * s->nc[1] + c[1]) * s->nc[0] + c[0];
+#else
+    return c[1] * s->nc[0] + c[0];
+#endif
+}
+
+static inline void FN(move)(double *p, double t)
+{
+    double dt = t - T(p);
+    for (int a = 0; a < DIM; a++) X(p)[a] += V(p)[a] * dt;
+    T(p) = t;
+}
+
+/* Look for pair collisions of i (whose clock is at t) with the particles in the given
+ * neighbour cells; keep the earliest in i's event if it beats the one there. */
+static inline void FN(scan)(gr_edmd *s, int32_t i, const FN(nbr) *nb, int count)
+{
+    const double *p = rec(s, i);
+    const double t = T(p), ri = R(p);
+    gr_event *e = &s->ev[i];
+    double best = e->t_coll - t;
+    int32_t partner = -1;
+    for (int k = 0; k < count; k++) {
+        for (int32_t j = s->head[nb[k].cell]; j >= 0; j = s->next[j]) {
+            if (j == i) continue;
+            const double *q = rec(s, j);
+            double dtj = t - T(q), dr[DIM], dv[DIM];
+            for (int a = 0; a < DIM; a++) {
+                dr[a] = X(q)[a] + V(q)[a] * dtj + nb[k].shift[a] - X(p)[a];
+                dv[a] = V(q)[a] - V(p)[a];
+            }
+            double dt = gr_pair_time(DIM, dr, dv, ri + R(q), best);
+            if (dt < best) {
+                best = dt;
+                partner = j;
+            }
+        }
+    }
+    if (partner >= 0) {
+        e->t_coll = t + best;
+        e->partner = partner;
+        e->pcount = s->count[partner];
+    }
+}
+
+/* Next cell crossing of i from its current position, cell and velocity. */
+static inline void FN(predict_cross)(gr_edmd *s, int32_t i)
+{
+    const double *p = rec(s, i);
+    const int32_t *c = s->cc + (size_t)i * DIM;
+    double best = INFINITY;
+    int32_t code = -1;
+    for (int a = 0; a < DIM; a++) {
+        double v = V(p)[a], bound;
+        if (v > 0.0) {
+            if (!s->cfg.periodic && c[a] == s->nc[a] - 1) continue;
+            bound = s->cfg.lo[a] + (c[a] + 1) * s->w[a];
+        } else if (v < 0.0) {
+            if (!s->cfg.periodic && c[a] == 0) continue;
+            bound = s->cfg.lo[a] + c[a] * s->w[a];
+        } else {
+            continue;
+        }
+        double dt = (bound - X(p)[a]) / v;
+        if (dt < 0.0) dt = 0.0; /* rounding left it a hair past the boundary */
+        if (dt < best) {
+            best = dt;
+            code = 2 * a + (v > 0.0);
+        }
+    }
+    s->ev[i].t_cross = T(p) + best;
+    s->ev[i].cross = code;
+}
+
+static inline void FN(schedule)(gr_edmd *s, int32_t i)
+{
+    const gr_event *e = &s->ev[i];
+    gr_heap_update(&s->heap, i, e->t_coll < e->t_cross ? e->t_coll : e->t_cross);
+}
+
+/* Full prediction for i, whose clock must be the current time: walls, all adjacent
+ * cells, the next crossing. */
+static void FN(predict)(gr_edmd *s, int32_t i)
+{
+    const double *p = rec(s, i);
+    gr_event *e = &s->ev[i];
+    e->t_coll = INFINITY;
+    e->partner = -1;
+    if (!s->cfg.periodic) {
+        double best = INFINITY;
+        int32_t wall = -1;
+        for (int a = 0; a < DIM; a++) {
+            double v = V(p)[a], dt;
+            if (v > 0.0) dt = (s->cfg.hi[a] - R(p) - X(p)[a]) / v;
+            else if (v < 0.0) dt = (s->cfg.lo[a] + R(p) - X(p)[a]) / v;
+            else continue;
+            if (dt < 0.0) dt = 0.0;
+            if (dt < best) {
+                best = dt;
+                wall = 2 * a + (v > 0.0);
+            }
+        }
+        if (wall >= 0) {
+            e->t_coll = T(p) + best;
+            e->partner = -2 - wall;
+        }
+    }
+    FN(nbr) nb[DIM == 3 ? 27 : 9];
+    int count = FN(neighbours)(s, s->cc + (size_t)i * DIM, -1, 0, nb);
+    FN(scan)(s, i, nb, count);
+    FN(predict_cross)(s, i);
+    FN(schedule)(s, i);
+}
+
+/* Collapse bookkeeping for a collision of i at t: count collisions that follow the
+ * previous one of the same particle within eps_t. */
+static inline int FN(streak)(gr_edmd *s, int32_t i, double t)
+{
+    gr_event *e = &s->ev[i];
+    if (t - e->t_last <= s->eps_t) e->streak++;
+    else e->streak = 0;
+    e->t_last = t;
+    return e->streak > GR_COLLAPSE_STREAK;
+}
+
+static int FN(do_cross)(gr_edmd *s, int32_t i, double t)
+{
+    double *p = rec(s, i);
+    gr_event *e = &s->ev[i];
+    int32_t *c = s->cc + (size_t)i * DIM;
+    const int a = e->cross >> 1, dir = (e->cross & 1) ? 1 : -1;
+    FN(move)(p, t);
+    int32_t old = FN(cell_of)(s, c);
+    int32_t q = c[a] + dir;
+    if (q >= s->nc[a]) {
+        q = 0;
+        X(p)[a] -= s->L[a];
+        s->image[(size_t)i * DIM + a]++;
+    } else if (q < 0) {
+        q = s->nc[a] - 1;
+        X(p)[a] += s->L[a];
+        s->image[(size_t)i * DIM + a]--;
+    }
+    c[a] = q;
+    cell_remove(s, i, old);
+    cell_insert(s, i, FN(cell_of)(s, c));
+    s->crossings++;
+    FN(predict_cross)(s, i);
+    FN(nbr) nb[DIM == 3 ? 9 : 3];
+    int count = FN(neighbours)(s, c, a, dir, nb);
+    FN(scan)(s, i, nb, count);
+    FN(schedule)(s, i);
+    return GR_OK;
+}
+
+static inline double FN(kinetic_of)(const gr_edmd *s, int32_t i)
+{
+    const double *v = V(rec(s, i));
+    double v2 = 0.0;
+    for (int a = 0; a < DIM; a++) v2 += v[a] * v[a];
+    return 0.5 * s->mass[i] * v2;
+}
+
+static int FN(do_pair)(gr_edmd *s, int32_t i, int32_t j, double t, gr_error *err)
+{
+    double *p = rec(s, i), *q = rec(s, j);
+    FN(move)(p, t);
+    FN(move)(q, t);
+    double dr[DIM];
+    for (int a = 0; a < DIM; a++) {
+        dr[a] = X(q)[a] - X(p)[a];
+        if (s->cfg.periodic) { /* contact distance < L/2, so the nearest image is the one */
+            if (dr[a] > 0.5 * s->L[a]) dr[a] -= s->L[a];
+            else if (dr[a] < -0.5 * s->L[a]) dr[a] += s->L[a];
+        }
+    }
+    double xi = s->cfg.restitution;
+    if (s->cfg.contact_duration > 0.0 && xi < 1.0 &&
+        (t - s->ev[i].t_last < s->cfg.contact_duration ||
+         t - s->ev[j].t_last < s->cfg.contact_duration)) {
+        xi = 1.0; /* TC model: within t_c of a previous collision, collide elastically */
+        s->elastic_tc++;
+    }
+    double before = FN(kinetic_of)(s, i) + FN(kinetic_of)(s, j);
+    double vir = gr_pair_collide(DIM, dr, V(p), V(q), s->mass[i], s->mass[j], xi);
+    if (vir < 0.0) { /* grazing: no longer approaching at contact after rounding */
+        s->invalid++;
+        FN(predict)(s, i);
+        FN(predict)(s, j);
+        return GR_OK;
+    }
+    s->kinetic += FN(kinetic_of)(s, i) + FN(kinetic_of)(s, j) - before;
+    s->virial += vir;
+    s->pair++;
+    s->count[i]++;
+    s->count[j]++;
+    int collapse_i = FN(streak)(s, i, t), collapse_j = FN(streak)(s, j, t);
+    if (collapse_i || collapse_j) {
+        gr_error_set(err, GR_ERR_COLLAPSE, i, j, t, (double)GR_COLLAPSE_STREAK,
+                     "over 1000 successive collisions of one particle within 1e-9 of a "
+                     "free-flight time of each other");
+        FN(predict)(s, i);
+        FN(predict)(s, j);
+        return GR_ERR_COLLAPSE;
+    }
+    FN(predict)(s, i);
+    FN(predict)(s, j);
+    return GR_OK;
+}
+
+static int FN(do_wall)(gr_edmd *s, int32_t i, int wall, double t, gr_error *err)
+{
+    double *p = rec(s, i);
+    const int a = wall >> 1, up = wall & 1;
+    FN(move)(p, t);
+    double before = FN(kinetic_of)(s, i), vn = V(p)[a];
+    double ew = s->cfg.wall_restitution;
+    if (ew < 1.0 && s->cfg.contact_duration > 0.0 && t - s->ev[i].t_last < s->cfg.contact_duration)
+        ew = 1.0;
+    V(p)[a] = -V(p)[a];
+    if (ew != 1.0)
+        for (int k = 0; k < DIM; k++) V(p)[k] *= ew; /* law of reflection kept (2.22) */
+    X(p)[a] = up ? s->cfg.hi[a] - R(p) : s->cfg.lo[a] + R(p);
+    for (int k = 0; k < DIM; k++) {
+        if (!isfinite(V(p)[k])) {
+            gr_error_set(err, GR_ERR_NONFINITE, i, -1, t, V(p)[k], "a velocity after a heated wall");
+            return GR_ERR_NONFINITE;
+        }
+    }
+    s->wall_impulse += s->mass[i] * (fabs(vn) + fabs(V(p)[a]));
+    s->kinetic += FN(kinetic_of)(s, i) - before;
+    s->wall++;
+    s->count[i]++;
+    if (FN(streak)(s, i, t)) {
+        gr_error_set(err, GR_ERR_COLLAPSE, i, -1, t, (double)GR_COLLAPSE_STREAK,
+                     "over 1000 successive wall collisions within 1e-9 of a free-flight time");
+        FN(predict)(s, i);
+        return GR_ERR_COLLAPSE;
+    }
+    FN(predict)(s, i);
+    return GR_OK;
+}
+
+static void FN(write_sample)(gr_edmd *s, gr_edmd_samples *smp, double ts)
+{
+    const int64_t k = smp->next;
+    const size_t base = (size_t)k * s->n * DIM;
+    double kin = 0.0, mom[DIM];
+    for (int a = 0; a < DIM; a++) mom[a] = 0.0;
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *p = rec(s, i);
+        const double dt = ts - T(p), m = s->mass[i];
+        for (int a = 0; a < DIM; a++) {
+            double v = V(p)[a];
+            if (smp->pos)
+                smp->pos[base + (size_t)i * DIM + a] =
+                    X(p)[a] + v * dt + (double)s->image[(size_t)i * DIM + a] * s->L[a];
+            if (smp->vel) smp->vel[base + (size_t)i * DIM + a] = v;
+            mom[a] += m * v;
+            kin += 0.5 * m * v * v;
+        }
+    }
+    if (smp->kinetic) smp->kinetic[k] = kin;
+    if (smp->momentum)
+        for (int a = 0; a < DIM; a++) smp->momentum[(size_t)k * DIM + a] = mom[a];
+    if (smp->pair) smp->pair[k] = s->pair;
+    if (smp->wall) smp->wall[k] = s->wall;
+    if (smp->virial) smp->virial[k] = s->virial;
+    if (smp->wall_impulse) smp->wall_impulse[k] = s->wall_impulse;
+    smp->next = k + 1;
+}
+
+static int FN(setup)(gr_edmd *s, gr_error *err)
+{
+    const int32_t n = s->n;
+    for (int32_t i = 0; i < n; i++) {
+        const double *p = rec(s, i);
+        int32_t *c = s->cc + (size_t)i * DIM;
+        for (int a = 0; a < DIM; a++) {
+            double f = floor((X(p)[a] - s->cfg.lo[a]) / s->w[a]);
+            int32_t q = f < 0.0 ? 0 : f >= s->nc[a] ? s->nc[a] - 1 : (int32_t)f;
+            c[a] = q;
+        }
+        cell_insert(s, i, FN(cell_of)(s, c));
+    }
+    /* Overlaps, O(N) through the cells.  Pairs touching to within a relative 1e-10 are
+     * accepted (a configuration built at contact rounds either way); if they approach,
+     * the engine collides them at once. */
+    FN(nbr) nb[DIM == 3 ? 27 : 9];
+    for (int32_t i = 0; i < n; i++) {
+        const double *p = rec(s, i);
+        int count = FN(neighbours)(s, s->cc + (size_t)i * DIM, -1, 0, nb);
+        for (int k = 0; k < count; k++) {
+            for (int32_t j = s->head[nb[k].cell]; j >= 0; j = s->next[j]) {
+                if (j <= i) continue;
+                const double *q = rec(s, j);
+                double d2 = 0.0;
+                for (int a = 0; a < DIM; a++) {
+                    double d = X(q)[a] + nb[k].shift[a] - X(p)[a];
+                    d2 += d * d;
+                }
+                double sigma = (R(p) + R(q)) * (1.0 - 1e-10);
+                if (d2 < sigma * sigma) {
+                    gr_error_set(err, GR_ERR_OVERLAP, i, j, 0.0, R(p) + R(q) - sqrt(d2),
+                                 "in the initial configuration");
+                    return GR_ERR_OVERLAP;
+                }
+            }
+        }
+    }
+    for (int32_t i = 0; i < n; i++) FN(predict)(s, i);
+    return GR_OK;
+}
+
+static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
+{
+    const double t_stop = stop->t_stop;
+    const int64_t n = s->n;
+    /* events at one instant beyond this are a pile-up (every particle crossing a cell
+     * wall at once, as a moving lattice does, is still well below it) */
+    const int64_t pileup = 16 * n + 1000;
+    for (int64_t k = 0;; k++) {
+        if (k >= stop->max_events) return GR_STOP_BUDGET;
+        const int32_t i = gr_heap_top(&s->heap);
+        const double te = gr_heap_top_time(&s->heap);
+        if (te != te) {
+            gr_error_set(err, GR_ERR_NONFINITE, i, -1, s->t, te, "an event time");
+            return GR_ERR_NONFINITE;
+        }
+        while (smp && smp->next < smp->count && smp->times[smp->next] <= te &&
+               smp->times[smp->next] <= t_stop) {
+            double ts = smp->times[smp->next];
+            FN(write_sample)(s, smp, ts);
+            if (ts > s->t) s->t = ts;
+        }
+        if (te > t_stop) {
+            if (t_stop > s->t) s->t = t_stop;
+            return GR_STOP_TIME;
+        }
+        if (te == INFINITY) return GR_STOP_IDLE;
+        if (te <= s->t_prev_event) {
+            if (++s->same_instant > pileup) {
+                gr_error_set(err, GR_ERR_COLLAPSE, i, s->ev[i].partner, te, (double)pileup,
+                             "events pile up at one instant");
+                return GR_ERR_COLLAPSE;
+            }
+        } else {
+            s->same_instant = 0;
+            s->t_prev_event = te;
+        }
+        s->t = te;
+        s->events++;
+        gr_event *e = &s->ev[i];
+        int status = GR_OK;
+        if (e->t_cross < e->t_coll) {
+            status = FN(do_cross)(s, i, te);
+        } else if (e->partner >= 0) {
+            if (s->count[e->partner] != e->pcount) { /* partner collided since: stale */
+                s->invalid++;
+                FN(move)(rec(s, i), te);
+                FN(predict)(s, i);
+                continue;
+            }
+            status = FN(do_pair)(s, i, e->partner, te, err);
+        } else {
+            status = FN(do_wall)(s, i, -2 - e->partner, te, err);
+        }
+        if (status != GR_OK) return status;
+        if ((double)(2 * s->pair + s->wall) >= stop->collisions_per_particle * (double)n)
+            return GR_STOP_COLLISIONS;
+        if (s->kinetic <= stop->kinetic_energy * (double)n) return GR_STOP_ENERGY;
+    }
+}
+
+#undef X
+#undef V
+#undef T
+#undef R
