@@ -2,7 +2,18 @@
 
 Event-driven molecular dynamics and Langevin models with a C core, and the analysis
 that checks them against theory.
+
+>>> import granular
+>>> scene = granular.Scene.random(1000, 0.025, restitution=0.8, seed=1)
+>>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 from . import errors
+from .errors import (GranularError, InelasticCollapseError, NonFiniteError, OutsideBoxError,
+                     OverlapError, UnstableStepError)
+from .scene import Scene
+from .simulation import Simulation
+from .trajectory import Trajectory
 
 __version__ = "0.1.0"
+__all__ = ["Scene", "Simulation", "Trajectory", "errors", "GranularError", "OverlapError",
+           "OutsideBoxError", "InelasticCollapseError", "NonFiniteError", "UnstableStepError"]

@@ -1,0 +1,339 @@
+"""Scenes: the state a simulation starts from, as a validated value object."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+BOUNDARIES = ("periodic", "walls")
+
+# Random sequential addition jams near these packing fractions (3D ~0.38, 2D ~0.55);
+# above a safe fraction of them Scene.random places on a lattice and melts it instead.
+_RSA_LIMIT = {2: 0.40, 3: 0.28}
+_LATTICE_MELT_COLLISIONS = 20.0
+
+
+def _box_corners(box, dim):
+    """(lower, upper) float64 arrays of length dim from a scalar L, a pair (lo, hi) of
+    scalars or a pair of length-dim arrays."""
+    if np.ndim(box) == 0:
+        lo, hi = np.zeros(dim), np.full(dim, float(box))
+    else:
+        if len(box) != 2:
+            raise ValueError("box must be a length L, or a pair (lower, upper)")
+        lo = np.broadcast_to(np.asarray(box[0], dtype=np.float64), (dim,)).copy()
+        hi = np.broadcast_to(np.asarray(box[1], dtype=np.float64), (dim,)).copy()
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
+        raise ValueError(f"box needs finite lower < upper on every axis, got {lo} and {hi}")
+    return lo, hi
+
+
+def _array(value, name, shape):
+    a = np.array(value, dtype=np.float64, order="C", copy=True)
+    if a.shape != shape:
+        if a.ndim == 0 and len(shape) == 1:
+            a = np.full(shape, float(a))
+        else:
+            raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} contains NaN or infinity")
+    a.setflags(write=False)
+    return a
+
+
+class Scene:
+    """Hard disks (2D) or hard spheres (3D) in a box: positions, velocities, radii, masses.
+
+    Parameters
+    ----------
+    positions, velocities : array_like, shape (N, d), d = 2 or 3
+    radii : float or array_like (N,)
+    masses : float or array_like (N,), default 1
+    box : float, or (lower, upper) with scalars or length-d arrays
+        A float L means the box [0, L]^d (the thesis' unit box is ``box=1``).
+    boundary : {"periodic", "walls"}
+    wall_restitution : float
+        Walls reflect with ``v' = e_w * (v mirrored)`` (thesis eq. 2.22): 1 elastic, < 1
+        inelastic, > 1 "heated".  Ignored for periodic boxes.
+    restitution : float in [0, 1]
+        Coefficient of restitution xi of pair collisions (thesis 2.10-2.11).
+    contact_duration : float >= 0
+        TC model t_c (thesis 3.6): a collision within t_c of a particle's previous one is
+        elastic, which prevents inelastic collapse.  0 turns it off.
+
+    A Scene is immutable (its arrays are read-only) and is checked on construction:
+    shapes, finite numbers, positive radii and masses, particles inside the box, and no
+    two particles overlapping (``OverlapError`` names the pair).
+    """
+
+    def __init__(self, positions, velocities, radii, masses=1.0, *, box=1.0,
+                 boundary="periodic", wall_restitution=1.0, restitution=1.0,
+                 contact_duration=0.0):
+        pos = np.asarray(positions, dtype=np.float64)
+        if pos.ndim != 2 or pos.shape[1] not in (2, 3) or pos.shape[0] < 1:
+            raise ValueError(f"positions must have shape (N, 2) or (N, 3) with N >= 1, got {pos.shape}")
+        n, d = pos.shape
+        self.positions = _array(pos, "positions", (n, d))
+        self.velocities = _array(velocities, "velocities", (n, d))
+        self.radii = _array(radii, "radii", (n,))
+        self.masses = _array(masses, "masses", (n,))
+        if np.any(self.radii <= 0):
+            raise ValueError(f"radii must be positive (particle {int(np.argmin(self.radii))})")
+        if np.any(self.masses <= 0):
+            raise ValueError(f"masses must be positive (particle {int(np.argmin(self.masses))})")
+        self.lower, self.upper = _box_corners(box, d)
+        self.lower.setflags(write=False)
+        self.upper.setflags(write=False)
+        if boundary not in BOUNDARIES:
+            raise ValueError(f"boundary must be one of {BOUNDARIES}, got {boundary!r}")
+        self.boundary = boundary
+        self.wall_restitution = float(wall_restitution)
+        if not (self.wall_restitution > 0 and math.isfinite(self.wall_restitution)):
+            raise ValueError(f"wall_restitution must be positive and finite, got {wall_restitution}")
+        self.restitution = float(restitution)
+        if not 0.0 <= self.restitution <= 1.0:
+            raise ValueError(f"restitution must lie in [0, 1], got {restitution}")
+        self.contact_duration = float(contact_duration)
+        if not (self.contact_duration >= 0 and math.isfinite(self.contact_duration)):
+            raise ValueError(f"contact_duration must be finite and >= 0, got {contact_duration}")
+        # The engine's constructor checks the geometry (inside the box, overlaps, a
+        # periodic box wide enough) in O(N) through its cell grid.
+        self._engine()
+
+    # -- derived quantities ---------------------------------------------------------
+    @property
+    def n(self):
+        """Number of particles."""
+        return self.positions.shape[0]
+
+    @property
+    def dim(self):
+        """Dimension, 2 or 3."""
+        return self.positions.shape[1]
+
+    @property
+    def lengths(self):
+        """Box edge lengths, shape (d,)."""
+        return self.upper - self.lower
+
+    @property
+    def volume(self):
+        """Box volume (area in 2D)."""
+        return float(np.prod(self.lengths))
+
+    @property
+    def density(self):
+        """Number density N / V."""
+        return self.n / self.volume
+
+    @property
+    def packing_fraction(self):
+        """Fraction of the box covered by particles (eta, thesis 2.44)."""
+        r = self.radii
+        unit = math.pi * r**2 if self.dim == 2 else 4.0 / 3.0 * math.pi * r**3
+        return float(unit.sum() / self.volume)
+
+    @property
+    def kinetic_energy(self):
+        """Total kinetic energy."""
+        return float(0.5 * np.sum(self.masses[:, None] * self.velocities**2))
+
+    @property
+    def temperature(self):
+        """Granular temperature T = 2 <E_kin> / d per particle (k_B = 1)."""
+        return 2.0 * self.kinetic_energy / (self.dim * self.n)
+
+    def replace(self, **changes):
+        """A copy with some fields changed, e.g. ``scene.replace(restitution=0.8)``."""
+        fields = dict(positions=self.positions, velocities=self.velocities, radii=self.radii,
+                      masses=self.masses, box=(self.lower, self.upper), boundary=self.boundary,
+                      wall_restitution=self.wall_restitution, restitution=self.restitution,
+                      contact_duration=self.contact_duration)
+        unknown = set(changes) - set(fields)
+        if unknown:
+            raise TypeError(f"unknown Scene fields: {sorted(unknown)}")
+        fields.update(changes)
+        positions = fields.pop("positions")
+        velocities = fields.pop("velocities")
+        radii = fields.pop("radii")
+        return Scene(positions, velocities, radii, **fields)
+
+    def __repr__(self):
+        return (f"Scene(n={self.n}, dim={self.dim}, boundary={self.boundary!r}, "
+                f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
+                f"temperature={self.temperature:.4g})")
+
+    def _engine(self, cell_factor=1.0):
+        from . import _core
+
+        return _core.EDMD(self.positions, self.velocities, self.radii, self.masses,
+                          self.lower, self.upper, self.boundary == "periodic",
+                          self.wall_restitution, self.restitution, self.contact_duration,
+                          float(cell_factor))
+
+    # -- constructors ---------------------------------------------------------------
+    @classmethod
+    def random(cls, n, radius, dim=3, box=1.0, boundary="periodic", restitution=1.0, *,
+               speed=None, temperature=None, mass=1.0, wall_restitution=1.0,
+               contact_duration=0.0, remove_drift=True, seed=None):
+        """Particles placed uniformly without overlap, with random velocities.
+
+        Positions: random sequential addition (accepting uniform candidates that overlap
+        nothing), also across periodic images.  Above packing fractions where that jams
+        (about 0.28 in 3D, 0.40 in 2D) particles start on a lattice that an elastic EDMD
+        run melts into an equilibrium fluid; very dense scenes (past the lattice's own
+        limit) raise ValueError.
+
+        Velocities: with ``speed`` (default sqrt(2), the thesis' choice) every particle
+        gets that speed in an isotropic random direction -- a normalised Gaussian vector.
+        (The thesis' eq. 3.3 draws the polar angle uniformly in [0, pi], which is not
+        isotropic: it puts too much speed along z.)  With ``temperature`` velocities are
+        Maxwell-Boltzmann, v_a ~ N(0, T/m).  Then the centre-of-mass velocity is
+        removed (unless ``remove_drift=False`` or N = 1), so speeds are fixed only up
+        to that O(1/sqrt(N)) shift.
+
+        ``seed`` is anything ``numpy.random.SeedSequence`` accepts (or a SeedSequence);
+        the same seed gives the same scene bit for bit.
+        """
+        if dim not in (2, 3):
+            raise ValueError(f"dim must be 2 or 3, got {dim}")
+        n = int(n)
+        if n < 1:
+            raise ValueError(f"n must be >= 1, got {n}")
+        if speed is not None and temperature is not None:
+            raise ValueError("give speed or temperature, not both")
+        radii = np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,)).copy()
+        if not np.all(radii > 0) or not np.all(np.isfinite(radii)):
+            raise ValueError("radius must be positive and finite")
+        masses = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,)).copy()
+        lo, hi = _box_corners(box, dim)
+        if boundary not in BOUNDARIES:
+            raise ValueError(f"boundary must be one of {BOUNDARIES}, got {boundary!r}")
+        ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+        rng_pos, rng_vel, rng_melt = (np.random.default_rng(s) for s in ss.spawn(3))
+
+        volume = float(np.prod(hi - lo))
+        unit = math.pi * radii**2 if dim == 2 else 4.0 / 3.0 * math.pi * radii**3
+        eta = float(unit.sum() / volume)
+        periodic = boundary == "periodic"
+        common = dict(box=(lo, hi), boundary=boundary, wall_restitution=wall_restitution,
+                      restitution=restitution, contact_duration=contact_duration)
+        velocities = _draw_velocities(rng_vel, n, dim, masses, speed, temperature, remove_drift)
+        if eta <= _RSA_LIMIT[dim]:
+            positions = _place_rsa(rng_pos, radii, lo, hi, periodic)
+            if positions is not None:
+                return cls(positions, velocities, radii, masses, **common)
+        positions = _place_lattice(rng_pos, radii, lo, hi, periodic)
+        # Melt the lattice: elastic collisions with thermal velocities, then keep the
+        # positions and give the scene the velocities asked for.
+        from .simulation import Simulation
+
+        melt_v = _draw_velocities(rng_melt, n, dim, masses, None, 1.0, n > 1)
+        hot = cls(positions, melt_v, radii, masses, box=(lo, hi), boundary=boundary)
+        sim = Simulation(hot)
+        sim.run(stop_when={"collisions_per_particle": _LATTICE_MELT_COLLISIONS})
+        return cls(sim.scene.positions, velocities, radii, masses, **common)
+
+    @classmethod
+    def seed_brownian_disks(cls, seed=None):
+        """The 2D Brownian-motion note's scene: 150 elastic hard disks of radius 0.1 and
+        mass 1 between elastic walls at +-3, unit speed in random directions."""
+        return cls.random(150, 0.1, dim=2, box=(-3.0, 3.0), boundary="walls", speed=1.0,
+                          remove_drift=False, seed=seed)
+
+    @classmethod
+    def seed_ideal_gas(cls, n=100, radius=0.01, seed=None):
+        """The lecture notes' ideal gas: elastic spheres in the unit box with reflecting
+        walls and Maxwell-Boltzmann velocities at T = 1."""
+        return cls.random(n, radius, dim=3, box=1.0, boundary="walls", temperature=1.0,
+                          seed=seed)
+
+
+def _draw_velocities(rng, n, dim, masses, speed, temperature, remove_drift):
+    if temperature is not None:
+        if not (temperature >= 0 and math.isfinite(temperature)):
+            raise ValueError(f"temperature must be finite and >= 0, got {temperature}")
+        v = rng.normal(size=(n, dim)) * np.sqrt(temperature / masses)[:, None]
+    else:
+        speed = math.sqrt(2.0) if speed is None else float(speed)
+        if not (speed >= 0 and math.isfinite(speed)):
+            raise ValueError(f"speed must be finite and >= 0, got {speed}")
+        g = rng.normal(size=(n, dim))
+        norm = np.linalg.norm(g, axis=1)
+        norm[norm == 0] = 1.0
+        v = speed * g / norm[:, None]
+    if remove_drift and n > 1:
+        v -= (masses[:, None] * v).sum(axis=0) / masses.sum()
+    return v
+
+
+def _place_rsa(rng, radii, lo, hi, periodic, max_rounds=200):
+    """Random sequential addition in batches, with a k-d tree for the neighbour search.
+    Returns None if it does not finish (too dense)."""
+    from scipy.spatial import cKDTree
+
+    n, dim = len(radii), len(lo)
+    L = hi - lo
+    rmax = float(radii.max())
+    order = np.argsort(-radii, kind="stable")  # big ones first: they are the hard ones
+    placed = np.empty((0, dim))
+    placed_r = np.empty(0)
+    todo = order
+    for _ in range(max_rounds):
+        if len(todo) == 0:
+            break
+        r = radii[todo]
+        inset = np.zeros((len(todo), 1)) if periodic else r[:, None]
+        cand = lo + inset + rng.random((len(todo), dim)) * (L - 2 * inset)
+        ok = np.ones(len(todo), dtype=bool)
+        box = L if periodic else None
+        shift = lambda x: np.mod(x - lo, L) if periodic else x  # noqa: E731
+        if len(placed):
+            tree = cKDTree(shift(placed), boxsize=box)
+            for k, nbrs in enumerate(tree.query_ball_point(shift(cand), r + rmax)):
+                if nbrs:
+                    d = _distance(cand[k], placed[nbrs], L, periodic)
+                    ok[k] = np.all(d >= r[k] + placed_r[nbrs])
+        # among the candidates themselves: the earlier one of a clashing pair wins
+        tree = cKDTree(shift(cand), boxsize=box)
+        for a, b in sorted(tree.query_pairs(2 * rmax)):
+            if ok[a] and ok[b]:
+                if _distance(cand[a], cand[b][None], L, periodic)[0] < r[a] + r[b]:
+                    ok[b] = False
+        placed = np.concatenate([placed, cand[ok]])
+        placed_r = np.concatenate([placed_r, r[ok]])
+        todo = todo[~ok]
+    if len(todo):
+        return None
+    out = np.empty((n, dim))
+    out[order] = placed
+    return out
+
+
+def _distance(x, ys, L, periodic):
+    d = ys - x
+    if periodic:
+        d -= L * np.round(d / L)
+    return np.sqrt((d * d).sum(axis=1))
+
+
+def _place_lattice(rng, radii, lo, hi, periodic):
+    """n sites drawn at random from the densest simple lattice that fits: face-centred
+    cubic in 3D (packing up to 0.74), square in 2D (up to 0.785)."""
+    n, dim = len(radii), len(lo)
+    L = hi - lo
+    sigma = 2 * float(radii.max()) * (1 + 1e-9)
+    basis = (np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]])
+             if dim == 3 else np.zeros((1, 2)))
+    k = max(1, math.ceil((n / len(basis)) ** (1.0 / dim)))
+    cell = (L if periodic else L - sigma) / k  # walls: keep the particles inside
+    nearest = cell.min() / math.sqrt(2) if dim == 3 else cell.min()
+    if nearest < sigma:
+        raise ValueError(
+            f"{n} particles of radius {radii.max():g} do not fit in this box even on a "
+            f"{'face-centred cubic' if dim == 3 else 'square'} lattice")
+    grid = np.stack(np.meshgrid(*[np.arange(k)] * dim, indexing="ij"), -1).reshape(-1, dim)
+    sites = (grid[:, None, :] + basis[None, :, :]).reshape(-1, dim)
+    pick = rng.choice(len(sites), size=n, replace=False)
+    offset = lo + (0.25 * cell if periodic else sigma / 2 + 0.25 * cell)
+    return offset + sites[pick] * cell
