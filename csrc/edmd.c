@@ -28,6 +28,7 @@ typedef struct {
     int64_t pcount;  /* partner's collision counter when predicted */
     int32_t partner; /* >= 0: particle; -1: none; <= -2: wall -(2 + 2*axis + side) */
     int32_t cross;   /* 2*axis + (1 if moving up) */
+    int32_t last;    /* partner of the last collision (a wall as in `partner`), -1 none */
     double t_last;   /* time of this particle's last collision (TC model, collapse) */
     int32_t streak;  /* consecutive collisions each within eps_t of the previous one */
 } gr_event;
@@ -295,6 +296,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         msum += mass[i];
         s->ev[i].t_last = -INFINITY;
         s->ev[i].streak = 0;
+        s->ev[i].last = -1;
     }
     s->kinetic = 0.5 * v2m;
     /* The collapse test's notion of "one instant": a billionth of the time a particle

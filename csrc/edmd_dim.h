@@ -91,6 +91,12 @@ static inline void FN(scan)(gr_edmd *s, int32_t i, const FN(nbr) *nb, int count)
                 dv[a] = V(q)[a] - V(p)[a];
             }
             double dt = gr_pair_time(DIM, dr, dv, ri + R(q), best);
+            /* A pair that collided with each other at this very instant cannot approach
+             * again in exact arithmetic (the normal relative velocity became -xi times
+             * the old one); any approach left is rounding, e.g. after xi = 0. */
+            if (dt == 0.0 && e->last == j && s->ev[j].last == i && e->t_last == t &&
+                s->ev[j].t_last == t)
+                continue;
             if (dt < best) {
                 best = dt;
                 partner = j;
@@ -256,6 +262,8 @@ static int FN(do_pair)(gr_edmd *s, int32_t i, int32_t j, double t, gr_error *err
     s->count[i]++;
     s->count[j]++;
     int collapse_i = FN(streak)(s, i, t), collapse_j = FN(streak)(s, j, t);
+    s->ev[i].last = j;
+    s->ev[j].last = i;
     if (collapse_i || collapse_j) {
         gr_error_set(err, GR_ERR_COLLAPSE, i, j, t, (double)GR_COLLAPSE_STREAK,
                      "over 1000 successive collisions of one particle within 1e-9 of a "
@@ -292,6 +300,7 @@ static int FN(do_wall)(gr_edmd *s, int32_t i, int wall, double t, gr_error *err)
     s->kinetic += FN(kinetic_of)(s, i) - before;
     s->wall++;
     s->count[i]++;
+    s->ev[i].last = -2 - wall;
     if (FN(streak)(s, i, t)) {
         gr_error_set(err, GR_ERR_COLLAPSE, i, -1, t, (double)GR_COLLAPSE_STREAK,
                      "over 1000 successive wall collisions within 1e-9 of a free-flight time");

@@ -100,22 +100,25 @@ class Trajectory:
     def msd(self, per_dimension=False):
         """Ensemble mean squared displacement from the first sample, at every sample
         (summed over dimensions, or (T, d) per dimension)."""
+        positions = self._need("positions")
         from . import analysis
 
-        return analysis.msd(self._need("positions"), per_dimension=per_dimension)
+        return analysis.msd(positions, per_dimension=per_dimension)
 
     def tamsd(self, lags, **kwargs):
         """Time-averaged MSD at the given lags; see ``granular.analysis.tamsd``."""
+        positions = self._need("positions")
         from . import analysis
 
-        return analysis.tamsd(self._need("positions"), lags, times=self.times, **kwargs)
+        return analysis.tamsd(positions, lags, times=self.times, **kwargs)
 
     def to_universe(self):
         """An MDAnalysis Universe of the particles (see ``granular.interop.to_universe``)."""
+        positions = self._need("positions")
         from . import interop
 
         box = (self.upper - self.lower) if self.boundary == "periodic" else None
-        return interop.to_universe(self.times, self._need("positions"), box=box, radii=self.radii)
+        return interop.to_universe(self.times, positions, box=box, radii=self.radii)
 
     def __len__(self):
         return len(self.times)

@@ -1,0 +1,290 @@
+"""The event-driven engine: exact cases, conservation laws, a slow reference, determinism."""
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+import granular
+from granular import Scene, Simulation
+
+import reference_edmd
+
+
+def two_disks(v1, v2, xi=1.0, dim=2, boundary="walls", m=(1.0, 1.0), y2=0.5):
+    pos = np.array([[0.3, 0.5], [0.7, y2]])
+    if dim == 3:
+        pos = np.hstack([pos, [[0.5], [0.5]]])
+    return Scene(pos, [v1, v2], 0.05, masses=list(m), box=1.0, boundary=boundary,
+                 restitution=xi)
+
+
+# -- exact cases ------------------------------------------------------------------------
+
+@pytest.mark.parametrize("xi", [1.0, 0.8, 0.0])
+def test_head_on_collision(xi):
+    """Thesis Fig. 4.1: two disks approach along x, touch at t = (0.4 - 0.1) / 2, and leave
+    with the 1D rule (2.27): equal masses swap for xi = 1, keep (1 -+ xi)/2 otherwise."""
+    s = two_disks([1.0, 0.0], [-1.0, 0.0], xi=xi)
+    sim = Simulation(s)
+    tr = sim.run(t_stop=0.2, sample_times=[0.0, 0.1499, 0.1501])
+    assert sim.stats["pair_collisions"] == 1
+    v = tr.velocities[-1]
+    # v1' = (1-xi)/2 v1 + (1+xi)/2 v2 with v1 = 1, v2 = -1  ->  -xi
+    np.testing.assert_allclose(v[:, 0], [-xi, xi], atol=1e-15)
+    np.testing.assert_allclose(v[:, 1], 0.0, atol=0)
+    gap = tr.positions[1, 1, 0] - tr.positions[1, 0, 0]
+    assert gap == pytest.approx(0.1 + 2 * 1e-4, rel=1e-12)
+
+
+def test_lone_disk_returns_after_four_bounces():
+    """A disk at 45 degrees in a square box is back where it started, moving the same way,
+    after hitting each of the four walls once (thesis 4.1)."""
+    x0 = np.array([[0.3, 0.6]])
+    v0 = np.array([[0.7, 0.7]])
+    s = Scene(x0, v0, 0.1, box=1.0, boundary="walls")
+    period = 2 * (1.0 - 0.2) / 0.7
+    sim = Simulation(s)
+    tr = sim.run(t_stop=period, sample_times=[period])
+    np.testing.assert_allclose(tr.positions[0], x0, atol=1e-14)
+    np.testing.assert_allclose(tr.velocities[0], v0, atol=1e-15)
+    assert sim.stats["wall_collisions"] == 4
+
+
+def test_periodic_free_flight_unwraps_exactly():
+    """A lone particle crossing a periodic box many times: unwrapped x(t) = x0 + v t."""
+    x0, v0 = np.array([[0.1, 0.2, 0.3]]), np.array([[3.1, -2.3, 1.7]])
+    s = Scene(x0, v0, 0.01, box=1.0)
+    times = np.linspace(0, 10, 21)
+    tr = Simulation(s).run(t_stop=10, sample_times=times)
+    np.testing.assert_allclose(tr.positions[:, 0], x0 + v0 * times[:, None], rtol=0, atol=1e-12)
+    assert np.all(np.abs(Simulation(s).scene.positions) <= 1.0)
+
+
+def test_inelastic_energy_loss_per_collision():
+    """Energy lost in one collision of equal masses: 1/4 m (1 - xi^2) (dv . n)^2 (App. B),
+    for an oblique impact."""
+    xi = 0.6
+    s = two_disks([1.0, 0.2], [-0.5, -0.1], xi=xi, y2=0.55)
+    sim = Simulation(s)
+    tr = sim.run(t_stop=0.5, sample_times=[0.0, 0.5])
+    assert sim.stats["pair_collisions"] == 1
+    # contact geometry from the pre-collision straight lines
+    x, v = s.positions, s.velocities
+    dx, dv = x[1] - x[0], v[1] - v[0]
+    b, a, c = dx @ dv, dv @ dv, dx @ dx - 0.1**2
+    tc = (-b - math.sqrt(b * b - a * c)) / a
+    n = (dx + dv * tc) / 0.1
+    expected = 0.25 * (1 - xi**2) * (dv @ n) ** 2
+    lost = tr.kinetic_energy[0] - tr.kinetic_energy[1]
+    assert lost == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("masses", [(1.0, 1.0), (1.0, 5.0)])
+def test_momentum_conserved_and_restitution_holds_for_mixtures(masses):
+    """(2.10)-(2.11) conserve momentum for any masses, and the normal relative velocity
+    is reversed and scaled by xi (2.12)."""
+    xi = 0.7
+    s = two_disks([1.0, 0.3], [-0.4, 0.0], xi=xi, m=masses, y2=0.54)
+    tr = Simulation(s).run(t_stop=0.4, sample_times=[0.0, 0.4])
+    m = np.array(masses)[:, None]
+    np.testing.assert_allclose((m * tr.velocities[1]).sum(0), (m * tr.velocities[0]).sum(0),
+                               atol=1e-15)
+    # normal direction at contact from the post-collision state traced back
+    x, v0, v1 = s.positions, tr.velocities[0], tr.velocities[1]
+    dx, dv = x[1] - x[0], v0[1] - v0[0]
+    b, a, c = dx @ dv, dv @ dv, dx @ dx - 0.1**2
+    tc = (-b - math.sqrt(b * b - a * c)) / a
+    n = (dx + dv * tc) / 0.1
+    assert (v1[1] - v1[0]) @ n == pytest.approx(-xi * (dv @ n), rel=1e-12)
+
+
+# -- conservation over many collisions ---------------------------------------------------
+
+def min_distance_ratio(scene, positions):
+    """Smallest centre distance over contact distance among all pairs (periodic images
+    included), with a k-d tree."""
+    lo, L = scene.lower, scene.lengths
+    periodic = scene.boundary == "periodic"
+    x = np.mod(positions - lo, L) if periodic else positions - lo
+    tree = cKDTree(x, boxsize=L if periodic else None)
+    pairs = tree.query_pairs(2 * scene.radii.max(), output_type="ndarray")
+    if len(pairs) == 0:
+        return np.inf
+    d = x[pairs[:, 1]] - x[pairs[:, 0]]
+    if periodic:
+        d -= L * np.round(d / L)
+    dist = np.linalg.norm(d, axis=1)
+    return float(np.min(dist / (scene.radii[pairs[:, 0]] + scene.radii[pairs[:, 1]])))
+
+
+@pytest.mark.parametrize("dim,boundary", [(3, "periodic"), (2, "periodic"), (3, "walls"), (2, "walls")])
+def test_energy_and_momentum_conserved_over_a_million_collisions(dim, boundary):
+    """xi = 1: kinetic energy constant to 1e-13 relative over >= 1e6 pair collisions; total
+    momentum (periodic) constant to 1e-13 of sum m|v|.  Rounding alone: each collision
+    perturbs E by ~1e-16 relative, a random walk over 1e6 collisions gives ~1e-13 at
+    worst, and it is far smaller in practice because errors cancel."""
+    n = 2000
+    radius = 0.012 if dim == 3 else 0.006
+    s = Scene.random(n, radius, dim=dim, boundary=boundary, seed=11)
+    sim = Simulation(s)
+    # 2 * 1e6 pair collisions / N = 1000 per particle, plus room for wall collisions
+    tr = sim.run(stop_when={"collisions_per_particle": 1300.0}, store=(),
+                 sample_times=None)
+    assert sim.stats["pair_collisions"] >= 1_000_000
+    e0, e1 = tr.kinetic_energy[0], tr.kinetic_energy[-1]
+    assert abs(e1 / e0 - 1) <= 1e-13
+    if boundary == "periodic":
+        scale = np.sum(s.masses * np.linalg.norm(s.velocities, axis=1))
+        assert np.max(np.abs(tr.momentum[-1] - tr.momentum[0])) <= 1e-13 * scale
+    final = sim.scene  # constructing it checks for overlaps and particles outside the box
+    assert min_distance_ratio(final, final.positions) >= 1 - 1e-10
+
+
+@pytest.mark.parametrize("dim,boundary", [(3, "periodic"), (2, "walls")])
+def test_no_overlaps_at_any_sample_dense(dim, boundary):
+    """Dense and granular (eta = 0.4 3D / 0.6 2D, xi = 0.9, TC model on): no pair is
+    closer than contact at any sample, beyond rounding (1e-10 relative)."""
+    n = 1000
+    eta = 0.4 if dim == 3 else 0.6
+    r = (eta / (n * 4 / 3 * math.pi)) ** (1 / 3) if dim == 3 else math.sqrt(eta / (n * math.pi))
+    s = Scene.random(n, r, dim=dim, boundary=boundary, restitution=0.9,
+                     contact_duration=1e-6, seed=5)
+    tr = Simulation(s).run(t_stop=0.5, sample_times=np.linspace(0, 0.5, 26),
+                           store=("positions",))
+    for x in tr.positions:
+        assert min_distance_ratio(s, x) >= 1 - 1e-10
+
+
+def test_centre_of_mass_moves_with_total_momentum():
+    """Unwrapped positions are the integral of the velocities: the centre of mass of a
+    periodic system moves at P / M exactly, through collisions and image crossings."""
+    s = Scene.random(500, 0.02, masses=None, seed=3, remove_drift=False) if False else \
+        Scene.random(500, 0.02, seed=3, remove_drift=False)
+    masses = np.linspace(1.0, 3.0, s.n)
+    s = s.replace(masses=masses)
+    times = np.linspace(0.0, 20.0, 41)
+    tr = Simulation(s).run(t_stop=20.0, sample_times=times)
+    M = masses.sum()
+    P = (masses[:, None] * s.velocities).sum(0)
+    com = (masses[:, None, None] * tr.positions.transpose(1, 0, 2)).sum(0) / M
+    expected = com[0] + np.outer(times, P / M)
+    np.testing.assert_allclose(com, expected, rtol=0, atol=1e-11)
+    # and particles did cross the box: displacements exceed its size
+    assert np.abs(tr.positions[-1] - tr.positions[0]).max() > 2.0
+
+
+# -- against the slow reference ------------------------------------------------------------
+
+@pytest.mark.parametrize("dim,boundary,xi", [(2, "walls", 1.0), (2, "periodic", 0.7),
+                                             (3, "periodic", 1.0), (3, "walls", 0.8)])
+def test_agrees_with_slow_reference(dim, boundary, xi):
+    """Same events as an O(N^2)-per-event NumPy EDMD, sample by sample, for a short time
+    (chaos amplifies rounding differences by ~e per collision, so the comparison stays
+    short: ~10 collisions per particle, agreement to 1e-8)."""
+    n = 12
+    radius = 0.08 if dim == 2 else 0.1
+    s = Scene.random(n, radius, dim=dim, boundary=boundary, restitution=xi,
+                     wall_restitution=0.9 if boundary == "walls" and xi < 1 else 1.0, seed=7)
+    t_stop = 1.0
+    times = np.linspace(0.0, t_stop, 11)
+    sim = Simulation(s)
+    tr = sim.run(t_stop=t_stop, sample_times=times)
+    assert sim.stats["pair_collisions"] >= n
+    rx, rv = reference_edmd.run(np.array(s.positions), np.array(s.velocities), s.radii,
+                                s.masses, s.lower, s.upper, boundary == "periodic", xi,
+                                t_stop, times, wall_e=s.wall_restitution)
+    np.testing.assert_allclose(tr.positions, rx, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(tr.velocities, rv, rtol=0, atol=1e-8)
+
+
+# -- runs: continuation, stop criteria, sampling, determinism ------------------------------
+
+def test_continued_run_equals_one_run():
+    s = Scene.random(300, 0.03, restitution=0.9, seed=2)
+    one = Simulation(s).run(t_stop=2.0, sample_times=[0.5, 1.0, 2.0])
+    sim = Simulation(s)
+    a = sim.run(t_stop=1.0, sample_times=[0.5, 1.0])
+    b = sim.run(t_stop=2.0, sample_times=[2.0])
+    np.testing.assert_array_equal(np.concatenate([a.positions, b.positions]), one.positions)
+    np.testing.assert_array_equal(np.concatenate([a.velocities, b.velocities]), one.velocities)
+
+
+def test_sampling_does_not_change_the_dynamics():
+    s = Scene.random(300, 0.03, restitution=0.8, seed=4)
+    sparse = Simulation(s).run(t_stop=3.0, sample_times=[3.0])
+    dense = Simulation(s).run(t_stop=3.0, sample_times=np.linspace(0, 3.0, 997))
+    np.testing.assert_array_equal(sparse.positions[-1], dense.positions[-1])
+    np.testing.assert_array_equal(sparse.velocities[-1], dense.velocities[-1])
+
+
+def test_same_seed_same_result_bit_for_bit():
+    a = Scene.random(400, 0.03, restitution=0.8, seed=42)
+    b = Scene.random(400, 0.03, restitution=0.8, seed=42)
+    np.testing.assert_array_equal(a.positions, b.positions)
+    np.testing.assert_array_equal(a.velocities, b.velocities)
+    ta = Simulation(a).run(t_stop=2.0)
+    tb = Simulation(b).run(t_stop=2.0)
+    np.testing.assert_array_equal(ta.positions, tb.positions)
+    c = Scene.random(400, 0.03, restitution=0.8, seed=43)
+    assert not np.array_equal(a.positions, c.positions)
+
+
+def test_stop_criteria():
+    s = Scene.random(500, 0.025, restitution=0.8, seed=9)
+    sim = Simulation(s)
+    tr = sim.run(stop_when={"collisions_per_particle": 10})
+    assert tr.stop_reason == "collisions"
+    assert 10 <= tr.collisions_per_particle[-1] < 10 + 2.0 / s.n + 1e-12
+    e_target = 0.25 * s.kinetic_energy / s.n
+    tr = sim.run(stop_when={"kinetic_energy": e_target})
+    assert tr.stop_reason == "kinetic_energy"
+    assert tr.kinetic_energy[-1] / s.n <= e_target
+    before = sim.stats["events"]
+    tr = sim.run(stop_when={"events": 1234})
+    assert tr.stop_reason == "events" and sim.stats["events"] - before == 1234
+    tr = sim.run(t_stop=sim.time + 0.1, stop_when={"collisions_per_particle": 1e9})
+    assert tr.stop_reason == "time"
+    with pytest.raises(ValueError, match="needs a finite t_stop"):
+        sim.run()
+
+
+def test_log_spaced_samples_and_counters():
+    s = Scene.random(500, 0.025, seed=1)
+    times = np.concatenate([[0.0], np.logspace(-3, 1, 30)])
+    tr = Simulation(s).run(t_stop=10.0, sample_times=times, store=())
+    assert tr.positions is None and tr.velocities is None
+    np.testing.assert_array_equal(tr.times, times)
+    assert np.all(np.diff(tr.pair_collisions) >= 0)
+    assert np.all(np.diff(tr.virial) >= 0)
+    with pytest.raises(ValueError, match="did not store positions"):
+        tr.msd()
+
+
+def test_idle_system_stops():
+    s = Scene([[0.5, 0.5]], [[0.0, 0.0]], 0.1)
+    tr = Simulation(s).run(stop_when={"collisions_per_particle": 1})
+    assert tr.stop_reason == "idle"
+
+
+def test_seed_scenes():
+    """Seed 000: 150 elastic disks between walls at +-3, energy and the speed of each
+    collision pair conserved; seed 003: elastic spheres in a walled unit box."""
+    b = Scene.seed_brownian_disks(seed=1)
+    assert b.n == 150 and b.dim == 2 and b.boundary == "walls"
+    np.testing.assert_array_equal(b.lower, [-3, -3])
+    np.testing.assert_allclose(np.linalg.norm(b.velocities, axis=1), 1.0, rtol=1e-15)
+    tr = Simulation(b).run(t_stop=50.0)
+    assert tr.kinetic_energy[-1] == pytest.approx(tr.kinetic_energy[0], rel=1e-13)
+    g = Scene.seed_ideal_gas(seed=2)
+    sim = Simulation(g)
+    tr = sim.run(t_stop=5.0)
+    assert sim.stats["wall_collisions"] > 0
+    assert tr.kinetic_energy[-1] == pytest.approx(tr.kinetic_energy[0], rel=1e-13)
+
+
+def test_tc_model_counts_elastic_collisions():
+    s = Scene.random(500, 0.03, restitution=0.5, contact_duration=1e-3, seed=8)
+    sim = Simulation(s)
+    sim.run(t_stop=5.0)
+    assert 0 < sim.stats["tc_elastic_collisions"] < sim.stats["pair_collisions"]
