@@ -266,8 +266,8 @@ static int FN(do_pair)(gr_edmd *s, int32_t i, int32_t j, double t, gr_error *err
     s->ev[j].last = i;
     if (collapse_i || collapse_j) {
         gr_error_set(err, GR_ERR_COLLAPSE, i, j, t, (double)GR_COLLAPSE_STREAK,
-                     "over 1000 successive collisions of one particle within 1e-9 of a "
-                     "free-flight time of each other");
+                     GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
+                     "each within 1e-9 of a free-flight time of the previous");
         FN(predict)(s, i);
         FN(predict)(s, j);
         return GR_ERR_COLLAPSE;
@@ -303,7 +303,8 @@ static int FN(do_wall)(gr_edmd *s, int32_t i, int wall, double t, gr_error *err)
     s->ev[i].last = -2 - wall;
     if (FN(streak)(s, i, t)) {
         gr_error_set(err, GR_ERR_COLLAPSE, i, -1, t, (double)GR_COLLAPSE_STREAK,
-                     "over 1000 successive wall collisions within 1e-9 of a free-flight time");
+                     GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
+                     "each within 1e-9 of a free-flight time of the previous");
         FN(predict)(s, i);
         return GR_ERR_COLLAPSE;
     }

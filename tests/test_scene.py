@@ -1,0 +1,175 @@
+"""Scenes: construction, random placement and velocities, and every bad input."""
+import math
+
+import numpy as np
+import pytest
+
+import granular
+from granular import Scene, Simulation
+
+
+def test_random_scene_is_uniform_isotropic_and_without_drift():
+    s = Scene.random(4000, 0.01, seed=1)
+    assert s.n == 4000 and s.dim == 3 and s.boundary == "periodic"
+    # centre of mass at rest to rounding
+    assert np.abs(s.velocities.sum(0)).max() < 1e-12
+    # fixed speed sqrt(2) up to the drift removal, a shift of O(sqrt(2/N))
+    speed = np.linalg.norm(s.velocities, axis=1)
+    assert abs(speed.mean() - math.sqrt(2)) < 0.01
+    # isotropic: each of <v_x^2>, <v_y^2>, <v_z^2> = 2/3, with relative standard error
+    # sqrt(Var(v_a^2)) / (<v_a^2> sqrt N) = sqrt(4/5) / sqrt(4000) ~ 1.4% for a fixed
+    # speed in random directions; 5 sigma.  The thesis' eq. 3.3 would give
+    # <v_z^2> = 1 (50% too much) and fail this.
+    comp = (s.velocities**2).mean(0)
+    np.testing.assert_allclose(comp, 2 / 3, rtol=5 * 0.0142)
+    # uniform positions: each octant holds N/8 +- sqrt(N/8 * 7/8), 5 sigma
+    octant = ((s.positions > 0.5) * [1, 2, 4]).sum(1)
+    counts = np.bincount(octant, minlength=8)
+    assert np.all(np.abs(counts - 500) < 5 * math.sqrt(500 * 7 / 8))
+
+
+def test_random_scene_temperature():
+    s = Scene.random(5000, 0.005, dim=2, temperature=2.5, seed=3)
+    # T estimate from 2N velocity components: relative standard error sqrt(2 / (2N)) = 1.4%
+    assert s.temperature == pytest.approx(2.5, rel=5 * math.sqrt(1 / 5000))
+
+
+def test_dense_random_scene_melts_a_lattice():
+    n = 2000
+    r = (0.5 / (n * 4 / 3 * math.pi)) ** (1 / 3)
+    s = Scene.random(n, r, seed=2)
+    assert s.packing_fraction == pytest.approx(0.5)
+    # melted: no longer on lattice sites (fractional coordinates spread out)
+    frac = np.mod(s.positions * 10, 1.0)
+    assert frac.std() > 0.2
+    with pytest.raises(ValueError, match="do not fit"):
+        Scene.random(n, (0.8 / (n * 4 / 3 * math.pi)) ** (1 / 3), seed=2)
+
+
+def test_walls_scene_keeps_particles_inside():
+    s = Scene.random(500, 0.02, dim=2, box=(-3, 3), boundary="walls", seed=4)
+    assert np.all(s.positions - 0.02 >= -3) and np.all(s.positions + 0.02 <= 3)
+
+
+def test_replace_and_repr():
+    s = Scene.random(10, 0.05, seed=5)
+    g = s.replace(restitution=0.5)
+    assert g.restitution == 0.5 and np.array_equal(g.positions, s.positions)
+    assert "restitution=0.5" in repr(g)
+    with pytest.raises(TypeError, match="unknown Scene fields"):
+        s.replace(colour="red")
+    with pytest.raises(ValueError):
+        s.positions[0, 0] = 1.0  # read-only
+
+
+# -- bad input: a clear exception, never a crash --------------------------------------
+
+GOOD = dict(positions=[[0.2, 0.2], [0.6, 0.6]], velocities=[[1, 0], [0, 1]], radii=0.1)
+
+
+def make(**changes):
+    kw = dict(GOOD)
+    kw.update(changes)
+    p, v, r = kw.pop("positions"), kw.pop("velocities"), kw.pop("radii")
+    return Scene(p, v, r, **kw)
+
+
+@pytest.mark.parametrize("changes,error,match", [
+    (dict(positions=[[0.2, 0.2], [0.3, 0.2]]), granular.OverlapError, "particles 0 and 1 overlap"),
+    (dict(positions=[[0.2, 0.2], [1.6, 0.6]]), granular.OutsideBoxError, "particle 1"),
+    (dict(positions=[[0.05, 0.2], [0.6, 0.6]], boundary="walls"), granular.OutsideBoxError, "crosses a wall"),
+    (dict(positions=[[np.nan, 0.2], [0.6, 0.6]]), ValueError, "NaN"),
+    (dict(velocities=[[np.inf, 0], [0, 1]]), ValueError, "NaN or infinity"),
+    (dict(radii=[0.1, -0.1]), ValueError, "radii must be positive"),
+    (dict(radii=[0.1, 0.0]), ValueError, "radii must be positive"),
+    (dict(masses=[1.0, 0.0]), ValueError, "masses must be positive"),
+    (dict(restitution=1.5), ValueError, "restitution must lie in"),
+    (dict(restitution=-0.1), ValueError, "restitution must lie in"),
+    (dict(wall_restitution=0.0), ValueError, "wall_restitution"),
+    (dict(contact_duration=-1.0), ValueError, "contact_duration"),
+    (dict(velocities=[[1, 0, 0], [0, 1, 0]]), ValueError, "velocities must have shape"),
+    (dict(positions=[[0.2], [0.6]]), ValueError, "shape"),
+    (dict(positions=[[0.2, 0.2, 0.2, 0.2]]), ValueError, "shape"),
+    (dict(positions=np.zeros((0, 2)), velocities=np.zeros((0, 2))), ValueError, "N >= 1"),
+    (dict(radii=[0.1, 0.1, 0.1]), ValueError, "radii must have shape"),
+    (dict(boundary="open"), ValueError, "boundary must be one of"),
+    (dict(box=(1.0, 0.0)), ValueError, "lower < upper"),
+    (dict(radii=0.3, positions=[[0.3, 0.3], [0.9, 0.9]]), ValueError, "two largest diameters"),
+    (dict(positions="abc"), ValueError, "could not convert"),
+])
+def test_bad_scenes_raise_clear_errors(changes, error, match):
+    with pytest.raises(error, match=match):
+        make(**changes)
+
+
+def test_overlap_error_names_the_pair_across_periodic_images():
+    with pytest.raises(granular.OverlapError) as info:
+        Scene([[0.02, 0.5], [0.5, 0.1], [0.97, 0.5]], np.zeros((3, 2)), 0.05)
+    assert info.value.particles == (0, 2)
+    assert info.value.value == pytest.approx(0.05, rel=1e-9)
+
+
+def test_bad_run_arguments():
+    sim = Simulation(Scene.random(20, 0.05, seed=1))
+    with pytest.raises(ValueError, match="strictly increasing"):
+        sim.run(t_stop=1.0, sample_times=[0.5, 0.2])
+    with pytest.raises(ValueError, match="finite"):
+        sim.run(t_stop=1.0, sample_times=[0.1, np.nan])
+    with pytest.raises(ValueError, match="unknown stop_when"):
+        sim.run(stop_when={"collisions": 3})
+    with pytest.raises(ValueError, match="store may contain"):
+        sim.run(t_stop=1.0, store=("forces",))
+    with pytest.raises(ValueError, match="NaN"):
+        sim.run(t_stop=float("nan"))
+    sim.run(t_stop=1.0)
+    with pytest.raises(ValueError, match="before the current time"):
+        sim.run(t_stop=0.5)
+    with pytest.raises(ValueError, match="before the current time"):
+        sim.run(t_stop=2.0, sample_times=[0.5, 1.5])
+    with pytest.raises(TypeError, match="needs a granular.Scene"):
+        Simulation("scene")
+    with pytest.raises(ValueError, match="cell_factor"):
+        Simulation(Scene.random(20, 0.05, seed=1), cell_factor=0.5)
+
+
+def test_heated_walls_report_non_finite_velocities():
+    """Walls with restitution > 1 pump energy in exponentially; when speeds overflow the
+    engine stops with NonFiniteError instead of carrying infinities on."""
+    s = Scene([[0.5, 0.5]], [[1.0, 0.0]], 0.1, boundary="walls", wall_restitution=1e100)
+    with pytest.raises(granular.NonFiniteError):
+        Simulation(s).run(t_stop=10.0)
+
+
+# -- inelastic collapse ------------------------------------------------------------------
+
+def three_in_line(xi, tc=0.0):
+    return Scene([[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]], [[1, 0], [0, 0], [-1, 0]], 0.05,
+                 boundary="walls", restitution=xi, contact_duration=tc)
+
+
+def test_collapse_of_three_disks_is_detected():
+    """Three disks in a line collapse for xi < 7 - 4 sqrt 3 = 0.0718 (thesis 2.3): the
+    engine raises InelasticCollapseError naming the particles and the time, after a
+    bounded number of collisions."""
+    sim = Simulation(three_in_line(0.05))
+    with pytest.raises(granular.InelasticCollapseError) as info:
+        sim.run(t_stop=10.0)
+    err = info.value
+    assert set(err.particles) <= {0, 1, 2} and 1 in err.particles
+    assert err.time == pytest.approx(0.1, abs=1e-6)  # the first contact is at t = 0.1
+    assert sim.stats["pair_collisions"] < 100
+    # the state stays consistent: the scene can still be read
+    assert sim.scene.n == 3
+
+
+def test_tc_model_lets_the_same_run_finish():
+    sim = Simulation(three_in_line(0.05, tc=1e-3))
+    tr = sim.run(t_stop=10.0)
+    assert tr.stop_reason == "time"
+    assert sim.stats["tc_elastic_collisions"] > 0
+
+
+def test_no_collapse_above_the_threshold():
+    """xi = 0.2 > 0.0718: a finite number of collisions, no error."""
+    sim = Simulation(three_in_line(0.2))
+    assert sim.run(t_stop=10.0).stop_reason == "time"
