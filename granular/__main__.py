@@ -1,0 +1,33 @@
+"""Command line: ``python -m granular demo | bench``."""
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m granular",
+                                     description="Molecular and granular gases of hard spheres.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    demo = sub.add_parser("demo", help="a granular and a molecular gas against theory")
+    demo.add_argument("--out", default="granular-demo", help="output folder for figures")
+    demo.add_argument("--quick", action="store_true", help="smaller, for tests")
+    bench = sub.add_parser("bench", help="throughput benchmarks")
+    bench.add_argument("--json", metavar="FILE", help="write the figures as JSON")
+    bench.add_argument("--quick", action="store_true", help="tiny workloads (seconds)")
+    bench.add_argument("--large", action="store_true", help="add N = 1e6")
+    args = parser.parse_args(argv)
+
+    if args.command == "demo":
+        from . import demo as demo_module
+
+        demo_module.main(out=args.out, quick=args.quick)
+    elif args.command == "bench":
+        from . import bench as bench_module
+
+        bench_module.main(json_path=args.json, quick=args.quick, large=args.large)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

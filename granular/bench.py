@@ -1,0 +1,86 @@
+"""Throughput benchmarks: pair collisions per second of the event-driven engine (and the
+Langevin engine's workloads when it is present).  Figures are printed and written as
+JSON, never asserted: speed is measured here, not in the tests."""
+from __future__ import annotations
+
+import json
+import math
+import platform
+import time
+
+from .scene import Scene
+from .simulation import Simulation
+
+
+def _radius_for(n, eta, dim, box=1.0):
+    if dim == 3:
+        return (eta * box**3 / (n * 4.0 / 3.0 * math.pi)) ** (1.0 / 3.0)
+    return math.sqrt(eta * box**2 / (n * math.pi))
+
+
+# (name, dim, n, packing fraction, collisions per particle timed)
+EDMD_WORKLOADS = [
+    ("edmd-3d-eta0.065-n1e3", 3, 1_000, 0.065, 2000.0),
+    ("edmd-3d-eta0.065-n1e4", 3, 10_000, 0.065, 200.0),
+    ("edmd-3d-eta0.065-n1e5", 3, 100_000, 0.065, 40.0),
+    ("edmd-3d-eta0.45-n1e4", 3, 10_000, 0.45, 200.0),
+    ("edmd-2d-eta0.16-n1e4", 2, 10_000, 0.16, 200.0),
+]
+LARGE_WORKLOADS = [("edmd-3d-eta0.065-n1e6", 3, 1_000_000, 0.065, 10.0)]
+
+
+def edmd_workload(name, dim, n, eta, collisions, *, boundary="periodic", restitution=1.0,
+                  equilibrate=10.0, seed=0):
+    """Time one EDMD workload: an equilibrated molecular gas, then `collisions` more
+    collisions per particle, timed."""
+    scene = Scene.random(n, _radius_for(n, eta, dim), dim=dim, boundary=boundary, seed=seed)
+    sim = Simulation(scene.replace(restitution=restitution))
+    sim.run(stop_when={"collisions_per_particle": equilibrate}, store=())
+    before = sim.stats
+    t0 = time.perf_counter()
+    sim.run(stop_when={"collisions_per_particle": equilibrate + collisions}, store=())
+    seconds = time.perf_counter() - t0
+    after = sim.stats
+    pairs = after["pair_collisions"] - before["pair_collisions"]
+    events = after["events"] - before["events"]
+    return dict(name=name, engine="edmd", dim=dim, n=n, packing_fraction=round(scene.packing_fraction, 6),
+                boundary=boundary, restitution=restitution, pair_collisions=pairs, events=events,
+                seconds=seconds, pair_collisions_per_second=pairs / seconds,
+                ns_per_event=1e9 * seconds / events,
+                cells=list(after["cells"][:dim]))
+
+
+def run(quick=False, large=False, langevin=True, out=print):
+    """Run the workloads; `quick` shrinks them to seconds (for tests)."""
+    results = []
+    workloads = EDMD_WORKLOADS + (LARGE_WORKLOADS if large else [])
+    for name, dim, n, eta, coll in workloads:
+        if quick:
+            n, coll = min(n, 2000), 5.0
+        r = edmd_workload(name, dim, n, eta, coll)
+        results.append(r)
+        out(f"{r['name']:<28} N={r['n']:>8}  {r['pair_collisions_per_second'] / 1e6:6.3f} M pair collisions/s"
+            f"  ({r['ns_per_event']:.0f} ns/event, {r['events'] / r['pair_collisions']:.2f} events/collision)")
+    if langevin:
+        try:
+            from . import bench_langevin
+        except ImportError:
+            bench_langevin = None
+        if bench_langevin is not None:
+            for r in bench_langevin.workloads(quick=quick):
+                results.append(r)
+                out(f"{r['name']:<28} N={r['n']:>8}  {r['particle_steps_per_second'] / 1e6:8.1f} M particle-steps/s"
+                    f"  (NumPy: {r['numpy_particle_steps_per_second'] / 1e6:.1f} M/s; peak {r['peak_memory_mb']:.1f} MB)")
+    return results
+
+
+def main(json_path=None, quick=False, large=False):
+    results = run(quick=quick, large=large)
+    if json_path:
+        meta = dict(python=platform.python_version(), machine=platform.machine(),
+                    processor=platform.processor())
+        for r in results:
+            r.setdefault("host", meta)
+        with open(json_path, "w") as f:
+            json.dump(results, f, indent=1)
+    return results
