@@ -86,15 +86,18 @@ class Trajectory:
         return float((2.0 * mean_k + w / span) / (self.dim * self.volume))
 
     def wall_pressure(self):
-        """Mechanical pressure on the walls between the first and last sample: normal
-        momentum given to them per unit time and unit wall area (length in 2D)."""
+        """Mechanical pressure on the walls between the first and last sample: the normal
+        momentum given to them per unit time, over the area the particle centres can
+        reach (each face shrunk by one radius at each edge; exact for equal radii, the
+        largest radius is used for mixtures).  This is the bulk pressure of the gas,
+        ``n_c T Z`` with ``n_c`` the centres' density in the volume they can reach."""
         if self.boundary != "walls":
             raise ValueError("wall_pressure needs a walled box")
         t = self.times
         if len(t) < 2 or t[-1] <= t[0]:
             raise ValueError("wall_pressure needs at least two samples spanning some time")
-        L = self.upper - self.lower
-        area = 2.0 * sum(np.prod(np.delete(L, a)) for a in range(self.dim))
+        reach = self.upper - self.lower - 2.0 * float(np.max(self.radii))
+        area = 2.0 * sum(np.prod(np.delete(reach, a)) for a in range(self.dim))
         return float((self.wall_impulse[-1] - self.wall_impulse[0]) / ((t[-1] - t[0]) * area))
 
     def msd(self, per_dimension=False):
