@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
@@ -132,6 +133,7 @@ class Simulation:
                 raise ValueError(f"sample_times start at {times[0]}, before the current time {t_now}")
             if np.any(np.diff(times) <= 0):
                 raise ValueError("sample_times must be strictly increasing")
+        _check_memory(len(times) + final_sample, self._initial.n * self._initial.dim * len(store))
         buf = self._buffers(len(times) + final_sample, store)
 
         # the C loop fills the first len(times) samples; a final one may follow
@@ -195,6 +197,20 @@ class Simulation:
 _REASONS = {_core.STOP_TIME: "time", _core.STOP_COLLISIONS: "collisions",
             _core.STOP_ENERGY: "kinetic_energy", _core.STOP_IDLE: "idle",
             _core.STOP_BUDGET: "events"}
+
+
+def _check_memory(samples, doubles_per_sample):
+    """Refuse sample buffers larger than half the machine's memory, before allocating."""
+    need = 8.0 * samples * doubles_per_sample
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return
+    if need > 0.5 * total:
+        raise MemoryError(
+            f"storing {samples} samples of positions/velocities needs {need / 2**30:.1f} GiB, "
+            f"more than half of this machine's {total / 2**30:.1f} GiB; sample less often or "
+            f"run with store=() and keep only the statistics")
 
 
 class _TimeBar:
