@@ -13,7 +13,8 @@ from .errors import (GranularError, InelasticCollapseError, NonFiniteError, Outs
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
+from .ensemble import EnsembleResult, ensemble
 
 __version__ = "0.1.0"
-__all__ = ["Scene", "Simulation", "Trajectory", "errors", "GranularError", "OverlapError",
+__all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "errors", "GranularError", "OverlapError",
            "OutsideBoxError", "InelasticCollapseError", "NonFiniteError", "UnstableStepError"]
