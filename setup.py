@@ -8,7 +8,7 @@ import os
 import numpy
 from setuptools import Extension, setup
 
-extra = ["-O3", "-std=c99", "-Wall", "-Wextra", "-Wno-unused-parameter"]
+extra = ["-O3", "-g", "-std=c99", "-Wall", "-Wextra", "-Wno-unused-parameter"]
 if os.environ.get("GRANULAR_ASAN"):
     extra += ["-fsanitize=address", "-fno-omit-frame-pointer", "-O1", "-g"]
 

@@ -44,6 +44,9 @@ struct gr_edmd {
     int64_t *image;   /* n * dim periodic image counters */
     gr_event *ev;
     gr_heap heap;
+    int32_t *id_of;   /* the caller's index of each internal particle (see reorder) */
+    void *scratch;    /* n * stride doubles, for reordering */
+    int64_t next_reorder;
 
     /* cell grid */
     int nc[3];
@@ -53,6 +56,11 @@ struct gr_edmd {
     int32_t *head, *next, *prev;
     int32_t *nb_cell[3];  /* [axis][3*c + d+1]: neighbouring coordinate or -1 */
     double *nb_shift[3];  /* [axis][3*c + d+1]: image shift in box lengths' units */
+    /* Linear index offsets of the adjacent cells of a cell away from the box edge (the
+     * common case, which then needs no wrapping and no image shifts): all of them, and
+     * the layer newly adjacent after a crossing along axis a in direction up/down. */
+    int32_t off_all[27];
+    int32_t off_layer[6][9];
 
     /* time and counters */
     double t, eps_t;
@@ -72,7 +80,16 @@ struct gr_edmd {
 #define GR_STR(x) #x
 #define GR_XSTR(x) GR_STR(x)
 
+/* Large systems renumber their particles in cell order every GR_REORDER_EVENTS_PER_N * N
+ * events, so that particles in adjacent cells are close in memory; small ones fit in
+ * the cache anyway and skip it. */
+#define GR_REORDER_MIN_N 4096
+#define GR_REORDER_EVENTS_PER_N 16
+
 static inline double *rec(const gr_edmd *s, int32_t i) { return s->P + (size_t)i * s->stride; }
+
+/* The caller's index of internal particle i (negative codes pass through). */
+static inline int64_t uid(const gr_edmd *s, int32_t i) { return i < 0 ? -1 : s->id_of[i]; }
 
 static inline void cell_insert(gr_edmd *s, int32_t i, int32_t c)
 {
@@ -88,6 +105,8 @@ static inline void cell_remove(gr_edmd *s, int32_t i, int32_t c)
     else s->head[c] = s->next[i];
     if (s->next[i] >= 0) s->prev[s->next[i]] = s->prev[i];
 }
+
+static int reorder(gr_edmd *s);
 
 #define DIM 2
 #define FN(name) name##_2d
@@ -108,6 +127,8 @@ void gr_edmd_free(gr_edmd *s)
     free(s->count);
     free(s->image);
     free(s->ev);
+    free(s->id_of);
+    free(s->scratch);
     gr_heap_free(&s->heap);
     free(s->cc);
     free(s->head);
@@ -149,6 +170,19 @@ static int build_grid(gr_edmd *s, double sigma_max)
     s->head = malloc((size_t)s->ncells * sizeof *s->head);
     if (!s->head) return GR_ERR_NOMEM;
     for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;
+    int k_all = 0, k_layer[6] = {0, 0, 0, 0, 0, 0};
+    for (int d2 = (d == 3 ? -1 : 0); d2 <= (d == 3 ? 1 : 0); d2++)
+        for (int d1 = -1; d1 <= 1; d1++)
+            for (int d0 = -1; d0 <= 1; d0++) {
+                int32_t off = d0 + s->nc[0] * (d1 + s->nc[1] * d2);
+                int dd[3] = {d0, d1, d2};
+                s->off_all[k_all++] = off;
+                for (int a = 0; a < d; a++)
+                    if (dd[a] != 0) {
+                        int layer = 2 * a + (dd[a] > 0);
+                        s->off_layer[layer][k_layer[layer]++] = off;
+                    }
+            }
     for (int a = 0; a < d; a++) {
         int m = s->nc[a];
         s->nb_cell[a] = malloc((size_t)3 * m * sizeof(int32_t));
@@ -277,8 +311,11 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->cc = malloc((size_t)n * d * sizeof *s->cc);
     s->next = malloc((size_t)n * sizeof *s->next);
     s->prev = malloc((size_t)n * sizeof *s->prev);
+    s->id_of = malloc((size_t)n * sizeof *s->id_of);
+    if (n >= GR_REORDER_MIN_N) s->scratch = malloc((size_t)n * s->stride * sizeof(double));
     int status = GR_OK;
-    if (!s->P || !s->mass || !s->count || !s->image || !s->ev || !s->cc || !s->next || !s->prev)
+    if (!s->P || !s->mass || !s->count || !s->image || !s->ev || !s->cc || !s->next || !s->prev ||
+        !s->id_of || (n >= GR_REORDER_MIN_N && !s->scratch))
         status = GR_ERR_NOMEM;
     if (status == GR_OK) status = gr_heap_init(&s->heap, n);
     if (status == GR_OK) status = build_grid(s, sigma_max);
@@ -299,9 +336,9 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         p[2 * d + 1] = radius[i];
         s->mass[i] = mass[i];
         msum += mass[i];
-        s->ev[i].t_last = -INFINITY;
-        s->ev[i].streak = 0;
-        s->ev[i].last = -1;
+        s->ev[i] = (gr_event){.t_coll = INFINITY, .t_cross = INFINITY, .pcount = 0, .partner = -1,
+                              .cross = -1, .t_last = -INFINITY, .streak = 0, .last = -1};
+        s->id_of[i] = i;
     }
     s->kinetic = 0.5 * v2m;
     /* The collapse test's notion of "one instant": a billionth of the time a particle
@@ -319,6 +356,81 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     return GR_OK;
 }
 
+/* Renumber the particles in the order of their cells (a counting sort, O(N + cells)),
+ * permuting every per-particle array and remapping every stored particle index: event
+ * partners, the heap, the cell lists.  Only the numbering changes -- positions,
+ * velocities, predictions and the order of events stay exactly as they were. */
+static int reorder(gr_edmd *s)
+{
+    const int32_t n = s->n;
+    const int d = s->dim;
+    if (!s->scratch) return GR_OK;
+    int32_t *start = calloc((size_t)s->ncells + 1, sizeof *start);
+    int32_t *newpos = malloc((size_t)n * sizeof *newpos);
+    if (!start || !newpos) {
+        free(start);
+        free(newpos);
+        return GR_ERR_NOMEM;
+    }
+    for (int32_t i = 0; i < n; i++) {
+        int32_t c = 0;
+        for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->cc[(size_t)i * d + a];
+        newpos[i] = c; /* the cell, for now */
+        start[c + 1]++;
+    }
+    for (int32_t c = 0; c < s->ncells; c++) start[c + 1] += start[c];
+    for (int32_t i = 0; i < n; i++) newpos[i] = start[newpos[i]]++;
+    free(start);
+
+#define PERMUTE(arr, type, width)                                                       \
+    do {                                                                                \
+        type *tmp = (type *)s->scratch;                                                 \
+        for (int32_t i = 0; i < n; i++)                                                 \
+            memcpy(tmp + (size_t)newpos[i] * (width), (arr) + (size_t)i * (width),      \
+                   (width) * sizeof(type));                                             \
+        memcpy((arr), tmp, (size_t)n * (width) * sizeof(type));                          \
+    } while (0)
+    PERMUTE(s->P, double, (size_t)s->stride);
+    PERMUTE(s->mass, double, 1);
+    PERMUTE(s->count, int64_t, 1);
+    PERMUTE(s->image, int64_t, (size_t)d);
+    PERMUTE(s->cc, int32_t, (size_t)d);
+    PERMUTE(s->id_of, int32_t, 1);
+#undef PERMUTE
+    /* gr_event is larger than a record in 2D; permute it through the event array itself
+     * by cycles would be slower to read; use the scratch in two halves if needed. */
+    {
+        size_t ev_bytes = (size_t)n * sizeof(gr_event);
+        gr_event *tmp = ev_bytes <= (size_t)n * s->stride * sizeof(double) ? s->scratch : malloc(ev_bytes);
+        if (!tmp) {
+            free(newpos);
+            return GR_ERR_NOMEM;
+        }
+        for (int32_t i = 0; i < n; i++) {
+            gr_event e = s->ev[i];
+            if (e.partner >= 0) e.partner = newpos[e.partner];
+            if (e.last >= 0) e.last = newpos[e.last];
+            tmp[newpos[i]] = e;
+        }
+        memcpy(s->ev, tmp, ev_bytes);
+        if (tmp != s->scratch) free(tmp);
+    }
+    for (int32_t k = 0; k < n; k++) {
+        int32_t id = newpos[s->heap.node[k].id];
+        s->heap.node[k].id = id;
+        s->heap.where[id] = k;
+    }
+    free(newpos);
+    for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;
+    for (int32_t i = n - 1; i >= 0; i--) { /* lists in increasing index order */
+        int32_t c = 0;
+        for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->cc[(size_t)i * d + a];
+        cell_insert(s, i, c);
+    }
+    s->next_reorder = s->events + (int64_t)GR_REORDER_EVENTS_PER_N * n;
+    return GR_OK;
+}
+
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
@@ -333,14 +445,15 @@ void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image)
         for (int a = 0; a < d; a++) {
             double x = p[a] + p[d + a] * dt;
             int64_t img = s->image[(size_t)i * d + a];
+            size_t out = (size_t)s->id_of[i] * d + a;
             if (s->cfg.periodic) {
                 /* a crossing due exactly now may not have been processed yet */
                 if (x >= s->cfg.hi[a]) { x -= s->L[a]; img++; }
                 else if (x < s->cfg.lo[a]) { x += s->L[a]; img--; }
             }
-            if (pos) pos[(size_t)i * d + a] = x;
-            if (vel) vel[(size_t)i * d + a] = p[d + a];
-            if (image) image[(size_t)i * d + a] = img;
+            if (pos) pos[out] = x;
+            if (vel) vel[out] = p[d + a];
+            if (image) image[out] = img;
         }
     }
 }

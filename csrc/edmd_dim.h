@@ -72,39 +72,61 @@ static inline void FN(move)(double *p, double t)
     T(p) = t;
 }
 
-/* Look for pair collisions of i (whose clock is at t) with the particles in the given
- * neighbour cells; keep the earliest in i's event if it beats the one there. */
-static inline void FN(scan)(gr_edmd *s, int32_t i, const FN(nbr) *nb, int count)
+/* Pair collisions of i (record p, clock at t) with the particles of one cell, seen
+ * through an image shift (NULL: none); keeps the earliest in *best / *partner.  `best` is
+ * relative to t and is also the horizon for the early exit in gr_pair_time. */
+static inline void FN(scan_cell)(const gr_edmd *s, int32_t i, const double *p, int32_t cell,
+                                 const double *shift, double *best, int32_t *partner)
 {
-    const double *p = rec(s, i);
     const double t = T(p), ri = R(p);
-    gr_event *e = &s->ev[i];
-    double best = e->t_coll - t;
-    int32_t partner = -1;
-    for (int k = 0; k < count; k++) {
-        for (int32_t j = s->head[nb[k].cell]; j >= 0; j = s->next[j]) {
-            if (j == i) continue;
-            const double *q = rec(s, j);
-            double dtj = t - T(q), dr[DIM], dv[DIM];
-            for (int a = 0; a < DIM; a++) {
-                dr[a] = X(q)[a] + V(q)[a] * dtj + nb[k].shift[a] - X(p)[a];
-                dv[a] = V(q)[a] - V(p)[a];
-            }
-            double dt = gr_pair_time(DIM, dr, dv, ri + R(q), best);
-            /* A pair that collided with each other at this very instant cannot approach
-             * again in exact arithmetic (the normal relative velocity became -xi times
-             * the old one); any approach left is rounding, e.g. after xi = 0. */
-            if (dt == 0.0 && e->last == j && s->ev[j].last == i && e->t_last == t &&
-                s->ev[j].t_last == t)
-                continue;
-            if (dt < best) {
-                best = dt;
-                partner = j;
-            }
+    for (int32_t j = s->head[cell]; j >= 0; j = s->next[j]) {
+        if (j == i) continue;
+        const double *q = rec(s, j);
+        double dtj = t - T(q), dr[DIM], dv[DIM];
+        for (int a = 0; a < DIM; a++) {
+            dr[a] = X(q)[a] + V(q)[a] * dtj - X(p)[a];
+            if (shift) dr[a] += shift[a];
+            dv[a] = V(q)[a] - V(p)[a];
+        }
+        double dt = gr_pair_time(DIM, dr, dv, ri + R(q), *best);
+        /* A pair that collided with each other at this very instant cannot approach
+         * again in exact arithmetic (the normal relative velocity became -xi times the
+         * old one); any approach left is rounding, e.g. after xi = 0. */
+        if (dt == 0.0 && s->ev[i].last == j && s->ev[j].last == i && s->ev[i].t_last == t &&
+            s->ev[j].t_last == t)
+            continue;
+        if (dt < *best) {
+            *best = dt;
+            *partner = j;
         }
     }
+}
+
+/* Look for pair collisions of i (whose clock is at t) in all adjacent cells (axis < 0) or
+ * in the layer newly adjacent after crossing along `axis` in direction `dir`; keep the
+ * earliest in i's event if it beats the one there. */
+static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
+{
+    const double *p = rec(s, i);
+    const int32_t *c = s->cc + (size_t)i * DIM;
+    gr_event *e = &s->ev[i];
+    double best = e->t_coll - T(p);
+    int32_t partner = -1;
+    int interior = 1;
+    for (int a = 0; a < DIM; a++) interior &= (c[a] >= 1) & (c[a] <= s->nc[a] - 2);
+    if (interior) {
+        const int32_t base = FN(cell_of)(s, c);
+        const int32_t *off = axis < 0 ? s->off_all : s->off_layer[2 * axis + (dir > 0)];
+        const int count = axis < 0 ? (DIM == 3 ? 27 : 9) : (DIM == 3 ? 9 : 3);
+        for (int k = 0; k < count; k++) FN(scan_cell)(s, i, p, base + off[k], NULL, &best, &partner);
+    } else {
+        FN(nbr) nb[DIM == 3 ? 27 : 9];
+        int count = FN(neighbours)(s, c, axis, dir, nb);
+        for (int k = 0; k < count; k++)
+            FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
+    }
     if (partner >= 0) {
-        e->t_coll = t + best;
+        e->t_coll = T(p) + best;
         e->partner = partner;
         e->pcount = s->count[partner];
     }
@@ -172,9 +194,7 @@ static void FN(predict)(gr_edmd *s, int32_t i)
             e->partner = -2 - wall;
         }
     }
-    FN(nbr) nb[DIM == 3 ? 27 : 9];
-    int count = FN(neighbours)(s, s->cc + (size_t)i * DIM, -1, 0, nb);
-    FN(scan)(s, i, nb, count);
+    FN(scan)(s, i, -1, 0);
     FN(predict_cross)(s, i);
     FN(schedule)(s, i);
 }
@@ -213,9 +233,7 @@ static int FN(do_cross)(gr_edmd *s, int32_t i, double t)
     cell_insert(s, i, FN(cell_of)(s, c));
     s->crossings++;
     FN(predict_cross)(s, i);
-    FN(nbr) nb[DIM == 3 ? 9 : 3];
-    int count = FN(neighbours)(s, c, a, dir, nb);
-    FN(scan)(s, i, nb, count);
+    FN(scan)(s, i, a, dir);
     FN(schedule)(s, i);
     return GR_OK;
 }
@@ -265,7 +283,7 @@ static int FN(do_pair)(gr_edmd *s, int32_t i, int32_t j, double t, gr_error *err
     s->ev[i].last = j;
     s->ev[j].last = i;
     if (collapse_i || collapse_j) {
-        gr_error_set(err, GR_ERR_COLLAPSE, i, j, t, (double)GR_COLLAPSE_STREAK,
+        gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), uid(s, j), t, (double)GR_COLLAPSE_STREAK,
                      GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
                      "each within 1e-9 of a free-flight time of the previous");
         FN(predict)(s, i);
@@ -292,7 +310,7 @@ static int FN(do_wall)(gr_edmd *s, int32_t i, int wall, double t, gr_error *err)
     X(p)[a] = up ? s->cfg.hi[a] - R(p) : s->cfg.lo[a] + R(p);
     for (int k = 0; k < DIM; k++) {
         if (!isfinite(V(p)[k])) {
-            gr_error_set(err, GR_ERR_NONFINITE, i, -1, t, V(p)[k], "a velocity after a heated wall");
+            gr_error_set(err, GR_ERR_NONFINITE, uid(s, i), -1, t, V(p)[k], "a velocity after a heated wall");
             return GR_ERR_NONFINITE;
         }
     }
@@ -302,7 +320,7 @@ static int FN(do_wall)(gr_edmd *s, int32_t i, int wall, double t, gr_error *err)
     s->count[i]++;
     s->ev[i].last = -2 - wall;
     if (FN(streak)(s, i, t)) {
-        gr_error_set(err, GR_ERR_COLLAPSE, i, -1, t, (double)GR_COLLAPSE_STREAK,
+        gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), -1, t, (double)GR_COLLAPSE_STREAK,
                      GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
                      "each within 1e-9 of a free-flight time of the previous");
         FN(predict)(s, i);
@@ -321,12 +339,12 @@ static void FN(write_sample)(gr_edmd *s, gr_edmd_samples *smp, double ts)
     for (int32_t i = 0; i < s->n; i++) {
         const double *p = rec(s, i);
         const double dt = ts - T(p), m = s->mass[i];
+        const size_t out = base + (size_t)s->id_of[i] * DIM;
         for (int a = 0; a < DIM; a++) {
             double v = V(p)[a];
             if (smp->pos)
-                smp->pos[base + (size_t)i * DIM + a] =
-                    X(p)[a] + v * dt + (double)s->image[(size_t)i * DIM + a] * s->L[a];
-            if (smp->vel) smp->vel[base + (size_t)i * DIM + a] = v;
+                smp->pos[out + a] = X(p)[a] + v * dt + (double)s->image[(size_t)i * DIM + a] * s->L[a];
+            if (smp->vel) smp->vel[out + a] = v;
             mom[a] += m * v;
             kin += 0.5 * m * v * v;
         }
@@ -379,6 +397,8 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
             }
         }
     }
+    int status = reorder(s);
+    if (status != GR_OK) return status;
     for (int32_t i = 0; i < n; i++) FN(predict)(s, i);
     return GR_OK;
 }
@@ -392,10 +412,14 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
     const int64_t pileup = 16 * n + 1000;
     for (int64_t k = 0;; k++) {
         if (k >= stop->max_events) return GR_STOP_BUDGET;
+        if (s->scratch && s->events >= s->next_reorder) {
+            int status = reorder(s);
+            if (status != GR_OK) return status;
+        }
         const int32_t i = gr_heap_top(&s->heap);
         const double te = gr_heap_top_time(&s->heap);
         if (te != te) {
-            gr_error_set(err, GR_ERR_NONFINITE, i, -1, s->t, te, "an event time");
+            gr_error_set(err, GR_ERR_NONFINITE, uid(s, i), -1, s->t, te, "an event time");
             return GR_ERR_NONFINITE;
         }
         while (smp && smp->next < smp->count && smp->times[smp->next] <= te &&
@@ -411,7 +435,7 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
         if (te == INFINITY) return GR_STOP_IDLE;
         if (te <= s->t_prev_event) {
             if (++s->same_instant > pileup) {
-                gr_error_set(err, GR_ERR_COLLAPSE, i, s->ev[i].partner, te, (double)pileup,
+                gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), uid(s, s->ev[i].partner), te, (double)pileup,
                              "events pile up at one instant");
                 return GR_ERR_COLLAPSE;
             }

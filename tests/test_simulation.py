@@ -156,22 +156,31 @@ def test_no_overlaps_at_any_sample_dense(dim, boundary):
         assert min_distance_ratio(s, x) >= 1 - 1e-10
 
 
-def test_centre_of_mass_moves_with_total_momentum():
+@pytest.mark.parametrize("n", [500, 6000])
+def test_centre_of_mass_moves_with_total_momentum(n):
     """Unwrapped positions are the integral of the velocities: the centre of mass of a
-    periodic system moves at P / M exactly, through collisions and image crossings."""
-    s = Scene.random(500, 0.02, masses=None, seed=3, remove_drift=False) if False else \
-        Scene.random(500, 0.02, seed=3, remove_drift=False)
+    periodic system moves at P / M exactly, through collisions and image crossings.
+    N = 6000 also exercises the engine's renumbering of particles in cell order (done
+    for N >= 4096), which must stay invisible: sample k is particle k of the scene."""
+    r = 0.02 * (500 / n) ** (1 / 3)
+    s = Scene.random(n, r, seed=3, remove_drift=False)
     masses = np.linspace(1.0, 3.0, s.n)
     s = s.replace(masses=masses)
     times = np.linspace(0.0, 20.0, 41)
-    tr = Simulation(s).run(t_stop=20.0, sample_times=times)
+    sim = Simulation(s)
+    tr = sim.run(t_stop=20.0, sample_times=times)
+    np.testing.assert_array_equal(tr.positions[0], s.positions)
+    np.testing.assert_array_equal(tr.velocities[0], s.velocities)
     M = masses.sum()
     P = (masses[:, None] * s.velocities).sum(0)
-    com = (masses[:, None, None] * tr.positions.transpose(1, 0, 2)).sum(0) / M
+    com = np.einsum("i,tia->ta", masses, tr.positions) / M
     expected = com[0] + np.outer(times, P / M)
     np.testing.assert_allclose(com, expected, rtol=0, atol=1e-11)
+    assert tr.kinetic_energy[-1] == pytest.approx(tr.kinetic_energy[0], rel=1e-13)
     # and particles did cross the box: displacements exceed its size
     assert np.abs(tr.positions[-1] - tr.positions[0]).max() > 2.0
+    assert sim.stats["events"] > 16 * n  # past at least one renumbering for the large case
+    np.testing.assert_allclose(sim.unwrapped_positions, tr.positions[-1], rtol=0, atol=1e-12)
 
 
 # -- against the slow reference ------------------------------------------------------------
@@ -200,8 +209,9 @@ def test_agrees_with_slow_reference(dim, boundary, xi):
 
 # -- runs: continuation, stop criteria, sampling, determinism ------------------------------
 
-def test_continued_run_equals_one_run():
-    s = Scene.random(300, 0.03, restitution=0.9, seed=2)
+@pytest.mark.parametrize("n", [300, 5000])
+def test_continued_run_equals_one_run(n):
+    s = Scene.random(n, 0.03 * (300 / n) ** (1 / 3), restitution=0.9, seed=2)
     one = Simulation(s).run(t_stop=2.0, sample_times=[0.5, 1.0, 2.0])
     sim = Simulation(s)
     a = sim.run(t_stop=1.0, sample_times=[0.5, 1.0])
