@@ -1,11 +1,11 @@
-/* heap.h -- an indexed binary min-heap of event times, one slot per particle.
+/* heap.h -- an indexed 4-ary min-heap of event times, one slot per particle.
  *
  * The queue knows no physics: it maps a particle id to one key (the time of that
  * particle's next event) and answers "which id has the smallest key".  Keys live in the
  * heap array beside their ids so that sifting touches one contiguous array; `where[id]`
  * gives each id's slot so a key can be changed in O(log N) without searching.
  * Invariant: every id 0..n-1 is in the heap exactly once (an id with no event has key
- * +inf), and heap[k].t <= heap[child].t for every slot k. */
+ * +inf), and node[k].t <= node[child].t for every slot k (children 4k+1 .. 4k+4). */
 #ifndef GR_HEAP_H
 #define GR_HEAP_H
 
@@ -18,7 +18,8 @@ typedef struct {
 
 typedef struct {
     int32_t n;
-    gr_heap_node *node; /* n slots, node[0] is the minimum */
+    gr_heap_node *node; /* n slots (+ padding), node[0] is the minimum */
+    gr_heap_node *raw;  /* the allocation node points into */
     int32_t *where;     /* where[id] = slot of id */
 } gr_heap;
 
