@@ -1,0 +1,254 @@
+"""Data reduction: arrays in, arrays out, no loops over particles or samples in Python.
+
+Shapes: ``times (T,)``, ``positions (T, N, d)`` unwrapped, ``velocities (T, N, d)`` or
+``(N, d)`` for one snapshot.  MSDs are totals over the d dimensions unless asked per
+dimension, as in ``granular.theory``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _positions(positions):
+    x = np.asarray(positions, dtype=np.float64)
+    if x.ndim != 3:
+        raise ValueError(f"positions must have shape (T, N, d), got {x.shape}")
+    return x
+
+
+def _times(times, count=None):
+    t = np.asarray(times, dtype=np.float64)
+    if t.ndim != 1:
+        raise ValueError("times must be one-dimensional")
+    if count is not None and len(t) != count:
+        raise ValueError(f"times has {len(t)} entries, positions {count} samples")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("times must be strictly increasing")
+    return t
+
+
+# -- mean squared displacements -------------------------------------------------------------
+
+def msd(positions, per_dimension=False):
+    """Ensemble MSD ``<|x(t) - x(0)|^2>`` over particles at every sample (any spacing).
+
+    Returns (T,) summed over dimensions, or (T, d) with ``per_dimension=True``.
+    """
+    x = _positions(positions)
+    d = x - x[0]
+    out = np.einsum("tna,tna->ta", d, d) / x.shape[1]
+    return out if per_dimension else out.sum(axis=1)
+
+
+def _uniform(times):
+    dt = np.diff(times)
+    return len(dt) > 0 and np.allclose(dt, dt[0], rtol=1e-9, atol=0)
+
+
+def tamsd(positions, lags, times=None, method="auto", per_particle=False):
+    """Time-averaged MSD (thesis 2.114-2.115) at the given lags, averaged over particles.
+
+    For each particle, ``delta^2(lag) = mean_k |x(t_k + lag) - x(t_k)|^2`` over all sample
+    pairs that are ``lag`` apart, summed over dimensions; then the mean over particles
+    (or all of them, (N, L), with ``per_particle=True``).
+
+    Parameters
+    ----------
+    lags : array_like
+        Without ``times``: lags in samples (integers).  With ``times``: lags in time
+        units, each of which must match a difference of sample times (to 1e-9 relative).
+    times : (T,) array, optional
+    method : "auto", "fft" or "direct"
+        "fft" (uniform sampling only): all lags at once in O(T log T) per particle, from
+        the autocorrelation of positions taken relative to each particle's start (which
+        keeps the rounding of the squared sums small).  "direct": pairs of samples
+        ``lag`` apart, for any sampling.  "auto" picks FFT when sampling is uniform.
+    """
+    x = _positions(positions)
+    T = x.shape[0]
+    lags = np.atleast_1d(np.asarray(lags, dtype=np.float64))
+    if times is not None:
+        t = _times(times, T)
+    else:
+        t = np.arange(T, dtype=np.float64)
+    if np.any(lags <= 0) or np.any(lags > t[-1] - t[0]):
+        raise ValueError("lags must be positive and no longer than the trajectory")
+    uniform = _uniform(t)
+    if method == "auto":
+        method = "fft" if uniform else "direct"
+    if method == "fft":
+        if not uniform:
+            raise ValueError("the FFT method needs uniformly spaced samples; use method='direct'")
+        steps = lags / (t[1] - t[0])
+        k = np.rint(steps).astype(np.int64)
+        if not np.allclose(steps, k, rtol=1e-9, atol=1e-9):
+            raise ValueError("with uniform sampling, lags must be multiples of the sample spacing")
+        out = _tamsd_fft(x, k)
+    elif method == "direct":
+        out = _tamsd_direct(x, t, lags)
+    else:
+        raise ValueError(f"method must be 'auto', 'fft' or 'direct', got {method!r}")
+    return out if per_particle else out.mean(axis=0)
+
+
+def _tamsd_fft(x, k, chunk_bytes=2**27):
+    """(N, L) TAMSD at integer lags k by the FFT algorithm, in chunks of particles."""
+    T, N, d = x.shape
+    nfft = 1 << int(math.ceil(math.log2(2 * T)))
+    out = np.empty((N, len(k)))
+    per_particle = 16 * (nfft // 2 + 1) * d + 8 * T * d
+    step = max(1, int(chunk_bytes // per_particle))
+    for lo in range(0, N, step):
+        y = x[:, lo:lo + step, :] - x[0, lo:lo + step, :]  # relative to the start
+        f = np.fft.rfft(y, n=nfft, axis=0)
+        auto = np.fft.irfft(f * f.conj(), n=nfft, axis=0)[:T]  # sum_j y_j y_{j+m}
+        sq = np.cumsum(y * y, axis=0)  # Q[m] = sum_{j<=m} y_j^2
+        total = sq[-1]
+        head = sq[T - 1 - k]  # sum_{j=0}^{T-1-m} y_j^2
+        tail = total - np.where((k >= 1)[:, None, None], sq[np.maximum(k - 1, 0)], 0.0)
+        s = (head + tail - 2.0 * auto[k]) / (T - k)[:, None, None]
+        out[lo:lo + step] = s.sum(axis=2).T
+    return out
+
+
+def _tamsd_direct(x, t, lags):
+    """(N, L) TAMSD from the pairs of samples exactly `lag` apart (any sampling)."""
+    T, N, _ = x.shape
+    out = np.empty((N, len(lags)))
+    for m, lag in enumerate(lags):
+        target = t + lag
+        j = np.clip(np.searchsorted(t, target), 0, T - 1)
+        j_lo = np.clip(j - 1, 0, T - 1)
+        pick = np.where(np.abs(t[j_lo] - target) < np.abs(t[j] - target), j_lo, j)
+        ok = np.isclose(t[pick], target, rtol=1e-9, atol=1e-12 * max(1.0, abs(t[-1])))
+        i = np.nonzero(ok)[0]
+        if len(i) == 0:
+            raise ValueError(f"no pair of sample times is {lag} apart")
+        diff = x[pick[i]] - x[i]
+        out[:, m] = np.einsum("pna,pna->n", diff, diff) / len(i)
+    return out
+
+
+def diffusivity(times, msd_values, dim=3):
+    """Time-dependent diffusivity ``D(t) = (1 / 2d) d MSD / dt`` (3D form of 2.64), with
+    the derivative taken as the mean of the forward and backward differences (4.1, 4.2)
+    on any grid; one-sided at the two ends."""
+    t = _times(times)
+    m = np.asarray(msd_values, dtype=np.float64)
+    if m.shape[0] != len(t) or len(t) < 2:
+        raise ValueError("msd must have one value per time, at least two")
+    slope = np.diff(m, axis=0) / np.diff(t).reshape((-1,) + (1,) * (m.ndim - 1))
+    deriv = np.empty_like(m)
+    deriv[0] = slope[0]
+    deriv[-1] = slope[-1]
+    deriv[1:-1] = 0.5 * (slope[:-1] + slope[1:])
+    return deriv / (2.0 * dim)
+
+
+def fit_slope(times, values, t_min=None, t_max=None, log=False):
+    """Least-squares straight line through ``values`` against ``times`` (or against
+    ``ln(times)`` with ``log=True``: the long-time MSD of a granular gas grows like
+    ln t) between t_min and t_max, as in the thesis' App. F.
+
+    Returns (slope, intercept, slope_standard_error) -- the error from the residuals
+    (ordinary least squares), which understates it for correlated MSD points.
+    """
+    t = np.asarray(times, dtype=np.float64)
+    v = np.asarray(values, dtype=np.float64)
+    sel = np.ones(len(t), dtype=bool)
+    if t_min is not None:
+        sel &= t >= t_min
+    if t_max is not None:
+        sel &= t <= t_max
+    if sel.sum() < 3:
+        raise ValueError("fit_slope needs at least three points in [t_min, t_max]")
+    xs = np.log(t[sel]) if log else t[sel]
+    A = np.vstack([xs, np.ones_like(xs)]).T
+    coef, res, *_ = np.linalg.lstsq(A, v[sel], rcond=None)
+    dof = len(xs) - 2
+    resid = v[sel] - A @ coef
+    s2 = float(resid @ resid) / dof if dof > 0 else np.nan
+    cov = s2 * np.linalg.inv(A.T @ A)
+    return float(coef[0]), float(coef[1]), float(math.sqrt(cov[0, 0]))
+
+
+# -- velocities ------------------------------------------------------------------------------
+
+def temperature(velocities, masses=1.0):
+    """Granular temperature ``T = 2 E_kin / (d N)`` of each snapshot ((N, d) -> scalar,
+    (T, N, d) -> (T,))."""
+    v = np.asarray(velocities, dtype=np.float64)
+    m = np.asarray(masses, dtype=np.float64)
+    e = 0.5 * np.sum(m[..., None] * v * v if m.ndim else m * v * v, axis=(-2, -1))
+    return 2.0 * e / (v.shape[-1] * v.shape[-2])
+
+
+_snapshot_temperature = temperature  # speed_statistics has an argument of that name
+
+
+def _speeds(velocities):
+    v = np.asarray(velocities, dtype=np.float64)
+    if v.ndim < 2 or v.shape[-1] not in (2, 3):
+        raise ValueError("velocities must have shape (..., N, d) with d = 2 or 3")
+    return np.linalg.norm(v, axis=-1).ravel(), v.shape[-1]
+
+
+def speed_histogram(velocities, bins=50, range=None):
+    """Normalised histogram of the speeds in one or more snapshots.
+
+    Returns (bin centres, density, standard error of the density) -- the error from the
+    Poisson count of each bin, ``sqrt(count) / (total * width)``.
+    """
+    speed, _ = _speeds(velocities)
+    counts, edges = np.histogram(speed, bins=bins, range=range)
+    width = np.diff(edges)
+    total = counts.sum()
+    return 0.5 * (edges[1:] + edges[:-1]), counts / (total * width), np.sqrt(counts) / (total * width)
+
+
+def speed_statistics(velocities, temperature=None, masses=1.0):
+    """Mean speed, mean squared speed and standard deviation of the speed (Table 4.1),
+    with the Maxwell-Boltzmann values at ``temperature`` (default: the snapshots' own
+    temperature) and the relative errors ``ours / theory - 1``.  As in the thesis, the
+    mean squared speed then agrees by construction."""
+    from . import theory
+
+    v = np.asarray(velocities, dtype=np.float64)
+    speed, dim = _speeds(v)
+    mass = float(np.mean(masses))
+    T = float(np.mean(_snapshot_temperature(v, masses))) if temperature is None else temperature
+    mb = theory.maxwell_boltzmann_moments(T, mass, dim)
+    ours = {"mean": speed.mean(), "mean_sq": np.mean(speed**2), "std": speed.std()}
+    return {k: {"ours": float(ours[k]), "theory": mb[k], "relative_error": float(ours[k] / mb[k] - 1)}
+            for k in ours}
+
+
+def fit_haff_tau0(times, temperature_values, t_max=None):
+    """Fit Haff's tau0 to a cooling curve: Haff's law makes ``sqrt(T0 / T(t)) - 1 = t/tau0``
+    a straight line through the origin; least squares with T0 the first sample.
+
+    Returns (tau0, standard error from the residuals).
+    """
+    t = np.asarray(times, dtype=np.float64)
+    T = np.asarray(temperature_values, dtype=np.float64)
+    sel = t > t[0] if t_max is None else (t > t[0]) & (t <= t_max)
+    y = np.sqrt(T[0] / T[sel]) - 1.0
+    x = t[sel] - t[0]
+    if len(x) < 2:
+        raise ValueError("fit_haff_tau0 needs at least two samples after the first")
+    k = float(x @ y / (x @ x))  # 1 / tau0
+    resid = y - k * x
+    err_k = math.sqrt(float(resid @ resid) / (len(x) - 1) / float(x @ x))
+    return 1.0 / k, err_k / k**2
+
+
+def ensemble_mean(values, axis=0):
+    """Mean over runs and its central-limit standard error ``std(ddof=1) / sqrt(M)``
+    (thesis 2.120-2.122)."""
+    a = np.asarray(values, dtype=np.float64)
+    m = a.shape[axis]
+    if m < 2:
+        raise ValueError("ensemble_mean needs at least two runs for an error")
+    return a.mean(axis=axis), a.std(axis=axis, ddof=1) / math.sqrt(m)

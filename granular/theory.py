@@ -1,0 +1,267 @@
+"""Analytic results the simulations are checked against.
+
+Equation numbers refer to the thesis (A. Gjersvoll, NTNU 2020) in ``shared/seeds``.
+Conventions: k_B = 1, so temperature is energy, ``T = 2 <E_kin> / d`` per particle and
+``<v_a^2> = T / m`` per velocity component.  **Every MSD here is the total over the d
+dimensions**: the thesis derives one-dimensional MSDs and multiplies by 3 (2.56); divide
+by ``dim`` for one component.  All functions accept NumPy arrays for ``t``.
+
+Validity: the kinetic-theory coefficients (collision frequency, Haff's tau0, D0, gamma0)
+are Enskog's, for a homogeneous gas (for xi < 1 the homogeneous cooling state) in the
+Maxwellian approximation -- they neglect the non-Gaussian (Sonine a2) correction of a
+granular gas, a percent-level effect for xi >= 0.5 that grows towards small xi -- and use
+approximate contact values g2 (Carnahan-Starling in 3D, Henderson's in 2D), good to
+about 1% up to eta = 0.4 (3D) and 0.5 (2D).
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+
+# -- geometry and equilibrium structure ---------------------------------------------------
+
+def packing_fraction(n, radius, volume, dim=3):
+    """Fraction of the volume (area in 2D) covered by n particles of the given radius
+    (2.44): ``eta = n (4/3) pi r^3 / V`` in 3D, ``n pi r^2 / A`` in 2D."""
+    _check_dim(dim)
+    unit = 4.0 / 3.0 * math.pi * radius**3 if dim == 3 else math.pi * radius**2
+    return n * unit / volume
+
+
+def contact_value(eta, dim=3):
+    """Contact value g2 of the equilibrium pair correlation function of hard spheres/disks.
+
+    3D: Carnahan-Starling ``(2 - eta) / (2 (1 - eta)^3)`` (2.43).  2D: Henderson's
+    ``(1 - 7 eta / 16) / (1 - eta)^2``.
+    """
+    _check_dim(dim)
+    eta = np.asarray(eta, dtype=np.float64)
+    if np.any((eta < 0) | (eta >= 1)):
+        raise ValueError("packing fraction must lie in [0, 1)")
+    g = (2 - eta) / (2 * (1 - eta) ** 3) if dim == 3 else (1 - 7 * eta / 16) / (1 - eta) ** 2
+    return g[()] if g.ndim == 0 else g
+
+
+def compressibility_factor(eta, dim=3):
+    """Equation of state Z = P / (n T) of hard spheres (Carnahan-Starling,
+    ``1 + 4 eta g2``) or disks (Henderson, ``1 + 2 eta g2``): the collision virial's
+    prediction with the approximate contact value."""
+    return 1 + (4.0 if dim == 3 else 2.0) * np.asarray(eta) * contact_value(eta, dim)
+
+
+# -- collisions, Haff's law, transport coefficients ----------------------------------------
+
+def _eta(density, radius, dim, eta):
+    return packing_fraction(density, radius, 1.0, dim) if eta is None else eta
+
+
+def collision_frequency(density, radius, temperature, mass=1.0, dim=3, eta=None):
+    """Enskog collision frequency per particle, the inverse mean collision time (2.42).
+
+    3D: ``4 sqrt(pi) g2 sigma^2 n sqrt(T/m)``; 2D: ``2 sqrt(pi) g2 sigma n sqrt(T/m)``,
+    with sigma = 2 r the diameter and n = N / V.  (2.70)-(2.71) print the collision time
+    as proportional to sqrt(T); (2.42), used here, makes it 1/sqrt(T).
+    """
+    _check_dim(dim)
+    g2 = contact_value(_eta(density, radius, dim, eta), dim)
+    sigma = 2.0 * radius
+    geometry = 4.0 * sigma**2 if dim == 3 else 2.0 * sigma
+    return geometry * math.sqrt(math.pi) * g2 * density * np.sqrt(np.asarray(temperature) / mass)
+
+
+def collision_time(density, radius, temperature, mass=1.0, dim=3, eta=None):
+    """Mean time between collisions of one particle, ``1 / collision_frequency`` (2.42)."""
+    return 1.0 / collision_frequency(density, radius, temperature, mass, dim, eta)
+
+
+def haff_tau0(density, radius, xi, temperature0, mass=1.0, dim=3, eta=None):
+    """Haff's time scale tau0 (2.41, 2.45): ``1/tau0 = (1 - xi^2) omega(T0) / (2 d)``.
+
+    In 3D this is (2.45), ``(2/3)(1 - xi^2) sqrt(pi) g2 n sigma^2 sqrt(T0/m)``.  The
+    general d follows the same derivation: a collision of equal masses loses
+    ``(1 - xi^2) m (v_n)^2 / 4``, which averages to ``(1 - xi^2) T`` over collisions of a
+    Maxwellian gas, so ``dT/dt = -(1 - xi^2) omega T / d``.  Infinite for xi = 1.
+    """
+    if not 0.0 <= xi <= 1.0:
+        raise ValueError("xi must lie in [0, 1]")
+    if xi == 1.0:
+        return math.inf
+    omega = collision_frequency(density, radius, temperature0, mass, dim, eta)
+    return 2 * dim / ((1.0 - xi**2) * omega)
+
+
+def haff_temperature(t, temperature0, tau0):
+    """Haff's law ``T(t) = T0 / (1 + t/tau0)^2`` (2.40), homogeneous cooling state."""
+    t = np.asarray(t, dtype=np.float64)
+    return temperature0 / (1.0 + t / tau0) ** 2
+
+
+def diffusion_d0(density, radius, xi, temperature0, mass=1.0, dim=3, eta=None):
+    """Self-diffusion coefficient at t = 0 (2.49-2.52): ``D0 = 4 D_E / (1 + xi)^2`` with
+    Enskog's D_E = ``3 / (8 n g2 sigma^2) sqrt(T0 / (pi m))`` in 3D (2.50), and its 2D
+    counterpart ``1 / (2 n g2 sigma) sqrt(T0 / (pi m))`` (velocity relaxation rate
+    gamma_E = (2/d) omega, the same Enskog derivation).  Per dimension:
+    ``<dx^2> = 2 D t``."""
+    _check_dim(dim)
+    g2 = contact_value(_eta(density, radius, dim, eta), dim)
+    sigma = 2.0 * radius
+    if dim == 3:
+        d_enskog = 3.0 / (8.0 * density * g2 * sigma**2)
+    else:
+        d_enskog = 1.0 / (2.0 * density * g2 * sigma)
+    return 4.0 * d_enskog * np.sqrt(np.asarray(temperature0) / (math.pi * mass)) / (1.0 + xi) ** 2
+
+
+class LangevinCoefficients(NamedTuple):
+    """Friction gamma0, diffusivity D0 (per dimension) and Haff time tau0 of a gas."""
+
+    gamma0: float
+    D0: float
+    tau0: float
+
+
+def langevin_coefficients(n, radius, volume, xi, temperature0, mass=1.0, dim=3):
+    """gamma0, D0, tau0 of a gas of n particles in a box of the given volume, as the thesis
+    derives them for its Langevin and UDSBM models: D0 (2.52), ``gamma0 = T0 / (m D0)``
+    (2.55), tau0 (2.45; infinite for xi = 1)."""
+    density = n / volume
+    d0 = float(diffusion_d0(density, radius, xi, temperature0, mass, dim))
+    gamma0 = temperature0 / (mass * d0)
+    tau0 = float(haff_tau0(density, radius, xi, temperature0, mass, dim))
+    return LangevinCoefficients(gamma0, d0, tau0)
+
+
+# -- mean squared displacements -------------------------------------------------------------
+
+def _x_plus_expm1(x):
+    """``x + expm1(-x)`` without cancellation for small x (a series there)."""
+    x = np.asarray(x, dtype=np.float64)
+    small = np.abs(x) < 1e-3
+    xs = np.where(small, x, 0.0)
+    series = xs**2 / 2 - xs**3 / 6 + xs**4 / 24 - xs**5 / 120
+    return np.where(small, series, x + np.expm1(-np.where(small, 1.0, x)))
+
+
+def _one_minus_exp_over(x):
+    """``(1 - exp(-x)) / x``, equal to 1 at x = 0."""
+    x = np.asarray(x, dtype=np.float64)
+    safe = np.where(x == 0, 1.0, x)
+    return np.where(x == 0, 1.0, -np.expm1(-safe) / safe)
+
+
+def msd_langevin(t, D0, gamma0, dim=3, v0_sq=None):
+    """MSD of a molecular gas and of the underdamped Langevin equation (2.68), total over
+    ``dim`` dimensions: ``d [2 D0 t + (2 D0/gamma0)(exp(-gamma0 t) - 1)]``.
+
+    ``v0_sq`` is the initial mean squared velocity per component; by default the thermal
+    ``T0/m = D0 gamma0`` of (2.68).  Otherwise the VACF gains
+    ``(v0_sq - D0 gamma0) exp(-gamma0 (t1 + t2))`` (2.101) and the MSD
+    ``d (v0_sq - D0 gamma0) ((1 - exp(-gamma0 t)) / gamma0)^2``.
+    Limits: ballistic ``d v0_sq t^2`` for t << 1/gamma0, diffusive ``2 d D0 t`` for
+    t >> 1/gamma0.
+    """
+    t = np.asarray(t, dtype=np.float64)
+    x = gamma0 * t
+    out = 2.0 * D0 / gamma0 * _x_plus_expm1(x)
+    if v0_sq is not None:
+        out = out + (v0_sq - D0 * gamma0) * (t * _one_minus_exp_over(x)) ** 2
+    return dim * out
+
+
+def msd_granular(t, D0, gamma0, tau0, dim=3):
+    """MSD of a granular gas in the homogeneous cooling state (2.79), total over ``dim``:
+    ``d 2 D0 tau0 [ln(1 + t/tau0) + ((1 + t/tau0)^(-gamma0 tau0) - 1) / (gamma0 tau0)]``.
+
+    From the VACF (2.77), Maxwellian start at T0.  Limits: ballistic ``d (T0/m) t^2`` for
+    t << tau0 and 1/gamma0; ultraslow ``2 d D0 tau0 ln(t/tau0)`` for t >> tau0.  Equals
+    ``msd_langevin`` for tau0 = inf.
+    """
+    if math.isinf(tau0):
+        return msd_langevin(t, D0, gamma0, dim)
+    a = gamma0 * tau0
+    u = np.log1p(np.asarray(t, dtype=np.float64) / tau0)
+    return dim * 2.0 * D0 * tau0 * _x_plus_expm1(a * u) / a
+
+
+def udsbm_v0_sq(D0, gamma0, tau0):
+    """The "correct" initial mean squared velocity per component of UDSBM (App. C):
+    ``(T0/m) gamma0 tau0 / (gamma0 tau0 - 1)``, the value for which the VACF is (2.111)
+    from t = 0 on and the MSD is (2.113).  Needs gamma0 tau0 > 1."""
+    a = gamma0 * tau0
+    if not a > 1:
+        raise ValueError("UDSBM needs gamma0 * tau0 > 1")
+    return D0 * gamma0 * a / (a - 1)
+
+
+def msd_udsbm(t, D0, gamma0, tau0, dim=3, v0_sq=None):
+    """MSD of underdamped scaled Brownian motion, total over ``dim`` dimensions.
+
+    With ``v0_sq = None`` (default) the particles start with App. C's initial speed
+    (``udsbm_v0_sq``) and the result is (2.113):
+    ``2 D0 a^2 / (a - 1)^2 [tau0 ln(1 + t/tau0) + tau0 ((1 + t/tau0)^(1-a) - 1) / (a - 1)]``
+    per dimension, a = gamma0 tau0 > 1.  Another initial mean squared velocity per
+    component adds ``(v0_sq - udsbm_v0_sq) (int_0^t (1 + s/tau0)^-a ds)^2`` (the
+    transient of the UDSBM solution, see ``granular.langevin``).
+    """
+    a = gamma0 * tau0
+    if not a > 1:
+        raise ValueError("UDSBM needs gamma0 * tau0 > 1")
+    t = np.asarray(t, dtype=np.float64)
+    u = np.log1p(t / tau0)
+    out = 2.0 * D0 * a**2 * tau0 / (a - 1) ** 3 * _x_plus_expm1((a - 1) * u)
+    if v0_sq is not None:
+        # int_0^t (1 + s/tau0)^-a ds = tau0 (1 - exp(-(a - 1) u)) / (a - 1)
+        integral = tau0 * u * _one_minus_exp_over((a - 1) * u)
+        out = out + (v0_sq - udsbm_v0_sq(D0, gamma0, tau0)) * integral**2
+    return dim * out
+
+
+def msd_ballistic(t, temperature, mass=1.0, dim=3):
+    """Short-time limit of every MSD here: free flight, ``d (T/m) t^2``."""
+    return dim * temperature / mass * np.asarray(t, dtype=np.float64) ** 2
+
+
+def msd_diffusive(t, D0, dim=3, gamma0=None):
+    """Einstein's long-time limit of a molecular gas, ``2 d D0 t`` (2.46); with gamma0 the
+    exact asymptote of (2.68), ``2 d D0 (t - 1/gamma0)``."""
+    shift = 0.0 if gamma0 is None else 1.0 / gamma0
+    return 2.0 * dim * D0 * (np.asarray(t, dtype=np.float64) - shift)
+
+
+def msd_logarithmic(t, D0, tau0, dim=3, gamma0=None):
+    """Long-time limit of a granular gas, ``2 d D0 tau0 ln(1 + t/tau0)`` (2.80); with gamma0
+    the exact asymptote of (2.79), ``2 d D0 tau0 (ln(1 + t/tau0) - 1/(gamma0 tau0))``."""
+    shift = 0.0 if gamma0 is None else 1.0 / (gamma0 * tau0)
+    return 2.0 * dim * D0 * tau0 * (np.log1p(np.asarray(t, dtype=np.float64) / tau0) - shift)
+
+
+# -- Maxwell-Boltzmann ----------------------------------------------------------------------
+
+def maxwell_boltzmann_pdf(speed, temperature, mass=1.0, dim=3):
+    """Speed density of a gas in equilibrium (2.30 in 2D, 2.32 in 3D):
+    2D ``(m v / T) exp(-m v^2 / 2T)``; 3D ``4 pi v^2 (m / 2 pi T)^(3/2) exp(-m v^2 / 2T)``."""
+    _check_dim(dim)
+    v = np.asarray(speed, dtype=np.float64)
+    b = mass / temperature
+    if dim == 2:
+        return b * v * np.exp(-0.5 * b * v * v)
+    return 4 * math.pi * v * v * (b / (2 * math.pi)) ** 1.5 * np.exp(-0.5 * b * v * v)
+
+
+def maxwell_boltzmann_moments(temperature, mass=1.0, dim=3):
+    """Expectation values of Table 2.2: mean speed, mean squared speed, standard deviation
+    of the speed and most probable speed."""
+    _check_dim(dim)
+    s = temperature / mass
+    mean = math.sqrt(math.pi * s / 2) if dim == 2 else math.sqrt(8 * s / math.pi)
+    mean_sq = dim * s
+    return {"mean": mean, "mean_sq": mean_sq, "std": math.sqrt(mean_sq - mean**2),
+            "most_probable": math.sqrt(s) if dim == 2 else math.sqrt(2 * s)}
+
+
+def _check_dim(dim):
+    if dim not in (2, 3):
+        raise ValueError(f"dim must be 2 or 3, got {dim}")

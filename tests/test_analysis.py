@@ -1,0 +1,122 @@
+"""Data reduction on synthetic trajectories with known answers."""
+import math
+
+import numpy as np
+import pytest
+
+from granular import analysis, theory
+
+
+def random_walk(T=400, N=300, d=3, D=0.5, dt=0.1, seed=0):
+    rng = np.random.default_rng(seed)
+    steps = rng.normal(scale=math.sqrt(2 * D * dt), size=(T - 1, N, d))
+    x = np.concatenate([np.zeros((1, N, d)), np.cumsum(steps, axis=0)]) + rng.random((1, N, d))
+    return np.arange(T) * dt, x
+
+
+def test_msd_of_ballistic_motion_is_exact():
+    rng = np.random.default_rng(1)
+    v = rng.normal(size=(50, 3))
+    t = np.logspace(-2, 2, 17)
+    x = rng.random((1, 50, 3)) + t[:, None, None] * v[None]
+    expected = np.mean(np.sum(v * v, axis=1)) * (t - t[0]) ** 2  # from the first sample
+    np.testing.assert_allclose(analysis.msd(x), expected, rtol=1e-12)
+    per = analysis.msd(x, per_dimension=True)
+    np.testing.assert_allclose(per.sum(1), expected, rtol=1e-12)
+    # TAMSD of ballistic motion (any lag): v^2 lag^2
+    tu = np.linspace(0, 10, 101)
+    xu = tu[:, None, None] * v[None]
+    np.testing.assert_allclose(analysis.tamsd(xu, [0.1, 2.5, 10.0], times=tu),
+                               np.mean(np.sum(v * v, 1)) * np.array([0.01, 6.25, 100.0]), rtol=1e-9)
+
+
+def test_random_walk_msd_and_tamsd_give_2dDt():
+    """Gaussian random walk, D = 0.5: MSD = 2 d D t.  The ensemble MSD at time t averages N
+    independent chi-square variables: relative standard error sqrt(2 / (d N)); 5 sigma."""
+    t, x = random_walk()
+    N, d = x.shape[1], x.shape[2]
+    m = analysis.msd(x)
+    k = [10, 100, 399]
+    np.testing.assert_allclose(m[k], 2 * d * 0.5 * t[k], rtol=5 * math.sqrt(2 / (d * N)))
+    lags = np.array([0.1, 1.0, 10.0])
+    tam = analysis.tamsd(x, lags, times=t)
+    # the TAMSD averages more windows: smaller error than the ensemble MSD's
+    np.testing.assert_allclose(tam, 2 * d * 0.5 * lags, rtol=5 * math.sqrt(2 / (d * N)))
+
+
+def test_fft_and_direct_tamsd_agree():
+    t, x = random_walk(T=257, N=40)
+    lags = t[[1, 2, 7, 64, 200, 256]]
+    fft = analysis.tamsd(x, lags, times=t, method="fft", per_particle=True)
+    direct = analysis.tamsd(x, lags, times=t, method="direct", per_particle=True)
+    np.testing.assert_allclose(fft, direct, rtol=1e-10)
+    # in samples when no times are given
+    np.testing.assert_allclose(analysis.tamsd(x, [1, 2, 7]), fft.mean(0)[:3], rtol=1e-12)
+
+
+def test_direct_tamsd_on_log_spaced_samples():
+    """Non-uniform sampling: only pairs exactly `lag` apart count.  Samples at 0, 1, 2, 4, 8:
+    lag 1 has the pairs (0,1), (1,2); lag 4 has (0,4)... of a ballistic x = v t."""
+    t = np.array([0.0, 1.0, 2.0, 4.0, 8.0])
+    x = (t[:, None, None] * np.array([[[2.0, 0.0]]]))
+    assert analysis.tamsd(x, [1.0, 4.0], times=t) == pytest.approx([4.0, 64.0])
+    with pytest.raises(ValueError, match="uniformly spaced"):
+        analysis.tamsd(x, [1.0], times=t, method="fft")
+    with pytest.raises(ValueError, match="no pair"):
+        analysis.tamsd(x, [5.0], times=t)
+
+
+def test_diffusivity_of_a_straight_line_and_a_parabola():
+    t = np.logspace(-2, 2, 40)
+    np.testing.assert_allclose(analysis.diffusivity(t, 6 * 0.3 * t, dim=3), 0.3, rtol=1e-12)
+    # forward/backward mean of t^2 on a non-uniform grid: (t_{i+1} + 2 t_i + t_{i-1}) / 2 / (2d)
+    d = analysis.diffusivity(t, t**2, dim=2)
+    expected = 0.5 * ((t[2:] + t[1:-1]) + (t[1:-1] + t[:-2])) / 4
+    np.testing.assert_allclose(d[1:-1], expected, rtol=1e-12)
+    slope, intercept, err = analysis.fit_slope(t, 3 * np.log(t) + 1, log=True)
+    assert slope == pytest.approx(3) and intercept == pytest.approx(1) and err < 1e-10
+
+
+def test_speed_statistics_of_maxwell_boltzmann_samples():
+    """Velocities drawn from Maxwell-Boltzmann at T: the mean speed agrees with theory
+    within 5 standard errors std(speed) / sqrt(N)."""
+    rng = np.random.default_rng(3)
+    for dim in (2, 3):
+        T, n = 0.8, 200_000
+        v = rng.normal(scale=math.sqrt(T), size=(n, dim))
+        st = analysis.speed_statistics(v, temperature=T)
+        mb = theory.maxwell_boltzmann_moments(T, dim=dim)
+        assert abs(st["mean"]["relative_error"]) < 5 * mb["std"] / math.sqrt(n) / mb["mean"]
+        assert abs(st["std"]["relative_error"]) < 0.01
+        centres, dens, err = analysis.speed_histogram(v, bins=40, range=(0, 4))
+        pdf = theory.maxwell_boltzmann_pdf(centres, T, dim=dim)
+        # bin-centre evaluation of a curved density: the midpoint rule's error is
+        # ~ w^2 f'' / 24, a few 1e-4 here; plus 5 Poisson sigma
+        assert np.all(np.abs(dens - pdf) < 5 * err + 2e-3)
+    assert analysis.temperature(v) == pytest.approx(T, rel=5 * math.sqrt(2 / (3 * n)))
+
+
+def test_fit_haff_tau0_recovers_tau0():
+    t = np.linspace(0, 50, 101)
+    T = theory.haff_temperature(t, 1.3, 2.5)
+    tau0, err = analysis.fit_haff_tau0(t, T)
+    assert tau0 == pytest.approx(2.5, rel=1e-12) and err < 1e-10
+
+
+def test_ensemble_mean_error_scales_with_sqrt_m():
+    rng = np.random.default_rng(4)
+    for m in (10, 1000):
+        mean, err = analysis.ensemble_mean(rng.normal(2.0, 3.0, size=(m, 200)))
+        assert np.mean(err) == pytest.approx(3 / math.sqrt(m), rel=5 / math.sqrt(2 * (m - 1) * 200))
+        assert abs(np.mean(mean) - 2.0) < 5 * 3 / math.sqrt(m * 200)
+
+
+def test_bad_input():
+    with pytest.raises(ValueError, match="shape \\(T, N, d\\)"):
+        analysis.msd(np.zeros((3, 4)))
+    with pytest.raises(ValueError, match="strictly increasing"):
+        analysis.tamsd(np.zeros((3, 2, 2)), [1.0], times=[0, 2, 1])
+    with pytest.raises(ValueError, match="lags must be positive"):
+        analysis.tamsd(np.zeros((3, 2, 2)), [5])
+    with pytest.raises(ValueError, match="at least two runs"):
+        analysis.ensemble_mean(np.zeros((1, 3)))

@@ -1,0 +1,128 @@
+"""Each formula of granular.theory against an independent evaluation: numerical
+integration of the velocity autocorrelation function it comes from, a differential
+equation solved numerically, or a known limit."""
+import math
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+from granular import theory
+
+D0, G0, TAU0 = 0.07, 9.0, 1.5
+
+
+def msd_from_vacf(vacf, t, dim=3):
+    """MSD = 2 int_0^t dt1 int_t1^t dt2 <v(t1) v(t2)> (2.59), per dimension times dim;
+    adaptive quadrature, relative accuracy ~1e-10."""
+    inner = lambda t1: integrate.quad(lambda t2: vacf(t1, t2), t1, t, epsabs=0, epsrel=1e-12, limit=200)[0]
+    return dim * 2 * integrate.quad(inner, 0, t, epsabs=0, epsrel=1e-11, limit=200)[0]
+
+
+@pytest.mark.parametrize("t", [1e-3, 0.05, 0.7, 6.0])
+def test_msd_formulas_are_the_double_integrals_of_their_vacf(t):
+    T0_m = D0 * G0  # T0 / m = D0 gamma0 (2.55)
+    a = G0 * TAU0
+    langevin = lambda t1, t2: T0_m * math.exp(-G0 * (t2 - t1))  # (2.66)
+    granular = lambda t1, t2: T0_m * (1 + t2 / TAU0) ** (-a - 1) * (1 + t1 / TAU0) ** (a - 1)  # (2.77)
+    udsbm = lambda t1, t2: T0_m * a / (a - 1) * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)  # (2.111)
+    assert theory.msd_langevin(t, D0, G0) == pytest.approx(msd_from_vacf(langevin, t), rel=1e-8)
+    assert theory.msd_granular(t, D0, G0, TAU0) == pytest.approx(msd_from_vacf(granular, t), rel=1e-8)
+    assert theory.msd_udsbm(t, D0, G0, TAU0) == pytest.approx(msd_from_vacf(udsbm, t), rel=1e-8)
+
+
+@pytest.mark.parametrize("t", [0.01, 0.5, 4.0])
+def test_msd_with_other_initial_speeds(t):
+    """A start with <v0^2> differing from the stationary value adds the decaying part of
+    the VACF: (v0^2 - v_s^2) Phi(t1) Phi(t2) with Phi = exp(-int gamma) (2.101)."""
+    v0 = 0.3
+    a = G0 * TAU0
+    vs_l = D0 * G0
+    vs_u = theory.udsbm_v0_sq(D0, G0, TAU0)
+    lang = lambda t1, t2: vs_l * math.exp(-G0 * (t2 - t1)) + (v0 - vs_l) * math.exp(-G0 * (t1 + t2))
+    phi = lambda s: (1 + s / TAU0) ** (-a)
+    uds = lambda t1, t2: (vs_u * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)
+                          + (v0 - vs_u) * phi(t1) * phi(t2))
+    assert theory.msd_langevin(t, D0, G0, v0_sq=v0) == pytest.approx(msd_from_vacf(lang, t), rel=1e-8)
+    assert theory.msd_udsbm(t, D0, G0, TAU0, v0_sq=v0) == pytest.approx(msd_from_vacf(uds, t), rel=1e-8)
+
+
+def test_msd_limits_and_numerical_stability():
+    t = np.array([1e-12, 1e-9, 1e-6])
+    T0_m = D0 * G0
+    for f in (lambda t: theory.msd_langevin(t, D0, G0),
+              lambda t: theory.msd_granular(t, D0, G0, TAU0),
+              lambda t: theory.msd_udsbm(t, D0, G0, TAU0, v0_sq=T0_m)):
+        np.testing.assert_allclose(f(t), theory.msd_ballistic(t, T0_m), rtol=1e-5)
+        assert f(0.0) == 0.0
+    big = 1e6
+    # the asymptotes with their offsets, reached to exp(-gamma0 t) and
+    # (t/tau0)^(-gamma0 tau0) -- far below rounding at t = 1e6
+    assert theory.msd_langevin(big, D0, G0) == pytest.approx(theory.msd_diffusive(big, D0, gamma0=G0), rel=1e-13)
+    assert theory.msd_granular(big, D0, G0, TAU0) == pytest.approx(
+        theory.msd_logarithmic(big, D0, TAU0, gamma0=G0), rel=1e-13)
+    assert theory.msd_langevin(big, D0, G0) == pytest.approx(theory.msd_diffusive(big, D0), rel=1e-6)
+    assert theory.msd_granular(3.0, D0, G0, math.inf) == theory.msd_langevin(3.0, D0, G0)
+    assert theory.msd_langevin(2.0, D0, G0, dim=2) == pytest.approx(theory.msd_langevin(2.0, D0, G0) * 2 / 3)
+    with pytest.raises(ValueError, match="gamma0 \\* tau0 > 1"):
+        theory.msd_udsbm(1.0, D0, 0.5, 1.0)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_maxwell_boltzmann_density_and_moments(dim):
+    T, m = 1.7, 2.0
+    pdf = lambda v: theory.maxwell_boltzmann_pdf(v, T, m, dim)
+    norm = integrate.quad(pdf, 0, np.inf)[0]
+    mean = integrate.quad(lambda v: v * pdf(v), 0, np.inf)[0]
+    mean_sq = integrate.quad(lambda v: v * v * pdf(v), 0, np.inf)[0]
+    mom = theory.maxwell_boltzmann_moments(T, m, dim)
+    assert norm == pytest.approx(1, rel=1e-10)
+    assert mom["mean"] == pytest.approx(mean, rel=1e-10)
+    assert mom["mean_sq"] == pytest.approx(mean_sq, rel=1e-10) == pytest.approx(dim * T / m)
+    assert mom["std"] == pytest.approx(math.sqrt(mean_sq - mean**2), rel=1e-10)
+    v = np.linspace(0.01, 5, 20001)
+    assert mom["most_probable"] == pytest.approx(v[np.argmax(pdf(v))], abs=3e-4)
+
+
+def test_contact_value_and_equation_of_state():
+    assert theory.contact_value(0.0) == 1.0 and theory.contact_value(0.0, dim=2) == 1.0
+    # Carnahan-Starling: 1 + 4 eta g2 = (1 + eta + eta^2 - eta^3) / (1 - eta)^3
+    for eta in (0.1, 0.3, 0.45):
+        assert theory.compressibility_factor(eta) == pytest.approx(
+            (1 + eta + eta**2 - eta**3) / (1 - eta) ** 3, rel=1e-14)
+        # second virial coefficients: g2 -> 1 + 5/2 eta (3D), 1 + 25/16... low density slopes
+    eps = 1e-7
+    assert (theory.contact_value(eps) - 1) / eps == pytest.approx(2.5, rel=1e-5)  # exact B3 term
+    assert (theory.contact_value(eps, 2) - 1) / eps == pytest.approx(25 / 16, rel=1e-5)  # 2 - 7/16
+    with pytest.raises(ValueError):
+        theory.contact_value(1.0)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_haff_law_solves_its_cooling_equation(dim):
+    """dT/dt = -(1 - xi^2) omega(T) T / d integrated numerically gives T0 / (1 + t/tau0)^2."""
+    n, xi, T0 = 1000.0, 0.7, 0.9
+    r = 0.02 if dim == 3 else 0.01
+    rhs = lambda t, T: -(1 - xi**2) * theory.collision_frequency(n, r, T, dim=dim) * T / dim
+    ts = np.linspace(0, 5, 11)
+    sol = integrate.solve_ivp(rhs, (0, 5), [T0], t_eval=ts, rtol=1e-11, atol=1e-14)
+    tau0 = theory.haff_tau0(n, r, xi, T0, dim=dim)
+    np.testing.assert_allclose(sol.y[0], theory.haff_temperature(ts, T0, tau0), rtol=1e-8)
+    assert theory.haff_tau0(n, r, 1.0, T0) == math.inf
+
+
+def test_thesis_standard_system_numbers():
+    """The thesis' standard gas: N = 1000, r = 0.025, unit box, T0 = 2/3 (speed sqrt 2):
+    eta = 0.0654 (2.44), and (2.45), (2.52), (2.55) evaluated by hand."""
+    n, r, T0, xi = 1000, 0.025, 2 / 3, 0.8
+    eta = theory.packing_fraction(n, r, 1.0)
+    assert eta == pytest.approx(0.06545, rel=1e-3)
+    g2 = (2 - eta) / (2 * (1 - eta) ** 3)
+    sigma = 0.05
+    tau0 = 1 / (2 / 3 * (1 - xi**2) * math.sqrt(math.pi) * g2 * n * sigma**2 * math.sqrt(T0))
+    d0 = 1.5 / (n * g2 * sigma**2 * (1 + xi) ** 2) * math.sqrt(T0 / math.pi)
+    c = theory.langevin_coefficients(n, r, 1.0, xi, T0)
+    assert c.tau0 == pytest.approx(tau0, rel=1e-12)
+    assert c.D0 == pytest.approx(d0, rel=1e-12)
+    assert c.gamma0 == pytest.approx(T0 / d0, rel=1e-12)
+    assert theory.langevin_coefficients(n, r, 1.0, 1.0, T0).tau0 == math.inf
