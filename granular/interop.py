@@ -1,0 +1,92 @@
+"""Trajectories out to MDAnalysis (and through it to OVITO, VMD, GROMACS tools).
+
+Units: MDAnalysis counts lengths in angstrom and time in picoseconds; granular's lengths
+(box units) and times are handed over as those numbers unchanged.  MDAnalysis keeps
+coordinates in float32 (about 7 significant digits) and gives frames evenly spaced times
+(``dt``), so log-spaced samples lose their real times in a Universe -- the file written by
+``write_trajectory`` keeps them.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def _mda():
+    try:
+        import MDAnalysis
+    except ImportError as exc:  # pragma: no cover - exercised only without MDAnalysis
+        raise ImportError("this needs MDAnalysis: pip install MDAnalysis "
+                          "(or pip install 'granular[interop]')") from exc
+    return MDAnalysis
+
+
+def _as_3d(positions):
+    x = np.asarray(positions, dtype=np.float64)
+    if x.ndim != 3 or x.shape[2] not in (2, 3):
+        raise ValueError(f"positions must have shape (T, N, d) with d = 2 or 3, got {x.shape}")
+    if x.shape[2] == 2:  # MDAnalysis is three-dimensional: disks lie in the plane z = 0
+        x = np.concatenate([x, np.zeros(x.shape[:2] + (1,))], axis=2)
+    return x
+
+
+def _dimensions(box, dim):
+    if box is None:
+        return None
+    L = np.broadcast_to(np.asarray(box, dtype=np.float64), (dim,))
+    lengths = np.concatenate([L, [1.0]]) if dim == 2 else L
+    return np.concatenate([lengths, [90.0, 90.0, 90.0]]).astype(np.float32)
+
+
+def to_universe(times, positions, box=None, radii=None):
+    """An in-memory ``MDAnalysis.Universe`` with one atom per particle and one frame per
+    sample (unwrapped positions).
+
+    ``box``: edge lengths of a periodic box (sets the frames' dimensions), or None.
+    ``radii``: stored as the atoms' ``radii`` attribute.  Frame times are evenly spaced by
+    the mean sample spacing (MDAnalysis' MemoryReader knows only a constant dt).
+    """
+    mda = _mda()
+    from MDAnalysis.coordinates.memory import MemoryReader
+
+    t = np.asarray(times, dtype=np.float64)
+    x = _as_3d(positions)
+    n = x.shape[1]
+    u = mda.Universe.empty(n, trajectory=False)
+    if radii is not None:
+        u.add_TopologyAttr("radii", np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)))
+    dims = _dimensions(box, np.asarray(positions).shape[2])
+    dt = float((t[-1] - t[0]) / (len(t) - 1)) if len(t) > 1 else 1.0
+    u.load_new(x.astype(np.float32), format=MemoryReader, order="fac", dt=dt,
+               dimensions=dims)
+    return u
+
+
+def write_trajectory(path, times, positions, velocities=None, box=None):
+    """Write a GROMACS TRR file (through MDAnalysis' TRRWriter): per frame its real time,
+    unwrapped positions and optionally velocities, in float32.  MDAnalysis, OVITO, VMD and
+    GROMACS read it; 2D scenes are written in the plane z = 0.
+
+    TRR rather than XTC because XTC compresses coordinates to a fixed precision.
+    """
+    mda = _mda()
+    from MDAnalysis.coordinates.TRR import TRRWriter
+
+    t = np.asarray(times, dtype=np.float64)
+    x = _as_3d(positions)
+    v = None if velocities is None else _as_3d(velocities)
+    if len(t) != len(x):
+        raise ValueError("times and positions must have the same number of samples")
+    n = x.shape[1]
+    u = mda.Universe.empty(n, trajectory=True, velocities=v is not None)
+    dims = _dimensions(box, np.asarray(positions).shape[2])
+    with TRRWriter(str(path), n) as w:
+        for k in range(len(t)):
+            ts = u.trajectory.ts
+            ts.positions = x[k]
+            if v is not None:
+                ts.velocities = v[k]
+            ts.dimensions = dims
+            ts.time = t[k]
+            ts.frame = k
+            w.write(u.atoms)
+    return str(path)

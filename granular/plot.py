@@ -1,0 +1,156 @@
+"""Figures: each function draws onto the given axes (or new ones) and returns them.
+
+matplotlib is imported only when a function is called.  Units follow the package:
+lengths in box lengths, k_B = 1 (temperature is energy), mass 1 unless given.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def _axes(ax):
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(figsize=(5.5, 4.0), layout="constrained")
+    return ax
+
+
+def energy(times, kinetic_energy, ax=None, label=None, relative=True):
+    """Kinetic energy against time; with ``relative`` the deviation E(t)/E(0) - 1 (thesis
+    Fig. 4.2: rounding-level for a molecular gas)."""
+    ax = _axes(ax)
+    e = np.asarray(kinetic_energy, dtype=np.float64)
+    y = e / e[0] - 1 if relative else e
+    ax.plot(times, y, label=label)
+    ax.set_xlabel("time t")
+    ax.set_ylabel(r"$E(t)/E(0) - 1$" if relative else "kinetic energy E")
+    if label:
+        ax.legend()
+    return ax
+
+
+def collisions_per_particle(times, collisions, ax=None, label=None):
+    """Mean collisions per particle against time (thesis Figs 4.3-4.4)."""
+    ax = _axes(ax)
+    ax.plot(times, collisions, label=label)
+    ax.set_xlabel("time t")
+    ax.set_ylabel("collisions per particle")
+    if label:
+        ax.legend()
+    return ax
+
+
+def speed_distribution(velocities, temperature=None, mass=1.0, bins=40, ax=None, label="simulation"):
+    """Histogram of speeds with Poisson error bars against Maxwell-Boltzmann (Figs 4.5-4.6)."""
+    from . import analysis, theory
+
+    ax = _axes(ax)
+    v = np.asarray(velocities, dtype=np.float64)
+    dim = v.shape[-1]
+    T = float(np.mean(analysis.temperature(v, mass))) if temperature is None else temperature
+    top = 4.0 * np.sqrt(dim * T / mass)
+    centres, dens, err = analysis.speed_histogram(v, bins=bins, range=(0.0, top))
+    width = centres[1] - centres[0]
+    ax.bar(centres, dens, width=width, alpha=0.5, label=label, yerr=err, ecolor="0.4")
+    s = np.linspace(0.0, top, 300)
+    ax.plot(s, theory.maxwell_boltzmann_pdf(s, T, mass, dim), "k--", label=f"Maxwell-Boltzmann ({dim}D)")
+    ax.set_xlabel("speed v")
+    ax.set_ylabel("probability density")
+    ax.legend()
+    return ax
+
+
+def haff(times, temperature, tau0, temperature0=None, ax=None, label="simulation", error=None):
+    """Granular temperature against Haff's law T0 / (1 + t/tau0)^2 on log-log axes
+    (Figs 4.8, 4.10)."""
+    from . import theory
+
+    ax = _axes(ax)
+    t = np.asarray(times, dtype=np.float64)
+    T = np.asarray(temperature, dtype=np.float64)
+    T0 = T[0] if temperature0 is None else temperature0
+    keep = t > 0
+    if error is not None:
+        ax.errorbar(t[keep], T[keep], yerr=np.asarray(error)[keep], fmt=".", label=label)
+    else:
+        ax.plot(t[keep], T[keep], ".", label=label)
+    ax.plot(t[keep], theory.haff_temperature(t[keep], T0, tau0), "k--",
+            label=rf"Haff, $\tau_0$ = {tau0:.3g}")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time t")
+    ax.set_ylabel("granular temperature T")
+    ax.legend()
+    return ax
+
+
+def msd(times, values, error=None, theory_values=None, ax=None, label="simulation",
+        theory_label="theory", loglog=True):
+    """MSD against time with error bars and a theory curve (Figs 4.11-4.13, 4.17-4.20)."""
+    ax = _axes(ax)
+    t = np.asarray(times, dtype=np.float64)
+    keep = t > 0 if loglog else np.ones(len(t), dtype=bool)
+    y = np.asarray(values)[keep]
+    if error is not None:
+        ax.errorbar(t[keep], y, yerr=np.asarray(error)[keep], fmt="o", ms=3, label=label)
+    else:
+        ax.plot(t[keep], y, "o", ms=3, label=label)
+    if theory_values is not None:
+        ax.plot(t[keep], np.asarray(theory_values)[keep], "k--", label=theory_label)
+    if loglog:
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    ax.set_xlabel("time t")
+    ax.set_ylabel(r"MSD $\langle |x(t) - x(0)|^2 \rangle$")
+    ax.legend()
+    return ax
+
+
+def diffusivity(times, values, theory_values=None, ax=None, label="simulation"):
+    """Time-dependent diffusivity (Figs 4.14-4.16)."""
+    ax = _axes(ax)
+    t = np.asarray(times, dtype=np.float64)
+    keep = t > 0
+    ax.plot(t[keep], np.asarray(values)[keep], "o", ms=3, label=label)
+    if theory_values is not None:
+        ax.plot(t[keep], np.asarray(theory_values)[keep], "k--", label="theory")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time t")
+    ax.set_ylabel("diffusivity D(t)")
+    ax.legend()
+    return ax
+
+
+def msd_vs_tamsd(times, msd_values, lags, tamsd_values, ax=None, label=""):
+    """Ensemble MSD and time-averaged MSD on one log-log plot (Figs 4.21-4.23): equal for an
+    ergodic process, apart for a non-ergodic one."""
+    ax = _axes(ax)
+    t = np.asarray(times, dtype=np.float64)
+    keep = t > 0
+    ax.plot(t[keep], np.asarray(msd_values)[keep], "-", label=f"ensemble MSD {label}".strip())
+    ax.plot(lags, tamsd_values, "o", ms=3, label=f"time-averaged MSD {label}".strip())
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("time t / lag")
+    ax.set_ylabel("MSD")
+    ax.legend()
+    return ax
+
+
+def snapshot(positions, radii, lower, upper, ax=None, color="C0"):
+    """Disks of a 2D configuration drawn to scale (Fig. 4.9)."""
+    from matplotlib.collections import EllipseCollection
+
+    ax = _axes(ax)
+    x = np.asarray(positions, dtype=np.float64)
+    if x.shape[1] != 2:
+        raise ValueError("snapshot draws 2D scenes")
+    d = 2 * np.broadcast_to(radii, (len(x),))
+    ax.add_collection(EllipseCollection(d, d, np.zeros(len(x)), units="xy", offsets=x,
+                                        offset_transform=ax.transData, facecolors=color))
+    ax.set_xlim(lower[0], upper[0])
+    ax.set_ylim(lower[1], upper[1])
+    ax.set_aspect("equal")
+    return ax
