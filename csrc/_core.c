@@ -12,6 +12,7 @@
 
 #include "common.h"
 #include "edmd.h"
+#include "rng.h"
 #include "sde.h"
 
 /* ------------------------------------------------------------------------------------ */
@@ -348,6 +349,116 @@ static PyTypeObject EDMDType = {
 
 
 /* ==== SDE binding begin ============================================================= */
+
+/* A writeable C-contiguous array of the given type and total size (for in/out buffers). */
+static void *inout(PyObject *obj, const char *name, int type, npy_intp size)
+{
+    void *data = NULL;
+    if (obj == Py_None) {
+        PyErr_Format(PyExc_ValueError, "%s is required", name);
+        return NULL;
+    }
+    return out_buffer(obj, name, type, size, &data) ? data : NULL;
+}
+
+static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *kw)
+{
+    static char *names[] = {"dim", "model", "scheme", "gamma0", "D0", "tau0", "dt", "key",
+                            "n", "first", "n_steps", "x", "v", "sample_steps", "x2", "v2",
+                            "positions", "lags", "tamsd", NULL};
+    gr_sde_config cfg;
+    unsigned long long key;
+    long long n, first, n_steps;
+    PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLOOOOOOOO", names, &cfg.dim,
+                                     &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0, &cfg.tau0,
+                                     &cfg.dt, &key, &n, &first, &n_steps, &ox, &ov, &osteps,
+                                     &ox2, &ov2, &opos, &olags, &otamsd))
+        return NULL;
+    cfg.key = key;
+    if (cfg.dim < 1 || cfg.dim > 3 || n < 0 || first < 0 || n_steps < 0) {
+        PyErr_SetString(PyExc_ValueError, "dim must be 1..3 and counts non-negative");
+        return NULL;
+    }
+    if (!PyArray_Check(ox) || !PyArray_Check(osteps) || !PyArray_Check(olags) ||
+        PyArray_TYPE((PyArrayObject *)osteps) != NPY_INT64 ||
+        PyArray_TYPE((PyArrayObject *)olags) != NPY_INT64 ||
+        !PyArray_IS_C_CONTIGUOUS((PyArrayObject *)osteps) ||
+        !PyArray_IS_C_CONTIGUOUS((PyArrayObject *)olags)) {
+        PyErr_SetString(PyExc_ValueError, "x must be an array; sample_steps and lags C-contiguous int64 arrays");
+        return NULL;
+    }
+    const npy_intp d = cfg.dim;
+    const npy_intp count = PyArray_SIZE((PyArrayObject *)ox) / d;
+    const npy_intp T = PyArray_SIZE((PyArrayObject *)osteps);
+    const npy_intp L = PyArray_SIZE((PyArrayObject *)olags);
+    if (first + count > n) {
+        PyErr_SetString(PyExc_ValueError, "first + len(x) exceeds n");
+        return NULL;
+    }
+    gr_sde_output out;
+    memset(&out, 0, sizeof out);
+    double *x = inout(ox, "x", NPY_FLOAT64, count * d);
+    double *v = x ? inout(ov, "v", NPY_FLOAT64, count * d) : NULL;
+    out.x2 = v ? inout(ox2, "x2", NPY_FLOAT64, T * d) : NULL;
+    out.v2 = out.x2 ? inout(ov2, "v2", NPY_FLOAT64, T * d) : NULL;
+    if (!out.v2) return NULL;
+    if (opos != Py_None && !(out.positions = inout(opos, "positions", NPY_FLOAT64, T * n * d)))
+        return NULL;
+    if (!(out.tamsd = inout(otamsd, "tamsd", NPY_FLOAT64, n * L))) return NULL;
+    out.n_samples = T;
+    out.sample_steps = PyArray_DATA((PyArrayObject *)osteps);
+    out.n_lags = L;
+    out.lags = PyArray_DATA((PyArrayObject *)olags);
+    for (npy_intp k = 0; k < T; k++)
+        if (out.sample_steps[k] < 0 || (k > 0 && out.sample_steps[k] <= out.sample_steps[k - 1])) {
+            PyErr_SetString(PyExc_ValueError, "sample_steps must be increasing and >= 0");
+            return NULL;
+        }
+    for (npy_intp l = 0; l < L; l++)
+        if (out.lags[l] < 1) {
+            PyErr_SetString(PyExc_ValueError, "lags must be >= 1 step");
+            return NULL;
+        }
+    /* scratch: per-lag strides, ring lengths, counters and the ring of past positions */
+    int64_t *ints = PyMem_Malloc((size_t)(6 * L + 1) * sizeof(int64_t));
+    int64_t ring_size = gr_sde_ring_size(cfg.dim, L, out.lags);
+    double *ring = PyMem_Malloc((size_t)(ring_size + 1) * sizeof(double));
+    if (!ints || !ring) {
+        PyMem_Free(ints);
+        PyMem_Free(ring);
+        return PyErr_NoMemory();
+    }
+    for (npy_intp l = 0; l < L; l++) {
+        ints[l] = gr_sde_lag_stride(out.lags[l]);
+        ints[L + l] = gr_sde_ring_len(out.lags[l]);
+    }
+    out.lag_stride = ints;
+    out.lag_len = ints + L;
+    out.lag_work = ints + 2 * L;
+    out.ring = ring;
+    gr_error err = {0, -1, -1, NAN, NAN, NULL};
+    int status;
+    Py_BEGIN_ALLOW_THREADS
+    status = gr_sde_run(&cfg, n, first, count, n_steps, x, v, &out, &err);
+    Py_END_ALLOW_THREADS
+    PyMem_Free(ints);
+    PyMem_Free(ring);
+    if (status != GR_OK) return raise_status(status, &err);
+    Py_RETURN_NONE;
+}
+
+static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *arg)
+{
+    long long lag = PyLong_AsLongLong(arg);
+    if (lag == -1 && PyErr_Occurred()) return NULL;
+    if (lag < 1) {
+        PyErr_SetString(PyExc_ValueError, "lag must be >= 1");
+        return NULL;
+    }
+    return PyLong_FromLongLong(gr_sde_lag_stride(lag));
+}
+
 /* ==== SDE binding end =============================================================== */
 
 /* ------------------------------------------------------------------------------------ */
@@ -356,6 +467,11 @@ static PyTypeObject EDMDType = {
 
 static PyMethodDef core_methods[] = {
     /* ==== SDE methods begin ==== */
+    {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
+     "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, n_steps, x, v,"
+     " sample_steps, x2, v2, positions, lags, tamsd): advance particles first..first+len(x)"
+     " by n_steps, accumulating into the given arrays (internal: use granular.langevin)."},
+    {"sde_lag_stride", sde_lag_stride, METH_O, "spacing of TAMSD window starts for a lag (steps)"},
     /* ==== SDE methods end ==== */
     {NULL, NULL, 0, NULL}
 };
@@ -383,5 +499,6 @@ PyMODINIT_FUNC PyInit__core(void)
     PyModule_AddIntConstant(m, "STOP_COLLISIONS", GR_STOP_COLLISIONS);
     PyModule_AddIntConstant(m, "STOP_ENERGY", GR_STOP_ENERGY);
     PyModule_AddIntConstant(m, "STOP_IDLE", GR_STOP_IDLE);
+    gr_rng_init();
     return m;
 }

@@ -1,0 +1,63 @@
+/* sde.h -- underdamped Langevin equation and underdamped scaled Brownian motion (UDSBM)
+ * for N independent particles: public interface.
+ *
+ *   dx = v dt,   dv = -gamma(t) v dt + sqrt(2 D(t)) gamma(t) dW
+ *   Langevin: gamma = gamma0, D = D0;  UDSBM: gamma0 / (1 + t/tau0), D0 / (1 + t/tau0)
+ *
+ * Schemes: Euler-Maruyama exactly as the thesis' (2.92)/(2.110), or the exact update of
+ * the Ornstein-Uhlenbeck process over a step (coefficients frozen at the step's midpoint
+ * for UDSBM).  Random numbers come from rng.h, keyed by (step, particle): results do not
+ * depend on chunking.  The caller owns every buffer; nothing is allocated here. */
+#ifndef GR_SDE_H
+#define GR_SDE_H
+
+#include <stdint.h>
+
+#include "common.h"
+
+enum { GR_SDE_LANGEVIN = 0, GR_SDE_UDSBM = 1 };
+enum { GR_SDE_EM = 0, GR_SDE_EXACT = 1 };
+
+typedef struct {
+    int dim;                 /* 1, 2 or 3 */
+    int model, scheme;
+    double gamma0, D0, tau0; /* tau0 = +inf for Langevin */
+    double dt;
+    uint64_t key;            /* random stream key */
+} gr_sde_config;
+
+/* What a run accumulates.  Sample k is taken after step sample_steps[k] (0 = the start);
+ * lags are in steps.  Sums run over particles in index order, so they are the same
+ * however the particles are chunked. */
+typedef struct {
+    int64_t n_samples;
+    const int64_t *sample_steps; /* increasing, >= 0 */
+    double *x2;                  /* n_samples x dim: sum over particles of x_a^2 */
+    double *v2;                  /* n_samples x dim: sum over particles of v_a^2 */
+    double *positions;           /* n_samples x n x dim, or NULL */
+    int64_t n_lags;
+    const int64_t *lags;         /* increasing, >= 1 */
+    const int64_t *lag_stride;   /* per lag: spacing of window starts (gr_sde_lag_stride) */
+    const int64_t *lag_len;      /* per lag: ring length (gr_sde_ring_len) */
+    int64_t *lag_work;           /* scratch: 4 x n_lags */
+    double *tamsd;               /* n x n_lags: per particle, sum over windows of |dx|^2 */
+    int64_t *windows;            /* n_lags: windows per particle */
+    double *ring;                /* scratch: sum over lags of (lag/stride + 1) * dim */
+} gr_sde_output;
+
+/* Stride of TAMSD window starts for a lag: windows start every max(1, lag/16) steps, so
+ * each particle keeps at most 17 past positions per lag. */
+int64_t gr_sde_lag_stride(int64_t lag);
+/* Past positions one particle keeps for a lag: lag/stride rounded up, plus one. */
+int64_t gr_sde_ring_len(int64_t lag);
+/* Doubles of ring scratch needed for the lags. */
+int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags);
+
+/* Advance particles [first, first + count) of n from step 0 to n_steps: positions x and
+ * velocities v (count x dim, starting values in, final values out; x starts at the
+ * particle's origin).  Returns GR_OK, GR_ERR_VALUE or GR_ERR_UNSTABLE (Euler-Maruyama
+ * with gamma0 dt >= 2). */
+int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
+               int64_t n_steps, double *x, double *v, gr_sde_output *out, gr_error *err);
+
+#endif

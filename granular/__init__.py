@@ -14,6 +14,7 @@ from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
 from .ensemble import EnsembleResult, ensemble
+from . import analysis, langevin, theory
 
 __version__ = "0.1.0"
 __all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "errors", "GranularError", "OverlapError",

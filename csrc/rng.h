@@ -1,0 +1,69 @@
+/* rng.h -- counter-based random numbers: every draw is a pure function of
+ * (key, step, particle, k), so results never depend on how the work is split into
+ * chunks or threads.
+ *
+ * Generator: a SplitMix64 stream per (step, particle).  Its seed is the 64-bit finaliser
+ * of SplitMix64 (Stafford's "Mix13") applied to key + counter * golden-gamma, and draw k
+ * of the stream is the finaliser of seed + (k + 1) * gamma -- the construction of
+ * SplitMix64 itself, which passes BigCrush.  Normal variates: the ziggurat method of
+ * Marsaglia and Tsang (2000) with 128 layers, taking the layer from the high bits and
+ * the magnitude from the low 32 bits of one 64-bit draw so the two are independent. */
+#ifndef GR_RNG_H
+#define GR_RNG_H
+
+#include <math.h>
+#include <stdint.h>
+
+#define GR_GOLDEN 0x9E3779B97F4A7C15ULL
+
+static inline uint64_t gr_mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+
+typedef struct {
+    uint64_t state;
+} gr_stream;
+
+/* The stream of draws for one (step, particle) under a key. */
+static inline gr_stream gr_stream_at(uint64_t key, uint64_t step, uint64_t particle)
+{
+    gr_stream s;
+    s.state = gr_mix64(key + gr_mix64(step * GR_GOLDEN + particle) * GR_GOLDEN);
+    return s;
+}
+
+static inline uint64_t gr_next64(gr_stream *s)
+{
+    s->state += GR_GOLDEN;
+    return gr_mix64(s->state);
+}
+
+/* Uniform in (0, 1), never 0 or 1 (53 bits). */
+static inline double gr_uniform(gr_stream *s)
+{
+    return ((double)(gr_next64(s) >> 11) + 0.5) * (1.0 / 9007199254740992.0);
+}
+
+/* Ziggurat tables, filled once by gr_rng_init() (call it before the first draw, from
+ * one thread; later calls return at once). */
+extern int gr_rng_ready;
+extern uint32_t gr_zig_k[128];
+extern double gr_zig_w[128], gr_zig_f[128];
+void gr_rng_init(void);
+double gr_normal_tail(gr_stream *s, int64_t hz, int iz);
+
+/* A standard normal variate. */
+static inline double gr_normal(gr_stream *s)
+{
+    uint64_t u = gr_next64(s);
+    int iz = (int)(u >> 57);            /* layer: top 7 bits */
+    int32_t hz = (int32_t)(uint32_t)u;  /* signed magnitude: low 32 bits */
+    uint32_t mag = hz < 0 ? (uint32_t)(-(int64_t)hz) : (uint32_t)hz;
+    if (mag < gr_zig_k[iz]) return hz * gr_zig_w[iz];
+    return gr_normal_tail(s, hz, iz);
+}
+
+#endif

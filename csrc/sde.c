@@ -1,0 +1,174 @@
+/* sde.c -- Euler-Maruyama and exact integration of the underdamped Langevin equation and
+ * of UDSBM (see sde.h), with the ensemble MSD and the time-averaged MSD accumulated on
+ * the fly.
+ *
+ * Each particle is independent, so the loop runs over particles outside and steps
+ * inside: a particle's state stays in registers for the whole run, and the TAMSD needs
+ * only the ring of one particle's recent positions at a time (O(lags) memory, not
+ * O(N x steps)).  Invariant: a particle's random numbers depend only on (key, step,
+ * particle), never on the order of work. */
+#include <math.h>
+#include <string.h>
+
+#include "rng.h"
+#include "sde.h"
+
+#define GR_TAMSD_WINDOWS_PER_LAG 16
+
+int64_t gr_sde_lag_stride(int64_t lag)
+{
+    int64_t s = lag / GR_TAMSD_WINDOWS_PER_LAG;
+    return s < 1 ? 1 : s;
+}
+
+int64_t gr_sde_ring_len(int64_t lag)
+{
+    int64_t s = gr_sde_lag_stride(lag);
+    return (lag + s - 1) / s + 1;
+}
+
+int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags)
+{
+    int64_t total = 0;
+    for (int64_t l = 0; l < n_lags; l++) total += gr_sde_ring_len(lags[l]) * dim;
+    return total;
+}
+
+/* x-noise variance of the exact step in units of D/gamma, minus the part explained by the
+ * velocity noise: g(h) = 2 f(h) - (1-c)^3/(1+c), c = exp(-h), with
+ * f(h) = h - 2(1-c) + (1-c^2)/2.  A series for small h, where the terms cancel. */
+static double exact_gxx(double h)
+{
+    if (h < 1e-2) return h * h * h * (1.0 / 6.0 - h * h / 60.0);
+    double omc = -expm1(-h), c = 1.0 - omc;
+    double f = h - 2.0 * omc - 0.5 * expm1(-2.0 * h);
+    return 2.0 * f - omc * omc * omc / (1.0 + c);
+}
+
+/* Per-step coefficients of the exact update for friction g and diffusivity D. */
+typedef struct {
+    double c, drift, sv, kx, sx;
+} exact_coef;
+
+static exact_coef exact_for(double g, double D, double dt)
+{
+    exact_coef e;
+    double h = g * dt, omc = -expm1(-h);
+    e.c = 1.0 - omc;
+    e.drift = omc / g;                              /* x += v (1 - c)/gamma */
+    double vv = -D * g * expm1(-2.0 * h);           /* Var(v noise) = D gamma (1 - c^2) */
+    e.sv = sqrt(vv);
+    double cxv = D * omc * omc;                     /* Cov(x noise, v noise) */
+    e.kx = vv > 0.0 ? cxv / e.sv : 0.0;
+    double rest = D / g * exact_gxx(h);
+    e.sx = rest > 0.0 ? sqrt(rest) : 0.0;
+    return e;
+}
+
+int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
+               int64_t n_steps, double *x, double *v, gr_sde_output *out, gr_error *err)
+{
+    const int d = cfg->dim;
+    const double dt = cfg->dt, g0 = cfg->gamma0, D0 = cfg->D0, tau0 = cfg->tau0;
+    const int udsbm = cfg->model == GR_SDE_UDSBM;
+    if (d < 1 || d > 3 || !(dt > 0.0) || !(g0 > 0.0) || !(D0 > 0.0) || !(tau0 > 0.0) ||
+        n_steps < 0 || first < 0 || count < 0 || first + count > n) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, "invalid SDE parameters");
+        return GR_ERR_VALUE;
+    }
+    if (cfg->scheme == GR_SDE_EM && g0 * dt >= 2.0) {
+        gr_error_set(err, GR_ERR_UNSTABLE, -1, -1, NAN, g0 * dt,
+                     "Euler-Maruyama diverges for gamma0*dt >= 2; take a smaller dt or the "
+                     "exact scheme (scheme='exact'), stable at any step");
+        return GR_ERR_UNSTABLE;
+    }
+    if (!gr_rng_ready) gr_rng_init();
+    const double sq_dt = sqrt(dt), b0 = sqrt(2.0 * D0) * g0 * sq_dt;
+    const exact_coef ex0 = exact_for(g0, D0, dt);
+
+    for (int64_t local = 0; local < count; local++) {
+        const int64_t i = first + local;
+        double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0};
+        for (int a = 0; a < d; a++) {
+            xi[a] = x[local * d + a];
+            vi[a] = v[local * d + a];
+        }
+        int64_t ks = 0;
+        /* per lag: next window end, next store, their ring slots (no divisions per step) */
+        int64_t *next_end = out->lag_work, *next_store = next_end + out->n_lags;
+        int64_t *slot_end = next_store + out->n_lags, *slot_store = slot_end + out->n_lags;
+        for (int64_t l = 0; l < out->n_lags; l++) {
+            next_end[l] = out->lags[l];
+            next_store[l] = 0;
+            slot_end[l] = 0;
+            slot_store[l] = 0;
+        }
+        /* step 0: the start is a sample and a window start for every lag */
+        for (int64_t step = 0;; step++) {
+            if (step > 0) {
+                gr_stream rs = gr_stream_at(cfg->key, (uint64_t)(step - 1), (uint64_t)i);
+                const double t = (double)(step - 1) * dt;
+                if (cfg->scheme == GR_SDE_EM) {
+                    double a_coef = 1.0 - g0 * dt, b = b0;
+                    if (udsbm) { /* gamma(t_n), D(t_n) at the start of the step (2.110) */
+                        double s = 1.0 / (1.0 + t / tau0);
+                        a_coef = 1.0 - g0 * s * dt;
+                        b = b0 * s * sqrt(s);
+                    }
+                    for (int a = 0; a < d; a++) {
+                        double z = gr_normal(&rs);
+                        xi[a] += vi[a] * dt;
+                        vi[a] = a_coef * vi[a] + b * z;
+                    }
+                } else {
+                    exact_coef e = ex0;
+                    if (udsbm) { /* coefficients frozen at the midpoint of the step */
+                        double s = 1.0 / (1.0 + (t + 0.5 * dt) / tau0);
+                        e = exact_for(g0 * s, D0 * s, dt);
+                    }
+                    for (int a = 0; a < d; a++) {
+                        double z1 = gr_normal(&rs), z2 = gr_normal(&rs);
+                        xi[a] += vi[a] * e.drift + e.kx * z1 + e.sx * z2;
+                        vi[a] = e.c * vi[a] + e.sv * z1;
+                    }
+                }
+            }
+            while (ks < out->n_samples && out->sample_steps[ks] == step) {
+                for (int a = 0; a < d; a++) {
+                    out->x2[ks * d + a] += xi[a] * xi[a];
+                    out->v2[ks * d + a] += vi[a] * vi[a];
+                    if (out->positions) out->positions[(ks * n + i) * d + a] = xi[a];
+                }
+                ks++;
+            }
+            double *r = out->ring;
+            for (int64_t l = 0; l < out->n_lags; l++) {
+                const int64_t stride = out->lag_stride[l], len = out->lag_len[l];
+                if (step == next_end[l]) {
+                    const double *old = r + slot_end[l] * d;
+                    double sum = 0.0;
+                    for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
+                    out->tamsd[i * out->n_lags + l] += sum;
+                    next_end[l] += stride;
+                    if (++slot_end[l] == len) slot_end[l] = 0;
+                }
+                if (step == next_store[l]) {
+                    memcpy(r + slot_store[l] * d, xi, (size_t)d * sizeof(double));
+                    next_store[l] += stride;
+                    if (++slot_store[l] == len) slot_store[l] = 0;
+                }
+                r += len * d;
+            }
+            if (step == n_steps) break;
+        }
+        for (int a = 0; a < d; a++) {
+            if (!isfinite(xi[a]) || !isfinite(vi[a])) {
+                gr_error_set(err, GR_ERR_NONFINITE, i, -1, NAN, NAN, "in the SDE state");
+                return GR_ERR_NONFINITE;
+            }
+            x[local * d + a] = xi[a];
+            v[local * d + a] = vi[a];
+        }
+    }
+    return GR_OK;
+}

@@ -1,0 +1,254 @@
+"""Langevin models of molecular and granular gases (thesis 2.9, 4.2, App. C, E.2).
+
+Each of N independent particles follows
+
+    dx = v dt,    dv = -gamma(t) v dt + sqrt(2 D(t)) gamma(t) dW
+
+- ``model="langevin"``: constant gamma0, D0 -- the underdamped Langevin equation, a model of
+  a molecular gas (its MSD is the molecular gas' (2.68));
+- ``model="udsbm"``: gamma0 / (1 + t/tau0) and D0 / (1 + t/tau0) -- underdamped scaled
+  Brownian motion, a model of a granular gas cooling by Haff's law (MSD 2.113).
+
+Schemes
+-------
+``scheme="em"``: Euler-Maruyama exactly as (2.92)/(2.110), ``x += v dt``,
+``v += -gamma_n v dt + sqrt(2 D_n) gamma_n dW`` with dW ~ N(0, dt) (the thesis' printed
+noise term lost a bracket in conversion; this is the intended one).  It is unstable for
+gamma0 dt >= 2, which is refused, and biased before: the stationary velocity variance of
+the Langevin model is ``(T/m) * 2 / (2 - gamma0 dt)`` instead of T/m.
+
+``scheme="exact"``: the exact Gaussian update of (x, v) over a step of the
+Ornstein-Uhlenbeck process with the step's coefficients -- exact for the Langevin model at
+any step, and stable at any step.  For UDSBM the coefficients are frozen at the step's
+midpoint; since they change on the time scale 1 + t/tau0, the local error per step is
+O((dt / tau0)^2) relative, and the integrated error O(dt^2 / (tau0 (tau0 + t))) -- far
+below Euler-Maruyama's O(gamma0 dt) bias.
+
+Random numbers are counter-based (see ``csrc/rng.h``): each particle's noise at each step
+is a function of (seed, step, particle) only, so results are bit-identical whatever the
+chunking.  Nothing of size N x steps is stored: the ensemble MSD at the sample times and
+the time-averaged MSD at the requested lags are accumulated on the fly (window starts every
+max(1, lag/16) steps, so each particle needs at most 17 past positions per lag).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _core
+
+MODELS = ("langevin", "udsbm")
+SCHEMES = ("em", "exact")
+INITIAL = ("thermal", "udsbm", "fixed")
+_CHUNK_PARTICLE_STEPS = 20_000_000  # per call into C: ~0.2 s, so Ctrl-C is prompt
+
+
+class LangevinResult:
+    """What a Langevin/UDSBM run measured.
+
+    Attributes
+    ----------
+    times : (T,) sample times (whole steps: ``steps * dt``)
+    msd, msd_per_dimension : (T,), (T, d) ensemble MSD from the common start
+    v2 : (T,) mean squared speed; ``temperature = mass * v2 / d``
+    tamsd_lags : (L,) lags in time; tamsd : (L,) particle-averaged time-averaged MSD;
+    tamsd_per_particle : (N, L)
+    positions : (T, N, d) or None
+    model, scheme, gamma0, D0, tau0, dt, n, dim, t_stop, v0_sq (initial mean squared
+    velocity per component)
+    """
+
+    def __init__(self, **fields):
+        self.__dict__.update(fields)
+
+    @property
+    def temperature(self):
+        return self.v2 / self.dim
+
+    def theory_msd(self, t=None):
+        """The analytic ensemble MSD of this model from ``granular.theory`` (with this
+        run's initial speed) at the sample times or at t."""
+        from . import theory
+
+        t = self.times if t is None else t
+        if self.model == "langevin":
+            return theory.msd_langevin(t, self.D0, self.gamma0, self.dim, v0_sq=self.v0_sq)
+        return theory.msd_udsbm(t, self.D0, self.gamma0, self.tau0, self.dim, v0_sq=self.v0_sq)
+
+    def __repr__(self):
+        return (f"LangevinResult(model={self.model!r}, scheme={self.scheme!r}, n={self.n}, "
+                f"dim={self.dim}, dt={self.dt}, t_stop={self.t_stop}, samples={len(self.times)}, "
+                f"lags={len(self.tamsd_lags)})")
+
+
+def _positive(name, value):
+    value = float(value)
+    if not (value > 0 and math.isfinite(value)):
+        raise ValueError(f"{name} must be positive and finite, got {value}")
+    return value
+
+
+def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="em", dim=3,
+        sample_times=None, tamsd_lags=None, initial="thermal", speed=None,
+        store_positions=False, seed=None, progress=False):
+    """Integrate N independent particles from a common start at the origin.
+
+    Parameters
+    ----------
+    n : number of particles
+    gamma0, D0 : friction and diffusivity (per dimension) at t = 0
+    tau0 : UDSBM time scale (infinite: the Langevin model)
+    model : "langevin" or "udsbm" (default: "udsbm" when tau0 is finite)
+    scheme : "em" (Euler-Maruyama, thesis 2.92/2.110) or "exact"
+    dt, t_stop : step and duration (t_stop is rounded to whole steps)
+    dim : 1, 2 or 3
+    sample_times : times to sample the ensemble MSD (rounded to whole steps; default 60
+        log-spaced times and 0)
+    tamsd_lags : lags (in time) of the time-averaged MSD over [0, t_stop]
+    initial : "thermal" -- Gaussian velocities with <v_a^2> = T0/m = D0 gamma0;
+        "udsbm" -- Gaussian with App. C's "correct" <v_a^2> = D0 gamma0 a/(a - 1),
+        a = gamma0 tau0, for which the UDSBM MSD is exactly (2.113);
+        "fixed" -- every particle at ``speed`` (default sqrt(d D0 gamma0), the thermal rms
+        speed) in an isotropic random direction (thesis 3.3, made isotropic).
+    store_positions : keep (T, N, d) positions at the sample times
+    seed : anything ``numpy.random.SeedSequence`` takes
+    progress : tqdm bar over particle chunks
+    """
+    n = int(n)
+    if n < 1:
+        raise ValueError(f"n must be >= 1, got {n}")
+    if dim not in (1, 2, 3):
+        raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
+    gamma0, D0, dt, t_stop = (_positive(k, v) for k, v in
+                              (("gamma0", gamma0), ("D0", D0), ("dt", dt), ("t_stop", t_stop)))
+    tau0 = float(tau0)
+    if not tau0 > 0:
+        raise ValueError(f"tau0 must be positive (inf for the Langevin model), got {tau0}")
+    if model is None:
+        model = "langevin" if math.isinf(tau0) else "udsbm"
+    if model not in MODELS:
+        raise ValueError(f"model must be one of {MODELS}, got {model!r}")
+    if model == "udsbm" and math.isinf(tau0):
+        raise ValueError("UDSBM needs a finite tau0")
+    if model == "langevin":
+        tau0 = math.inf
+    if scheme not in SCHEMES:
+        raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
+    if scheme == "em" and gamma0 * dt >= 2.0:
+        from .errors import UnstableStepError
+
+        raise UnstableStepError(
+            f"Euler-Maruyama diverges for gamma0*dt >= 2 (here {gamma0 * dt:.4g}); take "
+            f"dt < {2 / gamma0:.4g} or scheme='exact', which is stable at any step",
+            value=gamma0 * dt)
+    n_steps = int(round(t_stop / dt))
+    if n_steps < 1:
+        raise ValueError("t_stop must be at least one step")
+
+    if sample_times is None:
+        steps = np.unique(np.concatenate([[0], np.rint(np.logspace(0, math.log10(n_steps), 60))]))
+    else:
+        st = np.asarray(sample_times, dtype=np.float64).reshape(-1)
+        if not np.all(np.isfinite(st)) or np.any(st < 0):
+            raise ValueError("sample_times must be finite and >= 0")
+        steps = np.rint(st / dt)
+        if np.any(np.diff(steps) <= 0):
+            raise ValueError("sample_times must be increasing and at least one step apart")
+    steps = steps.astype(np.int64)
+    if len(steps) and steps[-1] > n_steps:
+        raise ValueError(f"sample_times reach past t_stop = {n_steps * dt}")
+    if tamsd_lags is None:
+        lags = np.zeros(0, dtype=np.int64)
+    else:
+        lags = np.rint(np.asarray(tamsd_lags, dtype=np.float64).reshape(-1) / dt).astype(np.int64)
+        if np.any(lags < 1) or np.any(lags > n_steps) or np.any(np.diff(lags) <= 0):
+            raise ValueError("tamsd_lags must be increasing, at least dt and at most t_stop")
+
+    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    key_seq, vel_seq = ss.spawn(2)
+    key = int(key_seq.generate_state(1, dtype=np.uint64)[0])
+    rng = np.random.default_rng(vel_seq)
+    thermal = D0 * gamma0  # T0/m (2.55)
+    if initial == "thermal":
+        v0_sq = thermal
+        v = rng.normal(scale=math.sqrt(v0_sq), size=(n, dim))
+    elif initial == "udsbm":
+        if model != "udsbm":
+            raise ValueError("initial='udsbm' is App. C's initial speed of the UDSBM model")
+        from .theory import udsbm_v0_sq
+
+        v0_sq = udsbm_v0_sq(D0, gamma0, tau0)
+        v = rng.normal(scale=math.sqrt(v0_sq), size=(n, dim))
+    elif initial == "fixed":
+        s = math.sqrt(dim * thermal) if speed is None else _positive("speed", speed)
+        g = rng.normal(size=(n, dim))
+        g /= np.maximum(np.linalg.norm(g, axis=1), 1e-300)[:, None]
+        v = s * g
+        v0_sq = s * s / dim
+    else:
+        raise ValueError(f"initial must be one of {INITIAL}, got {initial!r}")
+
+    T, L = len(steps), len(lags)
+    if store_positions:
+        need = 8.0 * T * n * dim
+        if need > 8e9:
+            raise MemoryError(f"storing positions needs {need / 2**30:.1f} GiB; sample fewer "
+                              "times or leave store_positions off (the MSD is accumulated anyway)")
+    x = np.zeros((n, dim))
+    x2 = np.zeros((T, dim))
+    v2 = np.zeros((T, dim))
+    positions = np.zeros((T, n, dim)) if store_positions else None
+    tamsd_sum = np.zeros((n, L))
+    model_code = MODELS.index(model)
+    scheme_code = SCHEMES.index(scheme)
+    per_call = max(1, _CHUNK_PARTICLE_STEPS // max(1, n_steps))
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=n, unit="particle", leave=False)
+    try:
+        for first in range(0, n, per_call):
+            xs = np.ascontiguousarray(x[first:first + per_call])
+            vs = np.ascontiguousarray(v[first:first + per_call])
+            _core.sde_run(dim, model_code, scheme_code, gamma0, D0, tau0, dt, key, n, first,
+                          n_steps, xs, vs, steps, x2, v2, positions, lags, tamsd_sum)
+            x[first:first + len(xs)] = xs
+            v[first:first + len(vs)] = vs
+            if bar is not None:
+                bar.update(len(xs))
+    finally:
+        if bar is not None:
+            bar.close()
+
+    strides = np.array([_core.sde_lag_stride(int(k)) for k in lags], dtype=np.int64)
+    windows = (n_steps - lags) // np.maximum(strides, 1) + 1
+    per_particle = tamsd_sum / windows if L else tamsd_sum
+    return LangevinResult(
+        times=steps * dt, steps=steps, msd=x2.sum(1) / n, msd_per_dimension=x2 / n,
+        v2=v2.sum(1) / n, tamsd_lags=lags * dt, tamsd=per_particle.mean(0) if L else np.zeros(0),
+        tamsd_per_particle=per_particle, positions=positions, final_positions=x,
+        final_velocities=v, model=model, scheme=scheme, gamma0=gamma0, D0=D0, tau0=tau0, dt=dt,
+        n=n, dim=dim, t_stop=n_steps * dt, v0_sq=v0_sq)
+
+
+def coefficients_from_scene(scene):
+    """gamma0, D0, tau0 of a Scene exactly as the thesis derives them (2.45, 2.52, 2.55),
+    from its N, radius, mass, restitution, box and temperature."""
+    from . import theory
+
+    radius = float(np.mean(scene.radii))
+    mass = float(np.mean(scene.masses))
+    return theory.langevin_coefficients(scene.n, radius, scene.volume, scene.restitution,
+                                        scene.temperature, mass, scene.dim)
+
+
+def from_scene(scene, *, dt, t_stop, scheme="em", n=None, **kwargs):
+    """A Langevin run (xi = 1) or UDSBM run (xi < 1) with the scene's coefficients, so it
+    can be set beside an EDMD run of the same scene.  ``n`` defaults to the scene's N;
+    other arguments as in ``run``."""
+    c = coefficients_from_scene(scene)
+    model = "langevin" if math.isinf(c.tau0) else "udsbm"
+    return run(scene.n if n is None else n, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, model=model,
+               scheme=scheme, dt=dt, t_stop=t_stop, dim=scene.dim, **kwargs)
