@@ -12,6 +12,10 @@ def main(argv=None):
     demo = sub.add_parser("demo", help="a granular and a molecular gas against theory")
     demo.add_argument("--out", default="granular-demo", help="output folder for figures")
     demo.add_argument("--quick", action="store_true", help="smaller, for tests")
+    rep = sub.add_parser("reproduce", help="the thesis' chapter 4, figure by figure")
+    rep.add_argument("--out", default="granular-reproduce", help="output folder")
+    rep.add_argument("--quick", action="store_true", help="small sizes, under a minute")
+    rep.add_argument("--runs", type=int, default=None, help="runs per experiment")
     bench = sub.add_parser("bench", help="throughput benchmarks")
     bench.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     bench.add_argument("--quick", action="store_true", help="tiny workloads (seconds)")
@@ -22,6 +26,10 @@ def main(argv=None):
         from . import demo as demo_module
 
         demo_module.main(out=args.out, quick=args.quick)
+    elif args.command == "reproduce":
+        from . import reproduce
+
+        reproduce.main(out=args.out, quick=args.quick, runs=args.runs)
     elif args.command == "bench":
         from . import bench as bench_module
 

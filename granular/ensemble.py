@@ -91,9 +91,10 @@ class _Accumulator:
                 self.ragged.add(k)
                 del self.mean[k], self.m2[k]
                 continue
-            delta = v - self.mean[k]
-            self.mean[k] += delta / self.count
-            self.m2[k] += delta * (v - self.mean[k])
+            with np.errstate(invalid="ignore"):  # inf parameters (tau0 = inf) stay inf
+                delta = v - self.mean[k]
+                self.mean[k] += delta / self.count
+                self.m2[k] += delta * (v - self.mean[k])
 
     def result(self):
         error = {}
