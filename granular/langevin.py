@@ -103,9 +103,11 @@ def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="em", di
     scheme : "em" (Euler-Maruyama, thesis 2.92/2.110) or "exact"
     dt, t_stop : step and duration (t_stop is rounded to whole steps)
     dim : 1, 2 or 3
-    sample_times : times to sample the ensemble MSD (rounded to whole steps; default 60
-        log-spaced times and 0)
-    tamsd_lags : lags (in time) of the time-averaged MSD over [0, t_stop]
+    sample_times : increasing times to sample the ensemble MSD, rounded to whole steps
+        (times that round to the same step are sampled once: ``result.times`` has the
+        times used); default 60 log-spaced times and 0
+    tamsd_lags : increasing lags (in time) of the time-averaged MSD over [0, t_stop],
+        rounded to whole steps like the sample times (``result.tamsd_lags``)
     initial : "thermal" -- Gaussian velocities with <v_a^2> = T0/m = D0 gamma0;
         "udsbm" -- Gaussian with App. C's "correct" <v_a^2> = D0 gamma0 a/(a - 1),
         a = gamma0 tau0, for which the UDSBM MSD is exactly (2.113);
@@ -152,18 +154,21 @@ def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="em", di
         st = np.asarray(sample_times, dtype=np.float64).reshape(-1)
         if not np.all(np.isfinite(st)) or np.any(st < 0):
             raise ValueError("sample_times must be finite and >= 0")
-        steps = np.rint(st / dt)
-        if np.any(np.diff(steps) <= 0):
-            raise ValueError("sample_times must be increasing and at least one step apart")
+        if np.any(np.diff(st) <= 0):
+            raise ValueError("sample_times must be strictly increasing")
+        steps = np.unique(np.rint(st / dt))  # whole steps; times within one step merge
     steps = steps.astype(np.int64)
     if len(steps) and steps[-1] > n_steps:
         raise ValueError(f"sample_times reach past t_stop = {n_steps * dt}")
     if tamsd_lags is None:
         lags = np.zeros(0, dtype=np.int64)
     else:
-        lags = np.rint(np.asarray(tamsd_lags, dtype=np.float64).reshape(-1) / dt).astype(np.int64)
-        if np.any(lags < 1) or np.any(lags > n_steps) or np.any(np.diff(lags) <= 0):
-            raise ValueError("tamsd_lags must be increasing, at least dt and at most t_stop")
+        lag_t = np.asarray(tamsd_lags, dtype=np.float64).reshape(-1)
+        if np.any(np.diff(lag_t) <= 0):
+            raise ValueError("tamsd_lags must be strictly increasing")
+        lags = np.unique(np.rint(lag_t / dt)).astype(np.int64)  # whole steps, merged
+        if np.any(lags < 1) or np.any(lags > n_steps):
+            raise ValueError("tamsd_lags must be at least dt and at most t_stop")
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     key_seq, vel_seq = ss.spawn(2)

@@ -403,12 +403,13 @@ def _report(cfg, rows, names, seconds):
         "Maxwell-Boltzmann within the statistical error; <v^2> agrees by construction (T is "
         "measured from the energy), as in the thesis.  The thesis' own Table 4.1 numbers did "
         "not survive the text conversion, so that column is empty.",
-        "- **Haff's law**: the fitted tau0 lies a few percent above (2.45) for xi = 0.99 and "
-        "0.5 and more for xi = 0.3 -- the gas cools a little more slowly than the Maxwellian "
-        "(Enskog) theory says, as the thesis also noticed ('computed values somewhat higher "
-        "than theory' at low xi).  The known cause is the non-Gaussian velocity distribution "
-        "of the cooling state (Sonine coefficient a2) and correlated collisions; both grow "
-        "with inelasticity.",
+        "- **Haff's law**: the fitted tau0 matches (2.45) at xi = 0.99 and lies above it by "
+        "several percent at xi = 0.5 and about ten at xi = 0.3 -- the gas cools more slowly "
+        "than the Maxwellian (Enskog) theory says, as the thesis also noticed ('computed "
+        "values somewhat higher than theory' at low xi).  The non-Gaussian velocity "
+        "distribution of the cooling state (Sonine coefficient a2) accounts for a percent or "
+        "two of this; the rest is beyond Enskog-level theory (velocity correlations that "
+        "inelastic collisions build up), and grows with inelasticity.",
         "- **MSD slopes** (App. F): for the molecular gas our slope, like the thesis' 0.364, "
         "lies a few percent above Enskog's 6 D0 = 0.350 (Enskog underestimates self-diffusion "
         "at this density).  For xi = 0.8 the theory value of 6 D0 tau0 from (2.45) and (2.52) "

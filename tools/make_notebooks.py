@@ -1,0 +1,110 @@
+"""Build the notebooks (outputs stripped) from cell lists -- run once, commit the .ipynb."""
+import nbformat as nbf
+
+def nb(cells):
+    n = nbf.v4.new_notebook()
+    n.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    n.cells = [nbf.v4.new_markdown_cell(c[3:]) if c.startswith("md:") else nbf.v4.new_code_cell(c) for c in cells]
+    return n
+
+setup = '''import os
+import numpy as np
+import matplotlib.pyplot as plt
+import granular
+from granular import theory, plot
+QUICK = os.environ.get("GRANULAR_QUICK") == "1"  # the test suite runs the notebooks small'''
+
+quick = [
+"md:# granular in ten cells\nA granular gas of hard spheres in the thesis' standard box, run by event-driven MD and compared with theory.",
+setup,
+"md:A scene: N = 1000 spheres of radius 0.025 in the periodic unit box (packing fraction 0.065), speed sqrt(2) in isotropic directions.",
+'''n, r = (1000, 0.025) if not QUICK else (300, 0.0373)
+scene = granular.Scene.random(n, r, seed=1)
+scene''',
+"md:Equilibrate it as a molecular gas, then make it granular (xi = 0.8) and run to t = 20, sampling on a log grid.",
+'''sim = granular.Simulation(scene)
+sim.run(stop_when={"collisions_per_particle": 20}, store=())
+gas = sim.scene.replace(restitution=0.8)
+times = np.concatenate([[0], np.logspace(-2, np.log10(20 if not QUICK else 5), 30)])
+traj = granular.Simulation(gas).run(t_stop=times[-1], sample_times=times)
+traj''',
+"md:Haff's law: the temperature against T0 / (1 + t/tau0)^2 with tau0 from (2.45).",
+'''c = theory.langevin_coefficients(n, r, 1.0, 0.8, gas.temperature)
+plot.haff(traj.times, traj.temperature, tau0=c.tau0)''',
+"md:The mean squared displacement against (2.79): ballistic, then logarithmic (ultraslow diffusion).",
+'''plot.msd(traj.times, traj.msd(), theory_values=theory.msd_granular(traj.times, c.D0, c.gamma0, c.tau0))''',
+]
+
+repro = [
+"md:# The thesis' chapter 4, the story\nThe same functions as `python -m granular reproduce`, one section at a time. Each call runs the thesis' system with five times its number of runs (set `QUICK` to shrink it) and returns figure files and summary rows.",
+setup + "\nfrom granular import reproduce\nfrom IPython.display import Image, display",
+'''cfg = reproduce.Config(quick=QUICK)
+out = "reproduction"
+os.makedirs(out, exist_ok=True)
+rows = []''',
+"md:## Verification: a head-on collision, energy conservation, collision counts (Figs 4.1-4.4)",
+'''for fn in (reproduce.fig_4_1, reproduce.fig_4_2_to_4_4):
+    names, r = fn(cfg, out)
+    rows += r
+    for name in names:
+        display(Image(os.path.join(out, name)))''',
+"md:## Speed distributions and Table 4.1 (Figs 4.5-4.7)",
+'''names, r = reproduce.fig_4_5_to_4_7(cfg, out)
+rows += r
+display(Image(os.path.join(out, names[1])))
+r''',
+"md:## Haff's law (Figs 4.8, 4.10) and 2D clustering (Fig. 4.9)",
+'''for fn in (reproduce.fig_4_8_and_4_10, reproduce.fig_4_9):
+    names, r = fn(cfg, out)
+    rows += r
+    for name in names:
+        display(Image(os.path.join(out, name)))''',
+"md:## Brownian motion: MSD, diffusivity and long-time slopes (Figs 4.11-4.16, F.1-F.2)",
+'''names, r = reproduce.fig_4_11_to_4_16_and_F(cfg, out)
+rows += r
+display(Image(os.path.join(out, names[2])))
+r''',
+"md:## Langevin and UDSBM, ergodicity (Figs 4.17-4.23)",
+'''names, r = reproduce.fig_4_17_to_4_23(cfg, out)
+rows += r
+display(Image(os.path.join(out, names[-2])))
+r''',
+]
+
+lve = [
+"md:# When is a Langevin model enough?\nThe thesis models a molecular gas by the underdamped Langevin equation and a granular gas by underdamped scaled Brownian motion (UDSBM), with coefficients from kinetic theory. Here both models meet the event-driven gas they stand for.",
+setup + "\nfrom granular import langevin",
+'''n, r = (1000, 0.025) if not QUICK else (300, 0.0373)
+sim = granular.Simulation(granular.Scene.random(n, r, seed=2))
+sim.run(stop_when={"collisions_per_particle": 20}, store=())
+eq = sim.scene
+t_stop = 50.0 if not QUICK else 5.0
+times = np.concatenate([[0], np.logspace(-2, np.log10(t_stop), 30)])''',
+"md:The same scene three ways: EDMD, the SDE model from `langevin.from_scene` (Euler-Maruyama and exact), and theory.",
+'''fig, axes = plt.subplots(1, 2, figsize=(11, 4), layout="constrained")
+for ax, xi in zip(axes, (1.0, 0.8)):
+    gas = eq.replace(restitution=xi)
+    traj = granular.Simulation(gas).run(t_stop=t_stop, sample_times=times)
+    for scheme in ("em", "exact"):
+        sde = langevin.from_scene(gas, dt=0.01, t_stop=t_stop, scheme=scheme, n=4 * n, sample_times=times, seed=3)
+        ax.plot(sde.times[1:], sde.msd[1:], label=f"{sde.model}, {scheme}")
+    plot.msd(traj.times, traj.msd(), ax=ax, label="EDMD")
+    ax.set_title(f"xi = {xi}")''',
+"md:For the molecular gas the Langevin model matches: its velocity autocorrelation is the gas' (2.66). For the granular gas UDSBM tracks EDMD only up to O(1 - xi) (thesis 4.2.2): its velocity autocorrelation (2.111) differs from the granular gas' (2.77) unless gamma0 tau0 >> 1. Ergodicity is where they part for good: UDSBM's time average never catches its ensemble average.",
+'''lags = np.logspace(-2, np.log10(t_stop / 2), 15)
+c = langevin.coefficients_from_scene(eq.replace(restitution=0.8))
+u = langevin.run(n, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=0.01, t_stop=t_stop, scheme="exact", initial="udsbm", tamsd_lags=lags, seed=4)
+plot.msd_vs_tamsd(u.times, u.msd, u.tamsd_lags, u.tamsd, label="UDSBM")''',
+"md:Ensembles of EDMD runs on all local cores (or a Dask cluster: pass `backend=distributed.Client(...)`), a sweep over xi:",
+'''import functools
+sweep = {}
+for xi in (1.0, 0.9, 0.8):
+    make = functools.partial(granular.Scene.random, n, r, restitution=xi)
+    sweep[xi] = granular.ensemble(make, runs=4 if not QUICK else 2, seed=1, t_stop=times[-1], sample_times=times, quantities=("msd",), progress=False)
+ax = None
+for xi, res in sweep.items():
+    ax = plot.msd(times, res.mean["msd"], error=res.error["msd"], ax=ax, label=f"xi = {xi}")''',
+]
+
+for name, cells in (("01_quickstart", quick), ("02_thesis_reproduction", repro), ("03_langevin_vs_edmd", lve)):
+    nbf.write(nb(cells), f"notebooks/{name}.ipynb")
