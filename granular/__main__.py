@@ -20,6 +20,9 @@ def main(argv=None):
     bench.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     bench.add_argument("--quick", action="store_true", help="tiny workloads (seconds)")
     bench.add_argument("--large", action="store_true", help="add N = 1e6")
+    bench.add_argument("--speed-accuracy", action="store_true",
+                       help="chart error against cost and map where methods fail")
+    bench.add_argument("--out", default="speed-accuracy", help="output folder (--speed-accuracy)")
     args = parser.parse_args(argv)
 
     if args.command == "demo":
@@ -31,9 +34,14 @@ def main(argv=None):
 
         reproduce.main(out=args.out, quick=args.quick, runs=args.runs)
     elif args.command == "bench":
-        from . import bench as bench_module
+        if args.speed_accuracy:
+            from . import speed_accuracy
 
-        bench_module.main(json_path=args.json, quick=args.quick, large=args.large)
+            speed_accuracy.main(out=args.out, quick=args.quick)
+        else:
+            from . import bench as bench_module
+
+            bench_module.main(json_path=args.json, quick=args.quick, large=args.large)
     return 0
 
 

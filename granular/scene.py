@@ -319,21 +319,38 @@ def _distance(x, ys, L, periodic):
 
 def _place_lattice(rng, radii, lo, hi, periodic):
     """n sites drawn at random from the densest simple lattice that fits: face-centred
-    cubic in 3D (packing up to 0.74), square in 2D (up to 0.785)."""
+    cubic in 3D (packing up to 0.74 when full), triangular in 2D (up to 0.91)."""
     n, dim = len(radii), len(lo)
     L = hi - lo
     sigma = 2 * float(radii.max()) * (1 + 1e-9)
-    basis = (np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]])
-             if dim == 3 else np.zeros((1, 2)))
-    k = max(1, math.ceil((n / len(basis)) ** (1.0 / dim)))
-    cell = (L if periodic else L - sigma) / k  # walls: keep the particles inside
-    nearest = cell.min() / math.sqrt(2) if dim == 3 else cell.min()
+    inner = L if periodic else L - sigma  # walls: keep the particles inside
+    if dim == 3:
+        k = max(1, math.ceil((n / 4) ** (1.0 / 3.0)))
+        basis = np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]])
+        grid = np.stack(np.meshgrid(*[np.arange(k)] * 3, indexing="ij"), -1).reshape(-1, 3)
+        cell = inner / k
+        sites = ((grid[:, None, :] + basis[None, :, :]).reshape(-1, 3) + 0.25) * cell
+        nearest = cell.min() / math.sqrt(2)
+    else:
+        # rows of kx sites, every other row shifted by half a spacing; ky even so the
+        # shift is periodic; pick kx for the largest nearest-neighbour distance
+        best = None
+        for kx in range(1, n + 1):
+            ky = math.ceil(n / kx)
+            ky += ky % 2 if ky > 1 else 0
+            ax, ay = inner[0] / kx, inner[1] / ky
+            # same row: ax; next row: (ax/2, ay); two rows on: 2 ay straight up
+            near = min(ax, math.hypot(ax / 2, ay), 2 * ay) if ky > 1 else ax
+            if best is None or near > best[0]:
+                best = (near, kx, ky, ax, ay)
+            if ax < sigma:
+                break
+        nearest, kx, ky, ax, ay = best
+        i, j = np.meshgrid(np.arange(kx), np.arange(ky), indexing="ij")
+        sites = np.stack([(i + 0.25 + 0.5 * (j % 2)) * ax, (j + 0.25) * ay], -1).reshape(-1, 2)
     if nearest < sigma:
         raise ValueError(
             f"{n} particles of radius {radii.max():g} do not fit in this box even on a "
-            f"{'face-centred cubic' if dim == 3 else 'square'} lattice")
-    grid = np.stack(np.meshgrid(*[np.arange(k)] * dim, indexing="ij"), -1).reshape(-1, dim)
-    sites = (grid[:, None, :] + basis[None, :, :]).reshape(-1, dim)
+            f"{'face-centred cubic' if dim == 3 else 'triangular'} lattice")
     pick = rng.choice(len(sites), size=n, replace=False)
-    offset = lo + (0.25 * cell if periodic else sigma / 2 + 0.25 * cell)
-    return offset + sites[pick] * cell
+    return lo + (0.0 if periodic else sigma / 2) + sites[pick]

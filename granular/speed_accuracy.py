@@ -1,0 +1,325 @@
+"""Speed against accuracy, and where each method fails
+(``python -m granular bench --speed-accuracy --out DIR``).
+
+Target: the MSD of a granular gas (xi = 0.8) and of a molecular gas in the thesis'
+standard box (N = 1000, r = 0.025, unit box, T0 = 2/3) at log-spaced times in [1e-2, 1e2].
+
+Error measures (each point measured, none modelled):
+- ``msd_error``: the largest relative deviation of the MSD from the reference over the
+  log-spaced sample times, ``max_t |MSD(t) / MSD_ref(t) - 1|`` (for an SDE step dt, at its
+  sample times rounded to whole steps, t >= dt: it cannot answer below one step; the
+  reference is interpolated log-log between its samples);
+- ``slope_error``: relative error of the long-time slope (MSD against t for the molecular
+  gas, against ln t for the granular gas, fitted over t in [10, 100]).
+The reference is a high-statistics EDMD ensemble; errors against theory ((2.68), (2.79))
+are reported beside.  Cost is wall-clock seconds on this machine.
+
+Where methods fail: Euler-Maruyama's MSD error against gamma0*dt up to and past its
+stability limit (refused at gamma0*dt >= 2) beside the exact scheme; inelastic collapse of
+2D disks between walls over restitution and area fraction, with and without the TC
+model; the cost of EDMD per unit time as the packing approaches the dense limit.
+"""
+from __future__ import annotations
+
+import functools
+import json
+import math
+import os
+import time
+
+import numpy as np
+
+from . import analysis, langevin, theory
+from .ensemble import ensemble
+from .errors import InelasticCollapseError, UnstableStepError
+from .scene import Scene
+from .simulation import Simulation
+
+T0 = 2.0 / 3.0
+R = 0.025
+
+
+def _times(t_max):
+    return np.concatenate([[0.0], np.logspace(-2, math.log10(t_max), 25)])
+
+
+def _loglog_interp(t, t_ref, y_ref):
+    """A smooth curve (the MSD) at other times: linear interpolation in log-log."""
+    ok = t_ref > 0
+    return np.exp(np.interp(np.log(t), np.log(t_ref[ok]), np.log(y_ref[ok])))
+
+
+def _errors(times, msd, t_ref, ref, slope_ref, log, t_fit):
+    """Errors at the method's own sample times (a step dt cannot answer below dt)."""
+    ok = times > 0
+    sel = times >= t_fit
+    slope = analysis.fit_slope(times[sel], msd[sel], log=log)[0]
+    ref_at = _loglog_interp(times[ok], t_ref, ref)
+    return float(np.max(np.abs(msd[ok] / ref_at - 1))), float(abs(slope / slope_ref - 1))
+
+
+def _equilibrated(n, box, seed):
+    sim = Simulation(Scene.random(n, R, box=box, temperature=T0, seed=seed))
+    sim.run(stop_when={"collisions_per_particle": 10}, store=())
+    return sim.scene
+
+
+def _edmd_msd(n, xi, runs, times, seed, backend):
+    """Mean MSD of `runs` EDMD runs of N particles at the standard density (box scaled)."""
+    box = (n / 1000) ** (1 / 3)
+    start = _equilibrated(n, box, seed)
+    t0 = time.perf_counter()
+    res = ensemble(start.replace(restitution=xi), runs, seed=seed, backend=backend,
+                   t_stop=times[-1], sample_times=times, quantities=("msd",), progress=False)
+    return res.mean["msd"], time.perf_counter() - t0
+
+
+def speed_accuracy_points(quick=False, backend="processes"):
+    """All points of the chart: EDMD (N, runs), EM and exact SDE schemes (dt)."""
+    t_max = 100.0 if not quick else 10.0
+    t_fit = t_max / 10
+    times = _times(t_max)
+    ref_runs = 32 if not quick else 4
+    points, refs = [], {}
+    for xi in (1.0, 0.8):
+        c = theory.langevin_coefficients(1000, R, 1.0, xi, T0)
+        th = theory.msd_granular(times, c.D0, c.gamma0, c.tau0)
+        ref, ref_cost = _edmd_msd(1000, xi, ref_runs, times, seed=99, backend=backend)
+        log = xi < 1
+        sel = times >= t_fit
+        slope_ref = analysis.fit_slope(times[sel], ref[sel], log=log)[0]
+        refs[xi] = dict(times=times.tolist(), msd=ref.tolist(), theory=th.tolist(), runs=ref_runs,
+                        seconds=ref_cost, slope=slope_ref)
+        slope_th = analysis.fit_slope(times[sel], th[sel], log=log)[0]
+
+        def add(method, label, msd, seconds, at=times, **extra):
+            e_ref, s_ref = _errors(at, msd, times, ref, slope_ref, log, t_fit)
+            e_th, s_th = _errors(at, msd, times, th, slope_th, log, t_fit)
+            points.append(dict(gas="molecular" if xi == 1 else "granular", xi=xi, method=method,
+                               label=label, seconds=seconds, msd_error=e_ref, slope_error=s_ref,
+                               msd_error_theory=e_th, slope_error_theory=s_th, **extra))
+
+        sizes = [(250, 1), (250, 4), (1000, 1), (1000, 4), (4000, 1)] if not quick else [(125, 1), (250, 2)]
+        for n, runs in sizes:
+            msd, sec = _edmd_msd(n, xi, runs, times, seed=n + runs, backend=backend)
+            add("edmd", f"N={n}, runs={runs}", msd, sec, n=n, runs=runs)
+        n_sde = 4000 if not quick else 500
+        dts = [1e-3, 1e-2, 0.05, 0.1, 0.2] if not quick else [1e-2, 0.1]
+        for scheme in ("em", "exact"):
+            for dt in dts:
+                if scheme == "em" and c.gamma0 * dt >= 2:
+                    continue
+                t0 = time.perf_counter()
+                r = langevin.run(n_sde, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=dt, t_stop=t_max,
+                                 scheme=scheme, sample_times=times, seed=5)
+                sec = time.perf_counter() - t0
+                add(scheme, f"{r.model} {scheme}, dt={dt:g}", r.msd, sec, at=r.times, dt=dt,
+                    n=n_sde, gamma_dt=c.gamma0 * dt)
+    return points, refs
+
+
+def em_stability(quick=False):
+    """MSD error of Euler-Maruyama and of the exact scheme against the Langevin theory as
+    gamma0*dt grows, for the molecular gas' coefficients; EM refused at >= 2."""
+    c = theory.langevin_coefficients(1000, R, 1.0, 1.0, T0)
+    n = 20000 if not quick else 2000
+    t_max = 20.0 if not quick else 5.0
+    rows = []
+    for gdt in (0.01, 0.05, 0.1, 0.3, 0.5, 1.0, 1.5, 1.9, 2.0, 3.0, 10.0):
+        dt = gdt / c.gamma0
+        times = np.unique(np.round(np.logspace(math.log10(dt), math.log10(t_max), 20) / dt)) * dt
+        th = theory.msd_langevin(times, c.D0, c.gamma0)
+        row = dict(gamma_dt=gdt, dt=dt)
+        for scheme in ("em", "exact"):
+            try:
+                r = langevin.run(n, gamma0=c.gamma0, D0=c.D0, dt=dt, t_stop=t_max, scheme=scheme,
+                                 sample_times=times, seed=1)
+                ok = r.times > 0
+                row[scheme] = float(np.max(np.abs(r.msd[ok] / th[ok] - 1)))
+                row[f"{scheme}_v2_bias"] = float(r.v2[-1] / (3 * c.gamma0 * c.D0) - 1)
+            except UnstableStepError:
+                row[scheme] = None
+                row[f"{scheme}_v2_bias"] = None
+        rows.append(row)
+    return rows
+
+
+def collapse_map(quick=False, contact_durations=(0.0, 1e-4)):
+    """2D disks between walls (where the thesis met collapse): for each restitution and area
+    fraction, run to 100 collisions per particle (bounded by an event budget) and record
+    'ok', 'collapse' (with time and particles) or 'tc' (the TC model had to act)."""
+    n = 500 if not quick else 150
+    xis = (0.9, 0.7, 0.5, 0.3, 0.1) if not quick else (0.9, 0.3)
+    etas = (0.05, 0.2, 0.4, 0.6, 0.7) if not quick else (0.1, 0.5)
+    cells = []
+    for tc in contact_durations:
+        for eta in etas:
+            r = math.sqrt(eta / (n * math.pi))
+            for xi in xis:
+                s = Scene.random(n, r, dim=2, boundary="walls", restitution=xi, contact_duration=tc, seed=1)
+                sim = Simulation(s)
+                t0 = time.perf_counter()
+                cell = dict(contact_duration=tc, eta=eta, xi=xi)
+                try:
+                    tr = sim.run(stop_when={"collisions_per_particle": 100, "events": 200 * n * 20}, store=())
+                    st = sim.stats
+                    cell.update(status="tc" if st["tc_elastic_collisions"] else "ok", stop=tr.stop_reason)
+                except InelasticCollapseError as e:
+                    cell.update(status="collapse", time=e.time, particles=list(e.particles))
+                cell.update(seconds=time.perf_counter() - t0,
+                            collisions_per_particle=sim.stats["collisions_per_particle"])
+                cells.append(cell)
+    return cells
+
+
+def dense_cost(quick=False):
+    """EDMD cost per unit of simulated time (and per collision) as the packing grows."""
+    rows = []
+    cases = [(3, (0.1, 0.2, 0.3, 0.4, 0.5, 0.55, 0.6)), (2, (0.1, 0.3, 0.5, 0.6, 0.7, 0.8))]
+    for dim, etas in cases:
+        # a full face-centred cubic lattice (4 k^3 sites) reaches the densest 3D cases
+        n = (2048 if dim == 3 else 2000) if not quick else (256 if dim == 3 else 300)
+        if quick:
+            etas = (etas[0], etas[-1])  # the dilute and the densest case
+        for eta in etas:
+            r = ((eta / (n * 4 / 3 * math.pi)) ** (1 / 3) if dim == 3 else math.sqrt(eta / (n * math.pi)))
+            sim = Simulation(Scene.random(n, r, dim=dim, temperature=1.0, seed=2))
+            sim.run(stop_when={"collisions_per_particle": 5}, store=())
+            b = sim.stats
+            t0 = time.perf_counter()
+            sim.run(stop_when={"collisions_per_particle": 5 + (50 if not quick else 5)}, store=())
+            sec = time.perf_counter() - t0
+            a = sim.stats
+            pairs = a["pair_collisions"] - b["pair_collisions"]
+            rows.append(dict(dim=dim, eta=eta, n=n, seconds_per_time=sec / (a["time"] - b["time"]),
+                             ns_per_collision=1e9 * sec / pairs,
+                             collisions_per_particle_per_time=2 * pairs / n / (a["time"] - b["time"])))
+    return rows
+
+
+def scene_costs(quick=False):
+    """What modelling choices cost, measured: 2D vs 3D, walls vs periodic, small N, and
+    storing trajectories vs accumulating statistics."""
+    rows = []
+    coll = 100.0 if not quick else 10.0
+
+    def per_collision(scene, **run):
+        sim = Simulation(scene)
+        sim.run(stop_when={"collisions_per_particle": 5}, store=())
+        b = sim.stats
+        t0 = time.perf_counter()
+        sim.run(stop_when={"collisions_per_particle": 5 + coll}, store=(), **run)
+        sec = time.perf_counter() - t0
+        return 1e9 * sec / (sim.stats["pair_collisions"] - b["pair_collisions"])
+
+    n = 2000
+    rows.append(dict(case="3D periodic, eta 0.1", ns_per_collision=per_collision(
+        Scene.random(n, (0.1 / (n * 4 / 3 * math.pi)) ** (1 / 3), seed=1))))
+    rows.append(dict(case="2D periodic, eta 0.1", ns_per_collision=per_collision(
+        Scene.random(n, math.sqrt(0.1 / (n * math.pi)), dim=2, seed=1))))
+    rows.append(dict(case="3D walls, eta 0.1", ns_per_collision=per_collision(
+        Scene.random(n, (0.1 / (n * 4 / 3 * math.pi)) ** (1 / 3), boundary="walls", seed=1))))
+    for small in (20, 100):
+        rows.append(dict(case=f"3D periodic, eta 0.1, N = {small}", ns_per_collision=per_collision(
+            Scene.random(small, (0.1 / (small * 4 / 3 * math.pi)) ** (1 / 3), seed=1))))
+    s = Scene.random(1000, R, seed=1)
+    for store in ((), ("positions", "velocities")):
+        sim = Simulation(s)
+        t0 = time.perf_counter()
+        tr = sim.run(t_stop=10.0, sample_times=np.linspace(0, 10, 1001), store=store)
+        sec = time.perf_counter() - t0
+        mb = sum(a.nbytes for a in (tr.positions, tr.velocities) if a is not None) / 2**20
+        rows.append(dict(case=f"1000 samples, store={store or 'statistics only'}", seconds=sec,
+                         stored_megabytes=mb))
+    for lags in (0, 30):
+        lag_t = np.logspace(-2, 1, lags) if lags else None
+        t0 = time.perf_counter()
+        langevin.run(1000, gamma0=9.26, D0=0.072, dt=0.01, t_stop=100.0 if not quick else 10.0,
+                     tamsd_lags=lag_t, seed=1)
+        rows.append(dict(case=f"Langevin EM, N = 1000, {lags} TAMSD lags accumulated",
+                         seconds=time.perf_counter() - t0))
+    return rows
+
+
+def _charts(out, points, refs, stab, cells, dense):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(12, 9), layout="constrained")
+    for col, gas in enumerate(("granular", "molecular")):
+        for row, key in enumerate(("msd_error", "slope_error")):
+            ax = axes[row, col]
+            for method, marker in (("edmd", "o"), ("em", "s"), ("exact", "^")):
+                pts = [p for p in points if p["gas"] == gas and p["method"] == method]
+                if not pts:
+                    continue
+                ax.loglog([p["seconds"] for p in pts], [max(p[key], 1e-5) for p in pts], marker,
+                          label={"edmd": "EDMD (N, runs)", "em": "Langevin/UDSBM, Euler-Maruyama",
+                                 "exact": "Langevin/UDSBM, exact scheme"}[method])
+                for p in pts:
+                    ax.annotate(p["label"].split(", ", 1)[-1], (p["seconds"], max(p[key], 1e-5)),
+                                fontsize=6, xytext=(3, 3), textcoords="offset points")
+            ax.set_xlabel("wall-clock seconds")
+            ax.set_ylabel("max relative MSD error vs EDMD reference" if key == "msd_error"
+                          else "relative error of the long-time slope")
+            ax.set_title(f"{gas} gas" + (r", $\xi$ = 0.8" if gas == "granular" else ""))
+            ax.legend(fontsize=7)
+    fig.savefig(os.path.join(out, "speed_accuracy.png"), dpi=110)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
+    g = [r["gamma_dt"] for r in stab]
+    for scheme, marker in (("em", "s-"), ("exact", "^-")):
+        ax.loglog(g, [r[scheme] if r[scheme] is not None else np.nan for r in stab], marker,
+                  label={"em": "Euler-Maruyama", "exact": "exact scheme"}[scheme])
+    ax.axvline(2.0, color="r", ls=":", label="EM refused (gamma0 dt >= 2)")
+    ax.set_xlabel(r"$\gamma_0 \Delta t$")
+    ax.set_ylabel("max relative MSD error vs (2.68)")
+    ax.legend()
+    fig.savefig(os.path.join(out, "em_stability.png"), dpi=110)
+    plt.close(fig)
+
+    tcs = sorted({c["contact_duration"] for c in cells})
+    fig, axes = plt.subplots(1, len(tcs), figsize=(5.5 * len(tcs), 4.2), layout="constrained", squeeze=False)
+    colors = {"ok": "tab:green", "tc": "tab:blue", "collapse": "tab:red"}
+    for ax, tc in zip(axes[0], tcs):
+        for c in (c for c in cells if c["contact_duration"] == tc):
+            ax.scatter(c["eta"], c["xi"], s=300, marker="s", color=colors[c["status"]])
+            ax.annotate(c["status"], (c["eta"], c["xi"]), ha="center", va="center", fontsize=7, color="w")
+        ax.set_xlabel("area fraction")
+        ax.set_ylabel(r"restitution $\xi$")
+        ax.set_title("2D disks, walls, " + ("no TC model" if tc == 0 else f"TC model t_c = {tc:g}"))
+    fig.savefig(os.path.join(out, "collapse_map.png"), dpi=110)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
+    for dim in (2, 3):
+        rows = [r for r in dense if r["dim"] == dim]
+        ax.semilogy([r["eta"] for r in rows], [r["seconds_per_time"] for r in rows], "o-", label=f"{dim}D, N = {rows[0]['n']}")
+    ax.set_xlabel("packing (area) fraction")
+    ax.set_ylabel("seconds per unit of simulated time (T = 1)")
+    ax.legend()
+    fig.savefig(os.path.join(out, "dense_cost.png"), dpi=110)
+    plt.close(fig)
+
+
+def main(out="speed-accuracy", quick=False, backend="processes"):
+    os.makedirs(out, exist_ok=True)
+    started = time.perf_counter()
+    points, refs = speed_accuracy_points(quick, backend)
+    print(f"  speed/accuracy points: {len(points)}  ({time.perf_counter() - started:.0f} s)", flush=True)
+    stab = em_stability(quick)
+    cells = collapse_map(quick)
+    dense = dense_cost(quick)
+    costs = scene_costs(quick)
+    _charts(out, points, refs, stab, cells, dense)
+    with open(os.path.join(out, "speed_accuracy.json"), "w") as f:
+        json.dump(dict(points=points, references=refs, em_stability=stab, collapse_map=cells,
+                       dense_cost=dense, scene_costs=costs), f, indent=1)
+    print(f"{'method':<34} {'seconds':>8} {'MSD err':>8} {'slope err':>9}  (granular | molecular)")
+    for p in points:
+        print(f"{p['gas'][:4] + ' ' + p['label']:<34} {p['seconds']:>8.2f} {p['msd_error']:>8.3f} {p['slope_error']:>9.3f}")
+    print(f"charts and speed_accuracy.json in {out}/ ({time.perf_counter() - started:.0f} s)")
+    return dict(points=points, em_stability=stab, collapse_map=cells, dense_cost=dense, scene_costs=costs)

@@ -1,0 +1,47 @@
+"""Speed against accuracy and the failure maps (quick sizes): the artefacts exist, each
+method fails where it should, and never hangs."""
+import json
+import math
+
+import numpy as np
+
+from granular import speed_accuracy
+
+
+def test_failure_maps_pin_each_failure_mode():
+    stab = speed_accuracy.em_stability(quick=True)
+    by_g = {r["gamma_dt"]: r for r in stab}
+    # Euler-Maruyama is refused at and past the limit; the exact scheme never is
+    assert all(by_g[g]["em"] is None for g in (2.0, 3.0, 10.0))
+    assert all(r["exact"] is not None and math.isfinite(r["exact"]) for r in stab)
+    # EM's stationary velocity bias follows 2 / (2 - gamma dt) - 1 (5 standard errors of
+    # the mean over 3 x 2000 Gaussian components, sqrt(2/6000) = 1.8%)
+    for g in (0.5, 1.0, 1.5):
+        assert abs(by_g[g]["em_v2_bias"] - (2 / (2 - g) - 1)) < 5 * math.sqrt(2 / 6000) * (2 / (2 - g))
+        assert abs(by_g[g]["exact_v2_bias"]) < 5 * math.sqrt(2 / 6000)
+    cells = speed_accuracy.collapse_map(quick=True)
+    plain = {(c["eta"], c["xi"]): c for c in cells if c["contact_duration"] == 0}
+    tc = [c for c in cells if c["contact_duration"] > 0]
+    assert plain[(0.1, 0.3)]["status"] == "collapse"  # 2D walls, strongly inelastic
+    assert plain[(0.1, 0.9)]["status"] in ("ok", "tc")
+    assert all(c["status"] != "collapse" for c in tc)  # the TC model lets every run finish
+    assert all(c["seconds"] < 60 for c in cells)  # bounded work, never a hang
+
+
+def test_speed_accuracy_cli_quick(tmp_path):
+    import subprocess
+    import sys
+
+    subprocess.run([sys.executable, "-m", "granular", "bench", "--speed-accuracy", "--quick",
+                    "--out", str(tmp_path)], check=True, capture_output=True, timeout=600)
+    data = json.loads((tmp_path / "speed_accuracy.json").read_text())
+    methods = {p["method"] for p in data["points"]}
+    assert methods == {"edmd", "em", "exact"}
+    assert {p["gas"] for p in data["points"]} == {"granular", "molecular"}
+    for p in data["points"]:
+        assert p["seconds"] > 0 and np.isfinite(p["msd_error"]) and np.isfinite(p["slope_error"])
+    for name in ("speed_accuracy.png", "em_stability.png", "collapse_map.png", "dense_cost.png"):
+        assert (tmp_path / name).stat().st_size > 5000
+    dense = data["dense_cost"]
+    assert max(r["eta"] for r in dense if r["dim"] == 3) >= 0.55
+    assert max(r["eta"] for r in dense if r["dim"] == 2) >= 0.7
