@@ -259,7 +259,8 @@ def _charts(out, points, refs, stab, cells, dense):
                           label={"edmd": "EDMD (N, runs)", "em": "Langevin/UDSBM, Euler-Maruyama",
                                  "exact": "Langevin/UDSBM, exact scheme"}[method])
                 for p in pts:
-                    ax.annotate(p["label"].split(", ", 1)[-1], (p["seconds"], max(p[key], 1e-5)),
+                    ax.annotate(p["label"] if method == "edmd" else p["label"].split(", ", 1)[-1],
+                                (p["seconds"], max(p[key], 1e-5)),
                                 fontsize=6, xytext=(3, 3), textcoords="offset points")
             ax.set_xlabel("wall-clock seconds")
             ax.set_ylabel("max relative MSD error vs EDMD reference" if key == "msd_error"
