@@ -139,7 +139,7 @@ class Simulation:
         # the C loop fills the first len(times) samples; a final one may follow
         views = {k: (None if v is None else v[:len(times)]) for k, v in buf.items()}
         reason, nxt, done = "events", 0, 0
-        bar = _progress_bar(progress, t_now, t_end)
+        bar = _progress_bar(progress, t_now, t_end, cpp)
         try:
             while budget - done > 0:
                 chunk = int(min(_CHUNK, budget - done))
@@ -147,7 +147,7 @@ class Simulation:
                 code, nxt = self._engine.advance(t_end, cpp, kin, chunk, times, nxt, **views)
                 done += self._engine.counters()["events"] - before
                 if bar is not None:
-                    bar.update(self.time)
+                    bar.update(self)
                 if code != _core.STOP_BUDGET:
                     reason = _REASONS[code]
                     break
@@ -213,24 +213,30 @@ def _check_memory(samples, doubles_per_sample):
             f"run with store=() and keep only the statistics")
 
 
-class _TimeBar:
-    def __init__(self, t0, t1):
+class _ProgressBar:
+    """tqdm over simulated time (t_stop given) or over collisions per particle."""
+
+    def __init__(self, start, end, by_time):
         from tqdm.auto import tqdm
 
-        self.t0 = t0
-        self.bar = tqdm(total=t1 - t0, unit="time", unit_scale=True, leave=False)
+        self.start, self.by_time = start, by_time
+        self.bar = tqdm(total=end - start, unit="time" if by_time else "collisions/particle",
+                        unit_scale=True, leave=False)
 
-    def update(self, t):
-        self.bar.n = t - self.t0
+    def update(self, sim):
+        now = sim.time if self.by_time else sim.stats["collisions_per_particle"]
+        self.bar.n = min(now - self.start, self.bar.total)
         self.bar.refresh()
 
     def close(self):
         self.bar.close()
 
 
-def _progress_bar(progress, t0, t1):
+def _progress_bar(progress, t0, t1, collisions):
     if not progress:
         return None
-    if not math.isfinite(t1):
-        return None
-    return _TimeBar(t0, t1)
+    if math.isfinite(t1):
+        return _ProgressBar(t0, t1, by_time=True)
+    if math.isfinite(collisions):
+        return _ProgressBar(0.0, collisions, by_time=False)
+    return None
