@@ -133,6 +133,10 @@ class Simulation:
                 raise ValueError(f"sample_times start at {times[0]}, before the current time {t_now}")
             if np.any(np.diff(times) <= 0):
                 raise ValueError("sample_times must be strictly increasing")
+            if len(times) and times[-1] > t_end:
+                if times[-1] > t_end + 1e-12 * max(1.0, abs(t_end)):
+                    raise ValueError(f"sample_times reach {times[-1]}, past t_stop = {t_end}")
+                times[-1] = t_end  # the same time up to rounding (e.g. from np.logspace)
         _check_memory(len(times) + final_sample, self._initial.n * self._initial.dim * len(store))
         buf = self._buffers(len(times) + final_sample, store)
 

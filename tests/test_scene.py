@@ -115,6 +115,8 @@ def test_bad_run_arguments():
         sim.run(t_stop=1.0, sample_times=[0.5, 0.2])
     with pytest.raises(ValueError, match="finite"):
         sim.run(t_stop=1.0, sample_times=[0.1, np.nan])
+    with pytest.raises(ValueError, match="past t_stop"):
+        sim.run(t_stop=1.0, sample_times=[0.5, 2.0])
     with pytest.raises(ValueError, match="unknown stop_when"):
         sim.run(stop_when={"collisions": 3})
     with pytest.raises(ValueError, match="store may contain"):
