@@ -437,6 +437,12 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     out.lag_len = ints + L;
     out.lag_work = ints + 2 * L;
     out.ring = ring;
+    /* the per-step coefficient table of exact UDSBM, when it is not too large (else the
+     * core computes the coefficients inline: slower, same numbers) */
+    double *coef = NULL;
+    if (cfg.model == GR_SDE_UDSBM && cfg.scheme == GR_SDE_EXACT && n_steps <= (1LL << 22))
+        coef = PyMem_Malloc((size_t)(5 * n_steps + 1) * sizeof(double));
+    out.step_coef = coef;
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
     int status;
     Py_BEGIN_ALLOW_THREADS
@@ -444,6 +450,7 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     Py_END_ALLOW_THREADS
     PyMem_Free(ints);
     PyMem_Free(ring);
+    PyMem_Free(coef);
     if (status != GR_OK) return raise_status(status, &err);
     Py_RETURN_NONE;
 }

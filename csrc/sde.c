@@ -85,6 +85,14 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
     if (!gr_rng_ready) gr_rng_init();
     const double sq_dt = sqrt(dt), b0 = sqrt(2.0 * D0) * g0 * sq_dt;
     const exact_coef ex0 = exact_for(g0, D0, dt);
+    exact_coef *table = NULL;
+    if (udsbm && cfg->scheme == GR_SDE_EXACT && out->step_coef) {
+        table = (exact_coef *)out->step_coef;
+        for (int64_t st = 0; st < n_steps; st++) {
+            double s = 1.0 / (1.0 + ((double)st + 0.5) * dt / tau0);
+            table[st] = exact_for(g0 * s, D0 * s, dt);
+        }
+    }
 
     for (int64_t local = 0; local < count; local++) {
         const int64_t i = first + local;
@@ -122,8 +130,11 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
                     }
                 } else {
                     exact_coef e = ex0;
-                    if (udsbm) { /* coefficients frozen at the midpoint of the step */
-                        double s = 1.0 / (1.0 + (t + 0.5 * dt) / tau0);
+                    if (table) {
+                        e = table[step - 1];
+                    } else if (udsbm) { /* coefficients frozen at the midpoint of the step,
+                                         * computed exactly as the table does */
+                        double s = 1.0 / (1.0 + ((double)(step - 1) + 0.5) * dt / tau0);
                         e = exact_for(g0 * s, D0 * s, dt);
                     }
                     for (int a = 0; a < d; a++) {

@@ -43,6 +43,9 @@ typedef struct {
     double *tamsd;               /* n x n_lags: per particle, sum over windows of |dx|^2 */
     int64_t *windows;            /* n_lags: windows per particle */
     double *ring;                /* scratch: sum over lags of (lag/stride + 1) * dim */
+    double *step_coef;           /* optional scratch, 5 x n_steps: the exact scheme's UDSBM
+                                    coefficients per step, computed once per call instead
+                                    of once per particle and step; NULL computes them inline */
 } gr_sde_output;
 
 /* Stride of TAMSD window starts for a lag: windows start every max(1, lag/16) steps, so
