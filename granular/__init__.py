@@ -17,5 +17,6 @@ from .ensemble import EnsembleResult, ensemble
 from . import analysis, langevin, theory
 
 __version__ = "0.1.0"
-__all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "errors", "GranularError", "OverlapError",
+__all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "analysis",
+           "langevin", "theory", "errors", "GranularError", "OverlapError",
            "OutsideBoxError", "InelasticCollapseError", "NonFiniteError", "UnstableStepError"]

@@ -4,7 +4,6 @@ MD over several independent realizations, their temperature and MSD compared wit
 figures and a summary written to a folder."""
 from __future__ import annotations
 
-import functools
 import json
 import math
 import os

@@ -7,7 +7,6 @@ seed gives the same results whichever backend and however many workers ran them.
 """
 from __future__ import annotations
 
-import math
 import os
 import sys
 import traceback

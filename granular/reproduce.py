@@ -226,7 +226,7 @@ def fig_4_9(cfg, out):
                          contact_duration=1e-3, seed=3)
         sim = Simulation(s)
         for t_snap in (2.5, 10.0):
-            tr = sim.run(t_stop=t_snap, sample_times=[t_snap], store=())
+            sim.run(t_stop=t_snap, sample_times=[t_snap], store=())
             plot.snapshot(sim.scene.positions, s.radii, s.lower, s.upper, ax=axes[k])
             axes[k].set_title(f"{name}, t = {t_snap}")
             axes[k].set_xticks([])
@@ -305,7 +305,7 @@ def fig_4_17_to_4_23(cfg, out):
               theory.msd_udsbm(r.times, c.D0, c.gamma0, c.tau0, v0_sq=v0))
         fig, ax = _fig()
         plot.msd(r.times, r.mean["msd"], error=r.error["msd"], theory_values=th, ax=ax,
-                 label=f"Euler-Maruyama, dt = 0.01", theory_label="(2.68)" if xi == 1 else "(2.113) + start")
+                 label="Euler-Maruyama, dt = 0.01", theory_label="(2.68)" if xi == 1 else "(2.113) + start")
         ax.set_title(f"Fig. {fig_no.replace('_', '.')}: " + ("Langevin" if xi == 1 else rf"UDSBM, $\xi$ = {xi}"))
         names.append(_save(fig, out, f"fig{fig_no}_sde_msd_xi{xi}.png"))
 

@@ -21,7 +21,6 @@ model; the cost of EDMD per unit time as the packing approaches the dense limit.
 """
 from __future__ import annotations
 
-import functools
 import json
 import math
 import os

@@ -1,5 +1,4 @@
 """The notebooks run from top to bottom (small sizes) with only the public API."""
-import os
 from pathlib import Path
 
 import pytest

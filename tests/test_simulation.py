@@ -5,7 +5,6 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-import granular
 from granular import Scene, Simulation
 
 import reference_edmd
