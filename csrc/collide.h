@@ -8,40 +8,18 @@
 
 #include <math.h>
 
-/* Time until two spheres touch, given their separation dr = x_j - x_i, relative velocity
- * dv = v_j - v_i and contact distance sigma (thesis 2.16-2.20).  Returns +inf if they
- * never touch on these lines.
+/* Whether two spheres on straight lines touch before `horizon`, given their separation
+ * dr = x_j - x_i, relative velocity dv = v_j - v_i and contact distance sigma (thesis
+ * 2.16-2.20); if so, *dt is the time until they touch.
  *
  * Robust to rounding: a pair that already touches or overlaps (|dr| <= sigma) and
- * approaches collides at once (returns 0), so an overlap produced by rounding can never
+ * approaches collides at once (dt = 0), so an overlap produced by rounding can never
  * grow.  The root is taken in the cancellation-free form c / (-b + sqrt(b^2 - a c)).
- * `horizon` is the caller's best time so far: a pair that cannot beat it returns +inf
- * before the square root is taken (dt >= c / (-2b) for an approaching pair). */
-static inline double gr_pair_time(int dim, const double *dr, const double *dv, double sigma,
-                                  double horizon)
-{
-    double b = 0.0, dr2 = 0.0, dv2 = 0.0;
-    for (int a = 0; a < dim; a++) {
-        b += dr[a] * dv[a];
-        dr2 += dr[a] * dr[a];
-        dv2 += dv[a] * dv[a];
-    }
-    if (b >= 0.0) return INFINITY; /* receding or parallel */
-    double c = dr2 - sigma * sigma;
-    if (c <= 0.0) return 0.0;      /* touching and approaching: collide now */
-    if (c >= -2.0 * b * horizon) return INFINITY;
-    double disc = b * b - dv2 * c;
-    if (disc <= 0.0) return INFINITY; /* they miss */
-    return c / (-b + sqrt(disc));
-}
-
-/* The same test as gr_pair_time, shaped for the scan over candidates, where nearly every
- * pair fails: whether a pair could collide before `horizon` is decided from flags
- * combined without branches, so that the one branch taken per candidate is almost
- * always "no" and predicted well (the separate early exits of gr_pair_time each go
- * either way about half the time, and mispredicting them cost more than the
- * arithmetic they skip).  Returns 1 and sets *dt exactly as gr_pair_time would when
- * that time is < horizon; returns 0 when gr_pair_time's result would be >= horizon. */
+ * Shaped for the scan over candidates, where nearly every pair fails: the tests
+ * (approaching? touching, or soon enough -- dt >= c / (-2b) -- and not missing?) are
+ * combined without branches, so that the one branch per candidate is almost always "no"
+ * and well predicted; separate early exits each go either way about half the time, and
+ * mispredicting them costs more than the arithmetic they skip. */
 static inline int gr_pair_beats(int dim, const double *dr, const double *dv, double sigma,
                                 double horizon, double *dt)
 {
