@@ -74,7 +74,7 @@ static inline void FN(move)(double *p, double t)
 
 /* Pair collisions of i (record p, clock at t) with the particles of one cell, seen
  * through an image shift (NULL: none); keeps the earliest in *best / *partner.  `best` is
- * relative to t and is also the horizon for the early exit in gr_pair_time. */
+ * relative to t and is also the horizon for the early exit in gr_pair_beats. */
 static inline void FN(scan_cell)(const gr_edmd *s, int32_t i, const double *p, int32_t cell,
                                  const double *shift, double *best, int32_t *partner)
 {
@@ -88,17 +88,16 @@ static inline void FN(scan_cell)(const gr_edmd *s, int32_t i, const double *p, i
             if (shift) dr[a] += shift[a];
             dv[a] = V(q)[a] - V(p)[a];
         }
-        double dt = gr_pair_time(DIM, dr, dv, ri + R(q), *best);
+        double dt;
+        if (!gr_pair_beats(DIM, dr, dv, ri + R(q), *best, &dt)) continue;
         /* A pair that collided with each other at this very instant cannot approach
          * again in exact arithmetic (the normal relative velocity became -xi times the
          * old one); any approach left is rounding, e.g. after xi = 0. */
         if (dt == 0.0 && s->ev[i].last == j && s->ev[j].last == i && s->ev[i].t_last == t &&
             s->ev[j].t_last == t)
             continue;
-        if (dt < *best) {
-            *best = dt;
-            *partner = j;
-        }
+        *best = dt;
+        *partner = j;
     }
 }
 
