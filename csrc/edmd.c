@@ -20,7 +20,7 @@
 
 #include "collide.h"
 #include "edmd.h"
-#include "heap.h"
+#include "calendar.h"
 
 typedef struct {
     double t_coll;   /* predicted pair or wall collision, +inf if none */
@@ -43,7 +43,7 @@ struct gr_edmd {
     int64_t *count;   /* collisions (pair and wall) per particle */
     int64_t *image;   /* n * dim periodic image counters */
     gr_event *ev;
-    gr_heap heap;
+    gr_cq queue;
     int32_t *id_of;   /* the caller's index of each internal particle (see reorder) */
     void *scratch;    /* n * stride doubles, for reordering */
     int64_t next_reorder;
@@ -129,7 +129,7 @@ void gr_edmd_free(gr_edmd *s)
     free(s->ev);
     free(s->id_of);
     free(s->scratch);
-    gr_heap_free(&s->heap);
+    gr_cq_free(&s->queue);
     free(s->cc);
     free(s->head);
     free(s->next);
@@ -317,7 +317,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     if (!s->P || !s->mass || !s->count || !s->image || !s->ev || !s->cc || !s->next || !s->prev ||
         !s->id_of || (n >= GR_REORDER_MIN_N && !s->scratch))
         status = GR_ERR_NOMEM;
-    if (status == GR_OK) status = gr_heap_init(&s->heap, n);
+    if (status == GR_OK) status = gr_cq_init(&s->queue, n);
     if (status == GR_OK) status = build_grid(s, sigma_max);
     if (status != GR_OK) {
         gr_edmd_free(s);
@@ -358,7 +358,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
 
 /* Renumber the particles in the order of their cells (a counting sort, O(N + cells)),
  * permuting every per-particle array and remapping every stored particle index: event
- * partners, the heap, the cell lists.  Only the numbering changes -- positions,
+ * partners, the event queue, the cell lists.  Only the numbering changes -- positions,
  * velocities, predictions and the order of events stay exactly as they were. */
 static int reorder(gr_edmd *s)
 {
@@ -415,11 +415,7 @@ static int reorder(gr_edmd *s)
         memcpy(s->ev, tmp, ev_bytes);
         if (tmp != s->scratch) free(tmp);
     }
-    for (int32_t k = 0; k < n; k++) {
-        int32_t id = newpos[s->heap.node[k].id];
-        s->heap.node[k].id = id;
-        s->heap.where[id] = k;
-    }
+    gr_cq_renumber(&s->queue, newpos);
     free(newpos);
     for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;
     for (int32_t i = n - 1; i >= 0; i--) { /* lists in increasing index order */

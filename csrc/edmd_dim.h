@@ -163,7 +163,7 @@ static inline void FN(predict_cross)(gr_edmd *s, int32_t i)
 static inline void FN(schedule)(gr_edmd *s, int32_t i)
 {
     const gr_event *e = &s->ev[i];
-    gr_heap_update(&s->heap, i, e->t_coll < e->t_cross ? e->t_coll : e->t_cross);
+    gr_cq_update(&s->queue, i, e->t_coll < e->t_cross ? e->t_coll : e->t_cross);
 }
 
 /* Full prediction for i, whose clock must be the current time: walls, all adjacent
@@ -415,8 +415,8 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
             int status = reorder(s);
             if (status != GR_OK) return status;
         }
-        const int32_t i = gr_heap_top(&s->heap);
-        const double te = gr_heap_top_time(&s->heap);
+        double te;
+        const int32_t i = gr_cq_top(&s->queue, &te);
         if (te != te) {
             gr_error_set(err, GR_ERR_NONFINITE, uid(s, i), -1, s->t, te, "an event time");
             return GR_ERR_NONFINITE;
