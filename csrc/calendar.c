@@ -10,6 +10,12 @@ enum { GR_CQ_LIST = -1, GR_CQ_OVER = -2, GR_CQ_NONE = -3 };
 /* Keys per bucket the width aims at: the near heap then stays a few entries deep, and
  * few buckets are stepped over empty.  Measured best among 1, 2, 4, 8 (edmd_perf.py). */
 #define GR_CQ_PER_BUCKET 2.0
+/* Bucket slots per id.  The calendar covers nb buckets ahead of the start of the
+ * current "year" (over_from - nb), so on average half of that ahead of now; keys
+ * further ahead take the slower way through the overflow list.  That fraction is about
+ * (mean time to a key) / (nb w) ~ n / (GR_CQ_PER_BUCKET nb): 4 slots per id keep it
+ * near 1/8 for 16 bytes per id. */
+#define GR_CQ_SLOTS_PER_ID 4
 /* Keys sampled to estimate their spread when choosing the width. */
 #define GR_CQ_SAMPLE 1024
 /* Beyond this, bucket numbers saturate (a key that far ahead only needs to be in the
@@ -185,14 +191,15 @@ static void rebuild(gr_cq *q)
         else if (t != INFINITY) place(q, id);
     }
     q->changes = 0;
-    q->rebuild_at = 4 * (int64_t)n + 64;
+    /* no keys yet: rebuild once the caller has set them */
+    q->rebuild_at = nf > 0 ? 4 * (int64_t)n + 64 : 0;
 }
 
 int gr_cq_init(gr_cq *q, int32_t n)
 {
     q->n = n;
     q->nb = 16;
-    while (q->nb < n && q->nb < (1 << 30)) q->nb <<= 1;
+    while (q->nb < GR_CQ_SLOTS_PER_ID * (int64_t)n && q->nb < (1 << 30)) q->nb <<= 1;
     q->item = malloc((size_t)(n > 0 ? n : 1) * sizeof *q->item);
     q->head = malloc((size_t)q->nb * sizeof *q->head);
     q->near = malloc((size_t)(n > 0 ? n : 1) * sizeof *q->near);
@@ -202,7 +209,6 @@ int gr_cq_init(gr_cq *q, int32_t n)
     }
     for (int32_t id = 0; id < n; id++) q->item[id].t = INFINITY;
     rebuild(q);
-    q->rebuild_at = 0; /* rebuild again once the caller has set the keys */
     return GR_OK;
 }
 

@@ -41,7 +41,7 @@ typedef struct {
     int32_t n;
     gr_cq_item *item;  /* n, indexed by id */
     int32_t *head;     /* nb bucket list heads, -1 if empty */
-    int32_t nb;        /* a power of two >= n */
+    int32_t nb;        /* a power of two, a few per id */
     double t0, inv_w;  /* bucket(t) = floor((t - t0) * inv_w) */
     int64_t cur, over_from;
     int32_t over;      /* head of the overflow list */
@@ -60,6 +60,27 @@ void gr_cq_update(gr_cq *q, int32_t id, double t);
 /* The id with the smallest key (-1 if every key is +inf) and that key in *t; a NaN key
  * comes first.  Does not remove it, but may move the calendar forward or rebuild it. */
 int32_t gr_cq_top(gr_cq *q, double *t);
+/* The id most likely to be on top once the current top's key has changed (the
+ * runner-up of the near heap, or the first id of the next bucket), -1 if none at hand:
+ * a hint for prefetching, no promise. */
+static inline int32_t gr_cq_hint(const gr_cq *q)
+{
+    if (q->n_near >= 3) return q->near[2].t < q->near[1].t ? q->near[2].id : q->near[1].id;
+    if (q->n_near == 2) return q->near[1].id;
+    return q->head[(q->cur + 1) & (q->nb - 1)];
+}
+
+/* Ask the memory system for id's entry ahead of a gr_cq_update of it. */
+static inline void gr_cq_prefetch(const gr_cq *q, int32_t id)
+{
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(&q->item[id]);
+#else
+    (void)q;
+    (void)id;
+#endif
+}
+
 /* After the caller renumbered its ids (id i is now newpos[i], a permutation): move
  * every key along. */
 void gr_cq_renumber(gr_cq *q, const int32_t *newpos);
