@@ -129,15 +129,23 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
         const int32_t base = FN(cell_of)(s, c);
         const int32_t *off = axis < 0 ? s->off_all : s->off_layer[2 * axis + (dir > 0)];
         const int count = axis < 0 ? (DIM == 3 ? 27 : 9) : (DIM == 3 ? 9 : 3);
-        /* the cell heads first, all at once: at large N they are misses, and the
-         * chained loads of the scan would otherwise wait for them one by one */
-        for (int k = 0; k < count; k++) GR_PREFETCH(&s->head[base + off[k]]);
-        for (int k = 0; k < count; k++) FN(scan_cell)(s, i, p, base + off[k], NULL, &best, &partner);
+        /* the occupied cells' heads first, all at once: at large N they are misses,
+         * and the chained loads of the scan would otherwise wait for them one by one */
+        int32_t full[27];
+        int m = 0;
+        for (int k = 0; k < count; k++) {
+            int32_t cell = base + off[k];
+            full[m] = cell;
+            m += cell_occupied(s, cell);
+        }
+        for (int k = 0; k < m; k++) GR_PREFETCH(&s->head[full[k]]);
+        for (int k = 0; k < m; k++) FN(scan_cell)(s, i, p, full[k], NULL, &best, &partner);
     } else {
         FN(nbr) nb[DIM == 3 ? 27 : 9];
         int count = FN(neighbours)(s, c, axis, dir, nb);
         for (int k = 0; k < count; k++)
-            FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
+            if (cell_occupied(s, nb[k].cell))
+                FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
     }
     if (partner >= 0) {
         e->t_coll = T(p) + best;
