@@ -1,9 +1,12 @@
 /* calendar.c -- indexed calendar queue; see calendar.h for the idea and the invariants. */
+#define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
+#define _POSIX_C_SOURCE 200112L /* posix_memalign */
 #include <math.h>
 #include <stdlib.h>
 
 #include "calendar.h"
 #include "common.h"
+#include "hugemem.h"
 
 enum { GR_CQ_LIST = -1, GR_CQ_OVER = -2, GR_CQ_NONE = -3 };
 
@@ -200,8 +203,8 @@ int gr_cq_init(gr_cq *q, int32_t n)
     q->n = n;
     q->nb = 16;
     while (q->nb < GR_CQ_SLOTS_PER_ID * (int64_t)n && q->nb < (1 << 30)) q->nb <<= 1;
-    q->item = malloc((size_t)(n > 0 ? n : 1) * sizeof *q->item);
-    q->head = malloc((size_t)q->nb * sizeof *q->head);
+    q->item = gr_big_alloc((size_t)n * sizeof *q->item);
+    q->head = gr_big_alloc((size_t)q->nb * sizeof *q->head);
     q->near = malloc((size_t)(n > 0 ? n : 1) * sizeof *q->near);
     if (!q->item || !q->head || !q->near) {
         gr_cq_free(q);

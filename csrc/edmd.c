@@ -13,6 +13,7 @@
  *    since (lazy invalidation) -- then only that particle is rescanned.
  * Invariant: for every pair of particles in adjacent cells, the earliest collision on
  * their current straight lines is no earlier than the queue key of one of the two. */
+#define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
 #define _POSIX_C_SOURCE 200112L /* posix_memalign */
 #include <math.h>
 #include <stdlib.h>
@@ -20,6 +21,7 @@
 
 #include "collide.h"
 #include "edmd.h"
+#include "hugemem.h"
 #include "calendar.h"
 
 typedef struct {
@@ -189,7 +191,7 @@ static int build_grid(gr_edmd *s, double sigma_max)
         s->w[a] = s->L[a] / s->nc[a];
         s->ncells *= s->nc[a];
     }
-    s->head = malloc((size_t)s->ncells * sizeof *s->head);
+    s->head = gr_big_alloc((size_t)s->ncells * sizeof *s->head);
     s->occ = calloc(((size_t)s->ncells + 63) / 64, sizeof *s->occ);
     if (!s->head || !s->occ) return GR_ERR_NOMEM;
     for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;
@@ -325,15 +327,14 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->n = n;
     for (int a = 0; a < 3; a++) s->L[a] = a < d ? cfg->hi[a] - cfg->lo[a] : 1.0;
     size_t bytes = ((size_t)n * s->stride * sizeof(double) + 63) / 64 * 64;
-    void *mem = NULL; /* records on cache-line boundaries: a 3D record is one line */
-    s->P = posix_memalign(&mem, 64, bytes) == 0 ? mem : NULL;
-    s->mass = malloc((size_t)n * sizeof *s->mass);
-    s->count = calloc((size_t)n, sizeof *s->count);
+    s->P = gr_big_alloc(bytes); /* records on cache-line boundaries: a 3D record is one line */
+    s->mass = gr_big_alloc((size_t)n * sizeof *s->mass);
+    s->count = gr_big_alloc((size_t)n * sizeof *s->count);
     s->image = calloc((size_t)n * d, sizeof *s->image);
-    s->ev = malloc((size_t)n * sizeof *s->ev);
-    s->cc = malloc((size_t)n * d * sizeof *s->cc);
-    s->next = malloc((size_t)n * sizeof *s->next);
-    s->prev = malloc((size_t)n * sizeof *s->prev);
+    s->ev = gr_big_alloc((size_t)n * sizeof *s->ev);
+    s->cc = gr_big_alloc((size_t)n * d * sizeof *s->cc);
+    s->next = gr_big_alloc((size_t)n * sizeof *s->next);
+    s->prev = gr_big_alloc((size_t)n * sizeof *s->prev);
     s->id_of = malloc((size_t)n * sizeof *s->id_of);
     if (n >= GR_REORDER_MIN_N) s->scratch = malloc((size_t)n * s->stride * sizeof(double));
     int status = GR_OK;
@@ -358,6 +359,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         p[2 * d] = 0.0;
         p[2 * d + 1] = radius[i];
         s->mass[i] = mass[i];
+        s->count[i] = 0;
         msum += mass[i];
         s->ev[i] = (gr_event){.t_coll = INFINITY, .t_cross = INFINITY, .pcount = 0, .partner = -1,
                               .cross = -1, .t_last = -INFINITY, .streak = 0, .last = -1};
