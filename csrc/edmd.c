@@ -6,11 +6,17 @@
  *    and is advanced only when an event touches it;
  *  - the box is cut into cells at least one largest diameter wide; a particle looks for
  *    partners in its own and the adjacent cells only, and crossing into a new cell is an
- *    event that scans just the newly adjacent layer of cells;
+ *    event that scans just the newly adjacent layer of cells; a bit per cell says which
+ *    cells hold anyone, so scans skip the empty ones (most of them in a dilute gas);
  *  - each particle keeps one predicted collision (pair or wall) and one cell crossing; the
  *    queue holds the earlier of the two.  A predicted pair collision remembers the
  *    partner's collision counter and is found stale when popped if the partner collided
- *    since (lazy invalidation) -- then only that particle is rescanned.
+ *    since (lazy invalidation) -- then only that particle is rescanned;
+ *  - the queue is a calendar queue (calendar.c): O(1) per key change, where a heap's
+ *    O(log N) sift is a chain of cache misses at large N;
+ *  - at large N what remains is memory latency: particles are renumbered in cell order
+ *    now and then (reorder), the next event's particle and a pair's partner are
+ *    prefetched, and the big arrays sit on huge pages where the OS offers them.
  * Invariant: for every pair of particles in adjacent cells, the earliest collision on
  * their current straight lines is no earlier than the queue key of one of the two. */
 #define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
