@@ -6,13 +6,20 @@
  *    and is advanced only when an event touches it;
  *  - the box is cut into cells at least one largest diameter wide; a particle looks for
  *    partners in its own and the adjacent cells only, and crossing into a new cell is an
- *    event that scans just the newly adjacent layer of cells;
+ *    event that scans just the newly adjacent layer of cells; a bit per cell says which
+ *    cells hold anyone, so scans skip the empty ones (most of them in a dilute gas);
  *  - each particle keeps one predicted collision (pair or wall) and one cell crossing; the
  *    queue holds the earlier of the two.  A predicted pair collision remembers the
  *    partner's collision counter and is found stale when popped if the partner collided
- *    since (lazy invalidation) -- then only that particle is rescanned.
+ *    since (lazy invalidation) -- then only that particle is rescanned;
+ *  - the queue is a calendar queue (calendar.c): O(1) per key change, where a heap's
+ *    O(log N) sift is a chain of cache misses at large N;
+ *  - at large N what remains is memory latency: particles are renumbered in cell order
+ *    now and then (reorder), the next event's particle and a pair's partner are
+ *    prefetched, and the big arrays sit on huge pages where the OS offers them.
  * Invariant: for every pair of particles in adjacent cells, the earliest collision on
  * their current straight lines is no earlier than the queue key of one of the two. */
+#define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
 #define _POSIX_C_SOURCE 200112L /* posix_memalign */
 #include <math.h>
 #include <stdlib.h>
@@ -20,7 +27,8 @@
 
 #include "collide.h"
 #include "edmd.h"
-#include "heap.h"
+#include "hugemem.h"
+#include "calendar.h"
 
 typedef struct {
     double t_coll;   /* predicted pair or wall collision, +inf if none */
@@ -43,7 +51,7 @@ struct gr_edmd {
     int64_t *count;   /* collisions (pair and wall) per particle */
     int64_t *image;   /* n * dim periodic image counters */
     gr_event *ev;
-    gr_heap heap;
+    gr_cq queue;
     int32_t *id_of;   /* the caller's index of each internal particle (see reorder) */
     void *scratch;    /* n * stride doubles, for reordering */
     int64_t next_reorder;
@@ -54,6 +62,11 @@ struct gr_edmd {
     int32_t ncells;
     int32_t *cc;          /* n * dim cell coordinates */
     int32_t *head, *next, *prev;
+    /* One bit per cell, set iff the cell holds a particle.  Most cells of a dilute gas
+     * are empty (cells are one diameter wide: ~8 per particle at packing 0.065), and at
+     * large N the head array is far out of cache; the bits are 32 times smaller, so a
+     * scan learns which of its 27 cells to visit from lines it mostly has at hand. */
+    uint64_t *occ;
     int32_t *nb_cell[3];  /* [axis][3*c + d+1]: neighbouring coordinate or -1 */
     double *nb_shift[3];  /* [axis][3*c + d+1]: image shift in box lengths' units */
     /* Linear index offsets of the adjacent cells of a cell away from the box edge (the
@@ -86,23 +99,39 @@ struct gr_edmd {
 #define GR_REORDER_MIN_N 4096
 #define GR_REORDER_EVENTS_PER_N 16
 
+/* Prefetching: at large N the particle an event touches is a cache miss in every
+ * per-particle array; asking for them one event ahead (and for a pair's partner before
+ * the first of them is used) overlaps those misses with useful work.  A hint only:
+ * compilers without the builtin lose speed, not correctness. */
+#if defined(__GNUC__) || defined(__clang__)
+#define GR_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define GR_PREFETCH(p) ((void)(p))
+#endif
+
 static inline double *rec(const gr_edmd *s, int32_t i) { return s->P + (size_t)i * s->stride; }
 
 /* The caller's index of internal particle i (negative codes pass through). */
 static inline int64_t uid(const gr_edmd *s, int32_t i) { return i < 0 ? -1 : s->id_of[i]; }
+
+static inline int cell_occupied(const gr_edmd *s, int32_t c)
+{
+    return (int)((s->occ[c >> 6] >> (c & 63)) & 1);
+}
 
 static inline void cell_insert(gr_edmd *s, int32_t i, int32_t c)
 {
     s->prev[i] = -1;
     s->next[i] = s->head[c];
     if (s->head[c] >= 0) s->prev[s->head[c]] = i;
+    else s->occ[c >> 6] |= (uint64_t)1 << (c & 63);
     s->head[c] = i;
 }
 
 static inline void cell_remove(gr_edmd *s, int32_t i, int32_t c)
 {
     if (s->prev[i] >= 0) s->next[s->prev[i]] = s->next[i];
-    else s->head[c] = s->next[i];
+    else if ((s->head[c] = s->next[i]) < 0) s->occ[c >> 6] &= ~((uint64_t)1 << (c & 63));
     if (s->next[i] >= 0) s->prev[s->next[i]] = s->prev[i];
 }
 
@@ -129,9 +158,10 @@ void gr_edmd_free(gr_edmd *s)
     free(s->ev);
     free(s->id_of);
     free(s->scratch);
-    gr_heap_free(&s->heap);
+    gr_cq_free(&s->queue);
     free(s->cc);
     free(s->head);
+    free(s->occ);
     free(s->next);
     free(s->prev);
     for (int a = 0; a < 3; a++) {
@@ -167,8 +197,9 @@ static int build_grid(gr_edmd *s, double sigma_max)
         s->w[a] = s->L[a] / s->nc[a];
         s->ncells *= s->nc[a];
     }
-    s->head = malloc((size_t)s->ncells * sizeof *s->head);
-    if (!s->head) return GR_ERR_NOMEM;
+    s->head = gr_big_alloc((size_t)s->ncells * sizeof *s->head);
+    s->occ = calloc(((size_t)s->ncells + 63) / 64, sizeof *s->occ);
+    if (!s->head || !s->occ) return GR_ERR_NOMEM;
     for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;
     int k_all = 0, k_layer[6] = {0, 0, 0, 0, 0, 0};
     for (int d2 = (d == 3 ? -1 : 0); d2 <= (d == 3 ? 1 : 0); d2++)
@@ -302,22 +333,21 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->n = n;
     for (int a = 0; a < 3; a++) s->L[a] = a < d ? cfg->hi[a] - cfg->lo[a] : 1.0;
     size_t bytes = ((size_t)n * s->stride * sizeof(double) + 63) / 64 * 64;
-    void *mem = NULL; /* records on cache-line boundaries: a 3D record is one line */
-    s->P = posix_memalign(&mem, 64, bytes) == 0 ? mem : NULL;
-    s->mass = malloc((size_t)n * sizeof *s->mass);
-    s->count = calloc((size_t)n, sizeof *s->count);
+    s->P = gr_big_alloc(bytes); /* records on cache-line boundaries: a 3D record is one line */
+    s->mass = gr_big_alloc((size_t)n * sizeof *s->mass);
+    s->count = gr_big_alloc((size_t)n * sizeof *s->count);
     s->image = calloc((size_t)n * d, sizeof *s->image);
-    s->ev = malloc((size_t)n * sizeof *s->ev);
-    s->cc = malloc((size_t)n * d * sizeof *s->cc);
-    s->next = malloc((size_t)n * sizeof *s->next);
-    s->prev = malloc((size_t)n * sizeof *s->prev);
+    s->ev = gr_big_alloc((size_t)n * sizeof *s->ev);
+    s->cc = gr_big_alloc((size_t)n * d * sizeof *s->cc);
+    s->next = gr_big_alloc((size_t)n * sizeof *s->next);
+    s->prev = gr_big_alloc((size_t)n * sizeof *s->prev);
     s->id_of = malloc((size_t)n * sizeof *s->id_of);
     if (n >= GR_REORDER_MIN_N) s->scratch = malloc((size_t)n * s->stride * sizeof(double));
     int status = GR_OK;
     if (!s->P || !s->mass || !s->count || !s->image || !s->ev || !s->cc || !s->next || !s->prev ||
         !s->id_of || (n >= GR_REORDER_MIN_N && !s->scratch))
         status = GR_ERR_NOMEM;
-    if (status == GR_OK) status = gr_heap_init(&s->heap, n);
+    if (status == GR_OK) status = gr_cq_init(&s->queue, n);
     if (status == GR_OK) status = build_grid(s, sigma_max);
     if (status != GR_OK) {
         gr_edmd_free(s);
@@ -335,6 +365,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         p[2 * d] = 0.0;
         p[2 * d + 1] = radius[i];
         s->mass[i] = mass[i];
+        s->count[i] = 0;
         msum += mass[i];
         s->ev[i] = (gr_event){.t_coll = INFINITY, .t_cross = INFINITY, .pcount = 0, .partner = -1,
                               .cross = -1, .t_last = -INFINITY, .streak = 0, .last = -1};
@@ -358,7 +389,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
 
 /* Renumber the particles in the order of their cells (a counting sort, O(N + cells)),
  * permuting every per-particle array and remapping every stored particle index: event
- * partners, the heap, the cell lists.  Only the numbering changes -- positions,
+ * partners, the event queue, the cell lists.  Only the numbering changes -- positions,
  * velocities, predictions and the order of events stay exactly as they were. */
 static int reorder(gr_edmd *s)
 {
@@ -415,13 +446,10 @@ static int reorder(gr_edmd *s)
         memcpy(s->ev, tmp, ev_bytes);
         if (tmp != s->scratch) free(tmp);
     }
-    for (int32_t k = 0; k < n; k++) {
-        int32_t id = newpos[s->heap.node[k].id];
-        s->heap.node[k].id = id;
-        s->heap.where[id] = k;
-    }
+    gr_cq_renumber(&s->queue, newpos);
     free(newpos);
     for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;
+    memset(s->occ, 0, ((size_t)s->ncells + 63) / 64 * sizeof *s->occ);
     for (int32_t i = n - 1; i >= 0; i--) { /* lists in increasing index order */
         int32_t c = 0;
         for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->cc[(size_t)i * d + a];

@@ -65,6 +65,18 @@ static inline int32_t FN(cell_of)(const gr_edmd *s, const int32_t *c)
 #endif
 }
 
+/* Everything an event of particle i is about to read or write, requested at once. */
+static inline void FN(prefetch)(const gr_edmd *s, int32_t i)
+{
+    GR_PREFETCH(rec(s, i));
+    GR_PREFETCH(&s->ev[i]);
+    GR_PREFETCH(s->cc + (size_t)i * DIM);
+    GR_PREFETCH(&s->count[i]);
+    GR_PREFETCH(&s->next[i]);
+    GR_PREFETCH(&s->prev[i]);
+    gr_cq_prefetch(&s->queue, i);
+}
+
 static inline void FN(move)(double *p, double t)
 {
     double dt = t - T(p);
@@ -117,12 +129,23 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
         const int32_t base = FN(cell_of)(s, c);
         const int32_t *off = axis < 0 ? s->off_all : s->off_layer[2 * axis + (dir > 0)];
         const int count = axis < 0 ? (DIM == 3 ? 27 : 9) : (DIM == 3 ? 9 : 3);
-        for (int k = 0; k < count; k++) FN(scan_cell)(s, i, p, base + off[k], NULL, &best, &partner);
+        /* the occupied cells' heads first, all at once: at large N they are misses,
+         * and the chained loads of the scan would otherwise wait for them one by one */
+        int32_t full[27];
+        int m = 0;
+        for (int k = 0; k < count; k++) {
+            int32_t cell = base + off[k];
+            full[m] = cell;
+            m += cell_occupied(s, cell);
+        }
+        for (int k = 0; k < m; k++) GR_PREFETCH(&s->head[full[k]]);
+        for (int k = 0; k < m; k++) FN(scan_cell)(s, i, p, full[k], NULL, &best, &partner);
     } else {
         FN(nbr) nb[DIM == 3 ? 27 : 9];
         int count = FN(neighbours)(s, c, axis, dir, nb);
         for (int k = 0; k < count; k++)
-            FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
+            if (cell_occupied(s, nb[k].cell))
+                FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
     }
     if (partner >= 0) {
         e->t_coll = T(p) + best;
@@ -163,7 +186,7 @@ static inline void FN(predict_cross)(gr_edmd *s, int32_t i)
 static inline void FN(schedule)(gr_edmd *s, int32_t i)
 {
     const gr_event *e = &s->ev[i];
-    gr_heap_update(&s->heap, i, e->t_coll < e->t_cross ? e->t_coll : e->t_cross);
+    gr_cq_update(&s->queue, i, e->t_coll < e->t_cross ? e->t_coll : e->t_cross);
 }
 
 /* Full prediction for i, whose clock must be the current time: walls, all adjacent
@@ -415,8 +438,8 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
             int status = reorder(s);
             if (status != GR_OK) return status;
         }
-        const int32_t i = gr_heap_top(&s->heap);
-        const double te = gr_heap_top_time(&s->heap);
+        double te;
+        const int32_t i = gr_cq_top(&s->queue, &te);
         if (te != te) {
             gr_error_set(err, GR_ERR_NONFINITE, uid(s, i), -1, s->t, te, "an event time");
             return GR_ERR_NONFINITE;
@@ -445,6 +468,11 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
         s->t = te;
         s->events++;
         gr_event *e = &s->ev[i];
+        {
+            int32_t h = gr_cq_hint(&s->queue);
+            if (h >= 0) FN(prefetch)(s, h);
+            if (e->t_coll <= e->t_cross && e->partner >= 0) FN(prefetch)(s, e->partner);
+        }
         int status = GR_OK;
         if (e->t_cross < e->t_coll) {
             status = FN(do_cross)(s, i, te);

@@ -1,0 +1,299 @@
+/* calendar.c -- indexed calendar queue; see calendar.h for the idea and the invariants. */
+#define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
+#define _POSIX_C_SOURCE 200112L /* posix_memalign */
+#include <math.h>
+#include <stdlib.h>
+
+#include "calendar.h"
+#include "common.h"
+#include "hugemem.h"
+
+enum { GR_CQ_LIST = -1, GR_CQ_OVER = -2, GR_CQ_NONE = -3 };
+
+/* Keys per bucket the width aims at: the near heap then stays a few entries deep, and
+ * few buckets are stepped over empty.  Measured best among 1, 2, 4, 8 (edmd_perf.py). */
+#define GR_CQ_PER_BUCKET 2.0
+/* Bucket slots per id.  The calendar covers nb buckets ahead of the start of the
+ * current "year" (over_from - nb), so on average half of that ahead of now; keys
+ * further ahead take the slower way through the overflow list.  That fraction is about
+ * (mean time to a key) / (nb w) ~ n / (GR_CQ_PER_BUCKET nb): 4 slots per id keep it
+ * near 1/8 for 16 bytes per id. */
+#define GR_CQ_SLOTS_PER_ID 4
+/* Keys sampled to estimate their spread when choosing the width. */
+#define GR_CQ_SAMPLE 1024
+/* Beyond this, bucket numbers saturate (a key that far ahead only needs to be in the
+ * overflow; saturation keeps bucket() monotonic and avoids an overflowing conversion). */
+#define GR_CQ_FAR 4611686018427387904.0 /* 2^62 */
+
+/* Monotonic non-decreasing in t, which is all the ordering needs; truncation rather
+ * than floor (keys before t0 share bucket 0, harmlessly). */
+static inline int64_t bucket_of(const gr_cq *q, double t)
+{
+    double x = (t - q->t0) * q->inv_w;
+    if (!(x < GR_CQ_FAR)) return (int64_t)GR_CQ_FAR;
+    if (x < -GR_CQ_FAR) return -(int64_t)GR_CQ_FAR;
+    return (int64_t)x;
+}
+
+/* ---- the near heap: a binary min-heap of (key, id), item[id].where = its slot ---- */
+
+static inline void near_place(gr_cq *q, int32_t k, gr_cq_near e)
+{
+    q->near[k] = e;
+    q->item[e.id].where = k;
+}
+
+static void near_sift_up(gr_cq *q, int32_t k, gr_cq_near e)
+{
+    while (k > 0) {
+        int32_t parent = (k - 1) >> 1;
+        if (!(e.t < q->near[parent].t)) break;
+        near_place(q, k, q->near[parent]);
+        k = parent;
+    }
+    near_place(q, k, e);
+}
+
+static void near_sift_down(gr_cq *q, int32_t k, gr_cq_near e)
+{
+    const int32_t n = q->n_near;
+    for (;;) {
+        int32_t c = 2 * k + 1;
+        if (c >= n) break;
+        if (c + 1 < n && q->near[c + 1].t < q->near[c].t) c++;
+        if (!(q->near[c].t < e.t)) break;
+        near_place(q, k, q->near[c]);
+        k = c;
+    }
+    near_place(q, k, e);
+}
+
+static void near_remove(gr_cq *q, int32_t k)
+{
+    gr_cq_near last = q->near[--q->n_near];
+    if (k == q->n_near) return;
+    if (k > 0 && last.t < q->near[(k - 1) >> 1].t) near_sift_up(q, k, last);
+    else near_sift_down(q, k, last);
+}
+
+/* ---- lists ---- */
+
+static inline void list_push(gr_cq *q, int32_t *head, int32_t id, int32_t where)
+{
+    gr_cq_item *it = &q->item[id];
+    it->where = where;
+    it->prev = -1;
+    it->next = *head;
+    if (*head >= 0) q->item[*head].prev = id;
+    *head = id;
+}
+
+static inline void list_unlink(gr_cq *q, int32_t *head, int32_t id)
+{
+    gr_cq_item *it = &q->item[id];
+    if (it->prev >= 0) q->item[it->prev].next = it->next;
+    else *head = it->next;
+    if (it->next >= 0) q->item[it->next].prev = it->prev;
+}
+
+/* Put id (finite key, in no structure) where the invariant wants it. */
+static inline void place(gr_cq *q, int32_t id)
+{
+    double t = q->item[id].t;
+    int64_t b = bucket_of(q, t);
+    if (b <= q->cur) {
+        gr_cq_near e = {t, id};
+        near_sift_up(q, q->n_near++, e);
+    } else if (b < q->over_from) {
+        list_push(q, &q->head[b & (q->nb - 1)], id, GR_CQ_LIST);
+        q->n_list++;
+    } else {
+        list_push(q, &q->over, id, GR_CQ_OVER);
+        q->n_over++;
+    }
+}
+
+static inline void take_out(gr_cq *q, int32_t id)
+{
+    gr_cq_item *it = &q->item[id];
+    if (it->where >= 0) {
+        near_remove(q, it->where);
+    } else if (it->where == GR_CQ_LIST) {
+        list_unlink(q, &q->head[bucket_of(q, it->t) & (q->nb - 1)], id);
+        q->n_list--;
+    } else if (it->where == GR_CQ_OVER) {
+        list_unlink(q, &q->over, id);
+        q->n_over--;
+    } else if (q->nan_id == id) {
+        q->nan_id = -1;
+    }
+    it->where = GR_CQ_NONE;
+}
+
+/* Move the overflow keys that now fall before over_from into the calendar. */
+static void spill(gr_cq *q)
+{
+    for (int32_t id = q->over, nx; id >= 0; id = nx) {
+        nx = q->item[id].next;
+        if (bucket_of(q, q->item[id].t) < q->over_from) {
+            list_unlink(q, &q->over, id);
+            q->n_over--;
+            place(q, id);
+        }
+    }
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Start the calendar afresh at the smallest key, with a width from the keys' spread:
+ * if the median of (key - smallest) over an evenly strided sample is m, about half of
+ * the nf finite keys lie within m, so the keys are about 2 m / nf apart. */
+static void rebuild(gr_cq *q)
+{
+    const int32_t n = q->n;
+    double tmin = INFINITY;
+    int32_t nf = 0;
+    for (int32_t id = 0; id < n; id++) {
+        double t = q->item[id].t;
+        if (isfinite(t)) {
+            nf++;
+            if (t < tmin) tmin = t;
+        }
+    }
+    double w = 0.0;
+    q->t0 = nf > 0 ? tmin : 0.0;
+    if (nf > 1) {
+        double sample[GR_CQ_SAMPLE];
+        int m = 0;
+        int32_t stride = n / GR_CQ_SAMPLE > 1 ? n / GR_CQ_SAMPLE : 1;
+        for (int32_t id = 0; id < n && m < GR_CQ_SAMPLE; id += stride)
+            if (isfinite(q->item[id].t)) sample[m++] = q->item[id].t - tmin;
+        if (m > 0) {
+            qsort(sample, (size_t)m, sizeof *sample, cmp_double);
+            double spread = sample[m / 2] > 0.0 ? 2.0 * sample[m / 2] : sample[m - 1];
+            w = GR_CQ_PER_BUCKET * spread / nf;
+        }
+    }
+    q->inv_w = 1.0 / w;
+    if (!(w > 0.0) || !isfinite(q->inv_w)) q->inv_w = 1.0; /* all keys equal: any width */
+    for (int32_t b = 0; b < q->nb; b++) q->head[b] = -1;
+    q->over = -1;
+    q->n_list = q->n_over = 0;
+    q->n_near = 0;
+    q->nan_id = -1;
+    q->cur = 0;
+    q->over_from = q->nb;
+    for (int32_t id = 0; id < n; id++) {
+        double t = q->item[id].t;
+        q->item[id].where = GR_CQ_NONE;
+        if (t != t) q->nan_id = id;
+        else if (t != INFINITY) place(q, id);
+    }
+    q->changes = 0;
+    /* no keys yet: rebuild once the caller has set them */
+    q->rebuild_at = nf > 0 ? 4 * (int64_t)n + 64 : 0;
+}
+
+int gr_cq_init(gr_cq *q, int32_t n)
+{
+    q->n = n;
+    q->nb = 16;
+    while (q->nb < GR_CQ_SLOTS_PER_ID * (int64_t)n && q->nb < (1 << 30)) q->nb <<= 1;
+    q->item = gr_big_alloc((size_t)n * sizeof *q->item);
+    q->head = gr_big_alloc((size_t)q->nb * sizeof *q->head);
+    q->near = malloc((size_t)(n > 0 ? n : 1) * sizeof *q->near);
+    if (!q->item || !q->head || !q->near) {
+        gr_cq_free(q);
+        return GR_ERR_NOMEM;
+    }
+    for (int32_t id = 0; id < n; id++) q->item[id].t = INFINITY;
+    rebuild(q);
+    return GR_OK;
+}
+
+void gr_cq_free(gr_cq *q)
+{
+    free(q->item);
+    free(q->head);
+    free(q->near);
+    q->item = NULL;
+    q->head = NULL;
+    q->near = NULL;
+}
+
+void gr_cq_update(gr_cq *q, int32_t id, double t)
+{
+    take_out(q, id);
+    q->item[id].t = t;
+    q->changes++;
+    if (t != t) q->nan_id = id;
+    else if (t != INFINITY) place(q, id);
+}
+
+int32_t gr_cq_top(gr_cq *q, double *t)
+{
+    if (q->nan_id >= 0) {
+        *t = NAN;
+        return q->nan_id;
+    }
+    if (q->changes >= q->rebuild_at) rebuild(q);
+    while (q->n_near == 0) {
+        if (q->n_list == 0) {
+            if (q->n_over == 0) {
+                *t = INFINITY;
+                return -1;
+            }
+            /* only far keys left: jump to the first of them rather than step there */
+            int64_t bmin = (int64_t)GR_CQ_FAR;
+            for (int32_t id = q->over; id >= 0; id = q->item[id].next) {
+                int64_t b = bucket_of(q, q->item[id].t);
+                if (b < bmin) bmin = b;
+            }
+            q->cur = bmin;
+            q->over_from = (bmin / q->nb + 1) * q->nb;
+            spill(q);
+            continue;
+        }
+        q->cur++;
+        if (q->cur >= q->over_from) {
+            q->over_from += q->nb;
+            spill(q);
+        }
+        int32_t *head = &q->head[q->cur & (q->nb - 1)];
+        while (*head >= 0) {
+            int32_t id = *head;
+            *head = q->item[id].next;
+            q->n_list--;
+            gr_cq_near e = {q->item[id].t, id};
+            near_sift_up(q, q->n_near++, e);
+        }
+    }
+    *t = q->near[0].t;
+    return q->near[0].id;
+}
+
+void gr_cq_renumber(gr_cq *q, const int32_t *newpos)
+{
+    /* permute the keys in place, cycle by cycle, with `where` marking the ids done
+     * (rebuild() sets every `where` afresh); no allocation, so nothing can fail */
+    gr_cq_item *it = q->item;
+    for (int32_t id = 0; id < q->n; id++) it[id].where = 0;
+    for (int32_t start = 0; start < q->n; start++) {
+        if (it[start].where) continue;
+        double carry = it[start].t;
+        int32_t j = start;
+        do {
+            int32_t k = newpos[j];
+            double t = it[k].t;
+            it[k].t = carry;
+            it[k].where = 1;
+            carry = t;
+            j = k;
+        } while (j != start);
+    }
+    rebuild(q);
+}
