@@ -39,32 +39,6 @@ static inline int gr_pair_beats(int dim, const double *dr, const double *dv, dou
     return t < horizon;
 }
 
-/* The same test as gr_pair_time, shaped for the scan over candidates, where nearly every
- * pair fails: whether a pair could collide before `horizon` is decided from flags
- * combined without branches, so that the one branch taken per candidate is almost
- * always "no" and predicted well (the separate early exits of gr_pair_time each go
- * either way about half the time, and mispredicting them cost more than the
- * arithmetic they skip).  Returns 1 and sets *dt exactly as gr_pair_time would when
- * that time is < horizon; returns 0 when gr_pair_time's result would be >= horizon. */
-static inline int gr_pair_beats(int dim, const double *dr, const double *dv, double sigma,
-                                double horizon, double *dt)
-{
-    double b = 0.0, dr2 = 0.0, dv2 = 0.0;
-    for (int a = 0; a < dim; a++) {
-        b += dr[a] * dv[a];
-        dr2 += dr[a] * dr[a];
-        dv2 += dv[a] * dv[a];
-    }
-    double c = dr2 - sigma * sigma;
-    double disc = b * b - dv2 * c;
-    int touching = c <= 0.0;
-    int soon = (c < -2.0 * b * horizon) & (disc > 0.0);
-    if (!((b < 0.0) & (touching | soon))) return 0;
-    double t = touching ? 0.0 : c / (-b + sqrt(disc));
-    *dt = t;
-    return t < horizon;
-}
-
 /* Apply the collision rule (thesis 2.10-2.11) to v_i and v_j in place, for separation
  * dr = x_j - x_i at contact, masses m_i, m_j and restitution xi.  |dr| is used rather
  * than the contact distance so that rounding in the contact position cannot bias the
