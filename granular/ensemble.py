@@ -2,8 +2,10 @@
 Dask cluster when one machine is outgrown, with the mean and central-limit error of
 every quantity (thesis 2.120-2.122).
 
-Every run r gets its own random stream ``SeedSequence(seed).spawn(K)[r]``, so the same
-seed gives the same results whichever backend and however many workers ran them.
+Every run r gets its own random stream ``SeedSequence(seed).spawn(K)[r]`` (run r of point p
+of a sweep over P models: ``SeedSequence(seed).spawn(P)[p].spawn(K)[r]``), and runs are
+reduced in run order, so the same seed gives bit-identical results whichever backend and
+however many workers ran them.
 """
 from __future__ import annotations
 
@@ -167,8 +169,13 @@ def _call_task(task, index, seed):
         return index, "error", (repr(exc), exc.__class__.__name__, traceback.format_exc())
 
 
-def _auto_progress():
-    return sys.stderr.isatty() or "ipykernel" in sys.modules
+def _progress_bar(total, progress):
+    """A tqdm bar over runs; by default shown in a terminal or a notebook only."""
+    from tqdm.auto import tqdm
+
+    if progress is None:
+        progress = sys.stderr.isatty() or "ipykernel" in sys.modules
+    return tqdm(total=total, unit="run", disable=not progress)
 
 
 def _executor(backend, workers):
@@ -181,38 +188,129 @@ def _executor(backend, workers):
     return cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
 
 
-def _results(task, seeds, backend, workers):
-    """Yield (index, status, payload) as runs finish, from the chosen backend."""
-    if backend == "serial":
-        for i, s in enumerate(seeds):
-            yield _call_task(task, i, s)
-        return
-    if hasattr(backend, "submit") and hasattr(backend, "gather"):  # a dask.distributed Client
-        from distributed import as_completed
+def _windowed(calls, submit, wait_any, window):
+    """Yield every call's (index, status, payload) as it finishes, submitting a call only
+    while it is fewer than ``window`` places after the earliest unfinished one.
 
-        futures = [backend.submit(_call_task, task, i, s, pure=False) for i, s in enumerate(seeds)]
-        for fut in as_completed(futures):
-            yield fut.result()
-            fut.release()
-        return
-    if backend not in ("processes", "threads"):
-        raise ValueError(f"backend must be 'serial', 'processes', 'threads' or a dask Client, got {backend!r}")
+    So at most ``window`` calls are in flight, and the results that ``ensemble`` holds back
+    until an earlier, slower run is reduced (it reduces in run order) number fewer than
+    ``window`` too: memory stays bounded however many runs there are.  The price: a run far
+    slower than the ``window - 1`` after it holds back further submissions until it ends.
+    A finished future is dropped as soon as its result is taken, which on Dask also frees
+    its result on the cluster.
+    """
+    running = {}  # future -> index of its call
+    finished = set()  # indices that finished while an earlier call still ran
+    first = submitted = 0  # every call before `first` has finished
+    while first < len(calls):
+        while submitted < min(first + window, len(calls)):
+            running[submit(calls[submitted])] = submitted
+            submitted += 1
+        done = wait_any(list(running))
+        while done:
+            future = done.pop()
+            finished.add(running.pop(future))
+            result = future.result()
+            del future
+            yield result
+        while first in finished:
+            finished.remove(first)
+            first += 1
+
+
+def _pool_results(calls, backend, workers):
     import concurrent.futures as cf
 
     with _executor(backend, workers) as pool:
-        futures = [pool.submit(_call_task, task, i, s) for i, s in enumerate(seeds)]
-        for fut in cf.as_completed(futures):
-            yield fut.result()
+        yield from _windowed(
+            calls, lambda call: pool.submit(_call_task, *call),
+            lambda futures: cf.wait(futures, return_when=cf.FIRST_COMPLETED).done,
+            window=2 * workers)  # a run queued behind each running one: no worker waits for us
+
+
+def _dask_results(calls, client):
+    from distributed import wait
+
+    threads = max(1, sum(client.nthreads().values()))
+    yield from _windowed(
+        calls, lambda call: client.submit(_call_task, *call, pure=False),
+        lambda futures: wait(futures, return_when="FIRST_COMPLETED").done,
+        window=2 * threads)  # as for local pools, per thread of the cluster as it is now
+
+
+def _results(calls, backend, workers):
+    """Yield (index, status, payload) as runs finish, from the chosen backend."""
+    if backend == "serial":
+        for call in calls:
+            yield _call_task(*call)
+    elif hasattr(backend, "submit") and hasattr(backend, "gather"):  # a dask.distributed Client
+        yield from _dask_results(calls, backend)
+    elif backend in ("processes", "threads"):
+        yield from _pool_results(calls, backend, workers)
+    else:
+        raise ValueError(f"backend must be 'serial', 'processes', 'threads' or a dask Client, got {backend!r}")
+
+
+def _seeds(seed, runs, points=None):
+    """Per point, its runs' SeedSequences: ``SeedSequence(seed).spawn(runs)`` for a single
+    model (``points=None``), ``SeedSequence(seed).spawn(points)[p].spawn(runs)`` for point p
+    of a sweep."""
+    root = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    if points is None:
+        return [root.spawn(runs)]
+    return [child.spawn(runs) for child in root.spawn(points)]
+
+
+class _PointReducer:
+    """One point's runs, fed in run order, reduced to an EnsembleResult."""
+
+    def __init__(self, seeds, keep_runs):
+        self.seeds = seeds
+        self.acc = _Accumulator()
+        self.kept = [] if keep_runs else None
+        self.failures = []
+
+    def add(self, run, status, payload):
+        if status == "ok":
+            self.acc.add(payload)
+            if self.kept is not None:
+                self.kept.append(payload)
+        else:
+            s = self.seeds[run]
+            self.failures.append(RunFailure(run, {"entropy": s.entropy, "spawn_key": s.spawn_key},
+                                            payload[0], payload[2]))
+
+    def result(self):
+        mean, error = self.acc.result()
+        times = mean.pop("times", None)
+        error.pop("times", None)
+        return EnsembleResult(self.kept if self.kept is not None else [], mean, error,
+                              self.acc.count, self.failures, times)
+
+
+def _reduce_in_order(results, reducers, runs, bar):
+    """Feed each (index, status, payload) to its point's reducer in index order, whatever
+    order the runs finish in, so that means are bit-identical across backends.  Results
+    that arrive early wait in ``pending``, which the windowed submission keeps small."""
+    pending = {}
+    next_index = 0
+    for index, status, payload in results:
+        pending[index] = (status, payload)
+        while next_index in pending:
+            point, run = divmod(next_index, runs)
+            reducers[point].add(run, *pending.pop(next_index))
+            next_index += 1
+        bar.update(1)
 
 
 def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progress=None,
              keep_runs=True, quantities=("msd", "temperature"), **run_kwargs):
-    """Run ``runs`` independent realizations and return their results with ensemble means
-    and standard errors.
+    """Run ``runs`` independent realizations of a model, or of every model of a sweep, and
+    return their results with ensemble means and standard errors.
 
     Parameters
     ----------
-    model : Scene, or a function of ``seed``
+    model : Scene, a function of ``seed``, or a list or tuple of these (a sweep)
         - a ``Scene``: each run shuffles its velocity vectors among the particles (the
           thesis' method, section 3.8) and runs EDMD with ``run_kwargs`` (``t_stop``,
           ``sample_times``, ``stop_when`` as in ``Simulation.run``);
@@ -221,72 +319,59 @@ def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progr
           per run, then EDMD as above;
         - a function ``f(seed=SeedSequence)`` returning anything else (e.g.
           ``functools.partial(granular.langevin.run, ...)``): its NumPy arrays and numbers
-          are the quantities (``run_kwargs`` must then be empty).
+          are the quantities (``run_kwargs`` must then be empty);
+        - a list or tuple of P such models, the points of a sweep: all P x ``runs`` runs
+          are scheduled together, so the backend's workers stay busy across points.
         Functions must be picklable (module level, or partials of such) for the process
         and Dask backends.
     runs : int
+        Realizations per model.
     seed : int, SeedSequence or None
-        Run r uses ``SeedSequence(seed).spawn(runs)[r]``.
+        Run r uses ``SeedSequence(seed).spawn(runs)[r]``; in a sweep, run r of point p uses
+        ``SeedSequence(seed).spawn(P)[p].spawn(runs)[r]``, so a point gives the same
+        results as ``ensemble(model[p], runs, seed=SeedSequence(seed).spawn(P)[p])``.
     backend : "processes" (default: all local cores), "serial", "threads", or a
         ``dask.distributed.Client`` (a real cluster, or a ``LocalCluster``)
     workers : int, optional
         Local worker count (default: all cores).
     progress : bool, optional
-        tqdm bar over runs; by default on in a terminal or a notebook, off otherwise.
+        tqdm bar over all runs; by default on in a terminal or a notebook, off otherwise.
     keep_runs : bool
         Keep every run's arrays (default), or only reduce them to means as they arrive.
+        Either way at most 2 runs per worker (local worker or Dask thread) are submitted
+        ahead of the earliest unfinished run, so results waiting to be reduced in run
+        order stay few.
     quantities : for EDMD, which of ``EDMD_QUANTITIES`` to collect.
 
-    Failed runs (e.g. inelastic collapse) are listed in ``.failures`` with their seeds and
-    do not lose the others.
+    Returns
+    -------
+    EnsembleResult, or for a sweep a list of them, one per point in order.
+
+    Failed runs (e.g. inelastic collapse) are listed in their point's ``.failures`` with
+    their seeds and do not lose the others.
     """
     runs = int(runs)
     if runs < 1:
         raise ValueError(f"runs must be >= 1, got {runs}")
-    root = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
-    seeds = root.spawn(runs)
-    if not (isinstance(model, Scene) or callable(model)):
-        raise TypeError(f"model must be a Scene or a function of seed, got {type(model).__name__}")
+    sweep = isinstance(model, (list, tuple))
+    models = list(model) if sweep else [model]
+    if not models:
+        raise ValueError("a sweep needs at least one model")
+    for m in models:
+        if not (isinstance(m, Scene) or callable(m)):
+            raise TypeError("model must be a Scene, a function of seed or a list of these, "
+                            f"got {type(m).__name__}")
     bad = set(quantities) - set(EDMD_QUANTITIES)
     if bad:
         raise ValueError(f"unknown quantities {sorted(bad)}; choose from {EDMD_QUANTITIES}")
-    task = _Task(model, run_kwargs, tuple(quantities))
-    if workers is None:
-        workers = os.cpu_count() or 1
-
-    acc = _Accumulator()
-    kept = {} if keep_runs else None
-    failures = []
-    bar = None
-    if progress if progress is not None else _auto_progress():
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=runs, unit="run")
-    try:
-        pending = {}
-        next_index = 0
-        # reduce in run order, whatever order runs finish in, so that means are
-        # bit-identical across backends
-        for index, status, payload in _results(task, seeds, backend, workers):
-            pending[index] = (status, payload)
-            while next_index in pending:
-                st, pl = pending.pop(next_index)
-                if st == "ok":
-                    acc.add(pl)
-                    if kept is not None:
-                        kept[next_index] = pl
-                else:
-                    s = seeds[next_index]
-                    failures.append(RunFailure(next_index, {"entropy": s.entropy, "spawn_key": s.spawn_key},
-                                               pl[0], pl[2]))
-                next_index += 1
-            if bar is not None:
-                bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
-    mean, error = acc.result()
-    times = mean.pop("times", None)
-    error.pop("times", None)
-    runs_list = [kept[i] for i in sorted(kept)] if kept is not None else []
-    return EnsembleResult(runs_list, mean, error, acc.count, failures, times)
+    seeds = _seeds(seed, runs, len(models) if sweep else None)
+    tasks = [_Task(m, run_kwargs, tuple(quantities)) for m in models]
+    # call index p * runs + r: run r of point p, the order in which runs are reduced
+    calls = [(task, p * runs + r, s)
+             for p, task in enumerate(tasks) for r, s in enumerate(seeds[p])]
+    reducers = [_PointReducer(point_seeds, keep_runs) for point_seeds in seeds]
+    with _progress_bar(len(calls), progress) as bar:
+        _reduce_in_order(_results(calls, backend, workers or os.cpu_count() or 1),
+                         reducers, runs, bar)
+    results = [r.result() for r in reducers]
+    return results if sweep else results[0]

@@ -1,7 +1,8 @@
 """Ensembles: identical results on every backend, independent runs, 1/sqrt(K) errors,
-failures reported without losing the other runs."""
+failures reported without losing the other runs, sweeps in one call, bounded memory."""
 import functools
 import math
+import weakref
 
 import numpy as np
 import pytest
@@ -16,13 +17,31 @@ RUN = dict(t_stop=1.0, sample_times=np.linspace(0.0, 1.0, 6))
 
 @pytest.fixture(scope="module")
 def dask_client():
+    """Worker processes, so that tasks and results really travel pickled through Dask."""
     distributed = pytest.importorskip("distributed")
-    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                                       dashboard_address=None)
-    client = distributed.Client(cluster)
-    yield client
-    client.close()
-    cluster.close()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        yield client
+
+
+class CountingClient:
+    """A Dask client that records how many of the futures it handed out are alive at once
+    (a live future keeps its result on the cluster)."""
+
+    def __init__(self, client):
+        self._client = client
+        self._live = weakref.WeakSet()
+        self.peak = 0
+
+    def submit(self, *args, **kwargs):
+        future = self._client.submit(*args, **kwargs)
+        self._live.add(future)
+        self.peak = max(self.peak, len(self._live))
+        return future
+
+    def __getattr__(self, name):
+        return getattr(self._client, name)
 
 
 def test_same_seed_same_results_on_every_backend(dask_client):
@@ -74,6 +93,40 @@ def test_failing_run_is_reported_and_the_others_returned():
     assert "InelasticCollapseError" in fail.error and "collapse in run 2" in fail.traceback
 
 
+def test_run_r_uses_child_r_of_the_seed():
+    res = granular.ensemble(ensemble_tasks.gaussian, 3, seed=5, backend="serial")
+    for run, child in zip(res.runs, np.random.SeedSequence(5).spawn(3)):
+        np.testing.assert_array_equal(run["x"], ensemble_tasks.gaussian(child)["x"])
+
+
+def test_a_sweep_gives_each_point_as_run_alone_with_its_child_seed():
+    points = [Scene.random(100, 0.03, restitution=1.0, seed=1),
+              functools.partial(Scene.random, 100, 0.03, restitution=0.8)]
+    kw = dict(quantities=("temperature", "pair_collisions"), **RUN)
+    sweep = granular.ensemble(points, 3, seed=11, backend="processes", workers=2, **kw)
+    assert isinstance(sweep, list) and len(sweep) == 2
+    for point, child, res in zip(points, np.random.SeedSequence(11).spawn(2), sweep):
+        alone = granular.ensemble(point, 3, seed=child, backend="serial", **kw)
+        assert res.count == alone.count == 3 and not res.failures
+        for a, b in zip(alone.runs, res.runs):
+            for k in a:
+                np.testing.assert_array_equal(a[k], b[k])
+        for k in alone.mean:
+            np.testing.assert_array_equal(alone.mean[k], res.mean[k])
+            np.testing.assert_array_equal(alone.error[k], res.error[k])
+    elastic, inelastic = (res.mean["temperature"] for res in sweep)
+    np.testing.assert_allclose(elastic, elastic[0], rtol=1e-9)
+    assert inelastic[-1] < 0.99 * inelastic[0]
+
+
+def test_a_sweep_reports_failures_per_point_with_their_seeds():
+    ok, failing = granular.ensemble([ensemble_tasks.gaussian, ensemble_tasks.fails_for_run_2],
+                                    4, seed=3, backend="threads", workers=2)
+    assert ok.count == 4 and not ok.failures
+    (fail,) = failing.failures
+    assert failing.count == 3 and fail.index == 2 and fail.seed["spawn_key"] == (1, 2)
+
+
 def test_reducing_as_runs_arrive_gives_the_same_means():
     kw = dict(runs=6, seed=5, backend="serial")
     full = granular.ensemble(ensemble_tasks.gaussian, **kw)
@@ -88,11 +141,43 @@ def test_reducing_as_runs_arrive_gives_the_same_means():
 def test_bad_arguments():
     with pytest.raises(ValueError, match="runs must be"):
         granular.ensemble(ensemble_tasks.gaussian, 0)
-    with pytest.raises(TypeError, match="Scene or a function"):
+    with pytest.raises(TypeError, match="a Scene, a function of seed"):
         granular.ensemble(42, 2)
+    with pytest.raises(TypeError, match="a Scene, a function of seed"):
+        granular.ensemble([ensemble_tasks.gaussian, 42], 2)
+    with pytest.raises(ValueError, match="at least one model"):
+        granular.ensemble([], 2)
     with pytest.raises(ValueError, match="unknown quantities"):
         granular.ensemble(ensemble_tasks.small_gas, 2, quantities=("colour",), **RUN)
     with pytest.raises(ValueError, match="backend must be"):
         granular.ensemble(ensemble_tasks.gaussian, 2, backend="gpu")
     res = granular.ensemble(ensemble_tasks.gaussian, 2, backend="serial", t_stop=1.0)
     assert res.count == 0 and "apply to EDMD scenes only" in res.failures[0].error
+
+
+def test_finished_runs_are_not_kept_when_only_means_are_asked_for():
+    """40 runs on 2 threads: submitting them all at once keeps most of the 40 results alive
+    (in their futures, or waiting for an earlier run to be reduced).  The window, 2 per
+    worker, lets at most 4 runs be submitted and not yet reduced; the last one reduced is
+    referenced until the next result arrives: 5 at most."""
+    ensemble_tasks.reset_tracking()
+    lean = granular.ensemble(ensemble_tasks.tracked_result, 40, seed=9, backend="threads",
+                             workers=2, keep_runs=False)
+    assert lean.runs == [] and lean.count == 40
+    assert ensemble_tasks.peak_live_results <= 4 + 1
+    serial = granular.ensemble(ensemble_tasks.tracked_result, 40, seed=9, backend="serial")
+    np.testing.assert_array_equal(lean.mean["x"], serial.mean["x"])
+    np.testing.assert_array_equal(lean.error["x"], serial.error["x"])
+
+
+def test_dask_submission_is_windowed(dask_client):
+    """2 worker threads: at most 2 x 2 futures alive at once, never all 24 of the sweep."""
+    client = CountingClient(dask_client)
+    models = [ensemble_tasks.gaussian, ensemble_tasks.gaussian]
+    lean = granular.ensemble(models, 12, seed=4, backend=client, keep_runs=False)
+    assert 1 < client.peak <= 4
+    serial = granular.ensemble(models, 12, seed=4, backend="serial")
+    for a, b in zip(lean, serial):
+        assert a.runs == [] and a.count == 12
+        np.testing.assert_array_equal(a.mean["x"], b.mean["x"])
+        np.testing.assert_array_equal(a.error["x"], b.error["x"])
