@@ -49,10 +49,17 @@ static PyObject *raise_status(int status, const gr_error *e)
         break;
     case GR_ERR_COLLAPSE:
         cls = "InelasticCollapseError";
-        snprintf(msg, sizeof msg,
-                 "inelastic collapse at t = %.17g: particles %lld and %lld collide over and over "
-                 "at one instant (%s); set contact_duration > 0 to use the TC model",
-                 t, (long long)i, (long long)j, what[0] ? what : "events pile up");
+        if (j >= 0)
+            snprintf(msg, sizeof msg,
+                     "inelastic collapse at t = %.17g: particles %lld and %lld collide over and "
+                     "over at one instant (%s); set contact_duration > 0 to use the TC model",
+                     t, (long long)i, (long long)j, what[0] ? what : "events pile up");
+        else
+            snprintf(msg, sizeof msg,
+                     "inelastic collapse at t = %.17g: particle %lld has event after event (with "
+                     "walls, or crossing cells) at one instant (%s); set contact_duration > 0 "
+                     "to use the TC model",
+                     t, (long long)i, what[0] ? what : "events pile up");
         break;
     case GR_ERR_NONFINITE:
         cls = "NonFiniteError";
@@ -309,12 +316,13 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     if (!check_ready(self)) return NULL;
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
-    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:(iii)}", "time", c.t,
+    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii)}", "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
                          (long long)c.crossings, "stale_events", (long long)c.invalid,
                          "tc_elastic_collisions", (long long)c.elastic_tc, "virial", c.virial,
-                         "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic, "cells",
+                         "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic,
+                         "kinetic_time_integral", c.kinetic_time, "cells",
                          c.ncell[0], c.ncell[1], c.ncell[2]);
 }
 

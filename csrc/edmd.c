@@ -81,6 +81,7 @@ struct gr_edmd {
     int64_t same_instant;
     int64_t events, pair, wall, crossings, invalid, elastic_tc;
     double virial, wall_impulse, kinetic;
+    double kinetic_time; /* integral of the total kinetic energy over time, for the pressure */
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are
@@ -108,6 +109,16 @@ struct gr_edmd {
 #else
 #define GR_PREFETCH(p) ((void)(p))
 #endif
+
+/* Move the system clock forward to t, integrating the kinetic energy on the way (it
+ * changes only at collisions, so the integral is exact up to rounding). */
+static inline void set_clock(gr_edmd *s, double t)
+{
+    if (t > s->t) {
+        s->kinetic_time += s->kinetic * (t - s->t);
+        s->t = t;
+    }
+}
 
 static inline double *rec(const gr_edmd *s, int32_t i) { return s->P + (size_t)i * s->stride; }
 
@@ -174,26 +185,37 @@ void gr_edmd_free(gr_edmd *s)
 /* Choose the cell grid: cells at least cell_factor largest diameters wide, and not more
  * cells than a few per particle (a dilute gas in a big box must not allocate a huge
  * empty grid; wider cells are always correct, only slower to scan). */
-static int build_grid(gr_edmd *s, double sigma_max)
+static int build_grid(gr_edmd *s, double sigma_max, gr_error *err)
 {
     const int d = s->dim;
-    double wmin = sigma_max * s->cfg.cell_factor;
-    double cap = 8.0 * (double)s->n + 64.0;
-    for (int iter = 0; iter < 64; iter++) {
-        double total = 1.0;
+    const double wmin = sigma_max * s->cfg.cell_factor;
+    const double cap = 8.0 * (double)s->n + 64.0;
+    double k[3] = {1.0, 1.0, 1.0}, total = 1.0;
+    for (int a = 0; a < d; a++) {
+        k[a] = floor(s->L[a] / wmin); /* cells at least wmin wide */
+        if (!(k[a] >= 1.0)) k[a] = 1.0;
+        if (k[a] > 1e9) k[a] = 1e9;
+        total *= k[a];
+    }
+    /* Fewer, wider cells until the grid fits the cap: each pass shrinks the total by
+     * about total / cap, and k = 1 on every axis always fits. */
+    while (total > cap) {
+        double f = pow(total / cap, 1.0 / d);
+        total = 1.0;
         for (int a = 0; a < d; a++) {
-            double k = floor(s->L[a] / wmin);
-            if (!(k >= 1.0)) k = 1.0;
-            if (k > 1e6) k = 1e6;
-            s->nc[a] = (int)k;
-            total *= k;
+            k[a] = floor(k[a] / f);
+            if (k[a] < 1.0) k[a] = 1.0;
+            total *= k[a];
         }
-        if (total <= cap) break;
-        wmin *= pow(total / cap, 1.0 / d) * 1.0001;
+    }
+    if (total > (double)(INT32_MAX / 2)) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, total, "too many cells for the particle count");
+        return GR_ERR_VALUE;
     }
     s->ncells = 1;
     for (int a = 0; a < 3; a++) {
         if (a >= d) { s->nc[a] = 1; s->w[a] = 1.0; continue; }
+        s->nc[a] = (int)k[a];
         s->w[a] = s->L[a] / s->nc[a];
         s->ncells *= s->nc[a];
     }
@@ -348,7 +370,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         !s->id_of || (n >= GR_REORDER_MIN_N && !s->scratch))
         status = GR_ERR_NOMEM;
     if (status == GR_OK) status = gr_cq_init(&s->queue, n);
-    if (status == GR_OK) status = build_grid(s, sigma_max);
+    if (status == GR_OK) status = build_grid(s, sigma_max, err);
     if (status != GR_OK) {
         gr_edmd_free(s);
         return status;
@@ -497,6 +519,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->elastic_tc = s->elastic_tc;
     c->virial = s->virial;
     c->wall_impulse = s->wall_impulse;
+    c->kinetic_time = s->kinetic_time;
     double k = 0.0;
     for (int32_t i = 0; i < s->n; i++) {
         const double *p = rec(s, i);

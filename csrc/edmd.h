@@ -71,6 +71,7 @@ typedef struct {
     double virial;          /* sum over pair collisions of r_ij . dp_j */
     double wall_impulse;    /* sum over wall collisions of |dp_normal| */
     double kinetic;         /* total kinetic energy now */
+    double kinetic_time;    /* integral over time of the total kinetic energy */
     int ncell[3];           /* cells per axis */
 } gr_edmd_counters;
 

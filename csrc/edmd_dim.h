@@ -448,10 +448,10 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
                smp->times[smp->next] <= t_stop) {
             double ts = smp->times[smp->next];
             FN(write_sample)(s, smp, ts);
-            if (ts > s->t) s->t = ts;
+            set_clock(s, ts);
         }
         if (te > t_stop) {
-            if (t_stop > s->t) s->t = t_stop;
+            set_clock(s, t_stop);
             return GR_STOP_TIME;
         }
         if (te == INFINITY) return GR_STOP_IDLE;
@@ -465,7 +465,7 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
             s->same_instant = 0;
             s->t_prev_event = te;
         }
-        s->t = te;
+        set_clock(s, te);
         s->events++;
         gr_event *e = &s->ev[i];
         {

@@ -8,8 +8,8 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 from . import errors
-from .errors import (GranularError, InelasticCollapseError, NonFiniteError, OutsideBoxError,
-                     OverlapError, UnstableStepError)
+from .errors import (GranularError, InelasticCollapseError, NoProgressError, NonFiniteError,
+                     OutsideBoxError, OverlapError, UnstableStepError)
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
@@ -19,4 +19,5 @@ from . import analysis, langevin, theory
 __version__ = "0.1.0"
 __all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "analysis",
            "langevin", "theory", "errors", "GranularError", "OverlapError",
-           "OutsideBoxError", "InelasticCollapseError", "NonFiniteError", "UnstableStepError"]
+           "OutsideBoxError", "InelasticCollapseError", "NoProgressError", "NonFiniteError",
+           "UnstableStepError"]

@@ -38,3 +38,8 @@ class NonFiniteError(GranularError, FloatingPointError):
 
 class UnstableStepError(GranularError, ValueError):
     """An integrator step is at or past its stability limit (``.value`` is gamma*dt)."""
+
+
+class NoProgressError(GranularError, RuntimeError):
+    """A run without a time limit made no progress towards its stop criterion (no
+    collision in a great many events), so it would never end."""

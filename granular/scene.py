@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
 
@@ -11,6 +12,22 @@ BOUNDARIES = ("periodic", "walls")
 # above a safe fraction of them Scene.random places on a lattice and melts it instead.
 _RSA_LIMIT = {2: 0.40, 3: 0.28}
 _LATTICE_MELT_COLLISIONS = 20.0
+# What the engine holds per particle (record, event, queue entry, cell links, counters,
+# image counters, reorder scratch, cells and buckets), rounded up from edmd.c/calendar.c.
+_ENGINE_BYTES_PER_PARTICLE = 400
+
+
+def _check_memory(need, what):
+    """Refuse, before allocating, anything that would take more than half of this
+    machine's memory (on Linux an allocation that large may 'succeed' and end in the
+    out-of-memory killer instead of an exception)."""
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return
+    if need > 0.5 * total:
+        raise MemoryError(f"{what} needs {need / 2**30:.1f} GiB, more than half of this "
+                          f"machine's {total / 2**30:.1f} GiB")
 
 
 def _box_corners(box, dim):
@@ -28,8 +45,19 @@ def _box_corners(box, dim):
     return lo, hi
 
 
+def _real(value, name):
+    """value as a float64 array, refusing what float64 would silently change: complex
+    numbers (the imaginary part dropped) and non-numbers."""
+    a = np.asarray(value)
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} must be real numbers, got complex")
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must be numbers, got dtype {a.dtype}")
+    return a.astype(np.float64)
+
+
 def _array(value, name, shape):
-    a = np.array(value, dtype=np.float64, order="C", copy=True)
+    a = np.array(_real(value, name), dtype=np.float64, order="C", copy=True)
     if a.shape != shape:
         if a.ndim == 0 and len(shape) == 1:
             a = np.full(shape, float(a))
@@ -69,7 +97,7 @@ class Scene:
     def __init__(self, positions, velocities, radii, masses=1.0, *, box=1.0,
                  boundary="periodic", wall_restitution=1.0, restitution=1.0,
                  contact_duration=0.0):
-        pos = np.asarray(positions, dtype=np.float64)
+        pos = _real(positions, "positions")
         if pos.ndim != 2 or pos.shape[1] not in (2, 3) or pos.shape[0] < 1:
             raise ValueError(f"positions must have shape (N, 2) or (N, 3) with N >= 1, got {pos.shape}")
         n, d = pos.shape
@@ -81,6 +109,10 @@ class Scene:
             raise ValueError(f"radii must be positive (particle {int(np.argmin(self.radii))})")
         if np.any(self.masses <= 0):
             raise ValueError(f"masses must be positive (particle {int(np.argmin(self.masses))})")
+        with np.errstate(over="ignore"):
+            finite_energy = math.isfinite(self.kinetic_energy)
+        if not finite_energy:
+            raise ValueError("the kinetic energy overflows: velocities too large for float64")
         self.lower, self.upper = _box_corners(box, d)
         self.lower.setflags(write=False)
         self.upper.setflags(write=False)
@@ -98,6 +130,7 @@ class Scene:
             raise ValueError(f"contact_duration must be finite and >= 0, got {contact_duration}")
         # The engine's constructor checks the geometry (inside the box, overlaps, a
         # periodic box wide enough) in O(N) through its cell grid.
+        _check_memory(_ENGINE_BYTES_PER_PARTICLE * n, "the event-driven engine's state")
         self._engine()
 
     # -- derived quantities ---------------------------------------------------------
@@ -197,6 +230,8 @@ class Scene:
         """
         if dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim}")
+        if isinstance(n, bool) or int(n) != n:
+            raise ValueError(f"n must be a whole number, got {n!r}")
         n = int(n)
         if n < 1:
             raise ValueError(f"n must be >= 1, got {n}")
@@ -206,6 +241,8 @@ class Scene:
         if not np.all(radii > 0) or not np.all(np.isfinite(radii)):
             raise ValueError("radius must be positive and finite")
         masses = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,)).copy()
+        if not np.all(masses > 0) or not np.all(np.isfinite(masses)):
+            raise ValueError("mass must be positive and finite")
         lo, hi = _box_corners(box, dim)
         if boundary not in BOUNDARIES:
             raise ValueError(f"boundary must be one of {BOUNDARIES}, got {boundary!r}")

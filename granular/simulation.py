@@ -2,12 +2,12 @@
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 
 from . import _core
-from .scene import Scene
+from .errors import GranularError, NoProgressError
+from .scene import Scene, _check_memory
 from .trajectory import Trajectory
 
 _STOP_KEYS = ("collisions_per_particle", "kinetic_energy", "events")
@@ -48,13 +48,15 @@ class Simulation:
     def stats(self):
         """Counters since the start: events, pair_collisions, wall_collisions,
         cell_crossings, stale_events, tc_elastic_collisions, virial, wall_impulse,
-        kinetic_energy, time, cells; and the pressure from the collision virial over the
-        whole simulation (mean kinetic term taken as the current one: exact for a
-        molecular gas)."""
+        kinetic_energy, kinetic_time_integral, time, cells; and the pressure averaged over
+        the whole simulation from the collision virial, P = (2 <E_kin>_t + W / t) / (d V)
+        with the time average <E_kin>_t (exact for a cooling gas too).  Walls add no
+        virial here: for a walled box see ``Trajectory.wall_pressure``."""
         c = self._engine.counters()
         s = self._initial
         if c["time"] > 0:
-            c["pressure"] = (2.0 * c["kinetic_energy"] + c["virial"] / c["time"]) / (s.dim * s.volume)
+            c["pressure"] = ((2.0 * c["kinetic_time_integral"] + c["virial"]) / c["time"]
+                             / (s.dim * s.volume))
         else:
             c["pressure"] = float("nan")
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
@@ -115,18 +117,25 @@ class Simulation:
             raise ValueError(f"t_stop = {t_end} lies before the current time {t_now}")
         cpp = float(crit.get("collisions_per_particle", math.inf))
         kin = float(crit.get("kinetic_energy", -1.0))
+        if math.isnan(cpp) or math.isnan(kin):
+            raise ValueError(f"stop_when criteria must be numbers, got {crit}")
         budget = crit.get("events")
-        if budget is not None and int(budget) < 0:
-            raise ValueError("stop_when['events'] must be >= 0")
+        if budget is not None and (isinstance(budget, bool) or int(budget) != budget or budget < 0):
+            raise ValueError(f"stop_when['events'] must be a whole number >= 0, got {budget!r}")
         budget = math.inf if budget is None else int(budget)
         if t_end == math.inf and cpp == math.inf and kin < 0 and budget == math.inf:
             raise ValueError("run needs a finite t_stop or a stop_when criterion")
+        unbounded = t_end == math.inf and budget == math.inf
+        if unbounded and cpp == math.inf:
+            self._check_energy_reachable(kin)
 
         final_sample = sample_times is None
         if final_sample:
             times = np.array([t_now])
         else:
-            times = np.array(sample_times, dtype=np.float64).reshape(-1)
+            times = np.array(sample_times, dtype=np.float64)
+            if times.ndim != 1:
+                raise ValueError(f"sample_times must be one-dimensional, got shape {times.shape}")
             if not np.all(np.isfinite(times)):
                 raise ValueError("sample_times must be finite")
             if len(times) and times[0] < t_now:
@@ -137,13 +146,17 @@ class Simulation:
                 if times[-1] > t_end + 1e-12 * max(1.0, abs(t_end)):
                     raise ValueError(f"sample_times reach {times[-1]}, past t_stop = {t_end}")
                 times[-1] = t_end  # the same time up to rounding (e.g. from np.logspace)
-        _check_memory(len(times) + final_sample, self._initial.n * self._initial.dim * len(store))
+        count = len(times) + final_sample
+        _check_memory(8.0 * count * self._initial.n * self._initial.dim * len(store),
+                      f"storing {count} samples of {' and '.join(store)} (sample less often, "
+                      f"or run with store=() and keep only the statistics)")
         buf = self._buffers(len(times) + final_sample, store)
 
         # the C loop fills the first len(times) samples; a final one may follow
         views = {k: (None if v is None else v[:len(times)]) for k, v in buf.items()}
         reason, nxt, done = "events", 0, 0
         bar = _progress_bar(progress, t_now, t_end, cpp)
+        stall = _StallGuard(self) if unbounded else None
         try:
             while budget - done > 0:
                 chunk = int(min(_CHUNK, budget - done))
@@ -155,6 +168,13 @@ class Simulation:
                 if code != _core.STOP_BUDGET:
                     reason = _REASONS[code]
                     break
+                if stall is not None:
+                    stall.check(crit)
+        except (GranularError, KeyboardInterrupt) as exc:
+            # keep what was sampled: every sample time up to the engine's clock is written
+            k = int(np.searchsorted(times, self.time, side="right"))
+            exc.trajectory = self._trajectory(times[:k], buf, k, "error")
+            raise
         finally:
             if bar is not None:
                 bar.close()
@@ -163,6 +183,18 @@ class Simulation:
             self._sample_now(buf, nxt)
             nxt += 1
         return self._trajectory(times[:nxt], buf, nxt, reason)
+
+    def _check_energy_reachable(self, target):
+        """Refuse a kinetic-energy stop that can never come, before running forever: with
+        elastic collisions and walls that heat or conserve, the energy never falls."""
+        s = self._initial
+        conserving = s.restitution == 1.0 and (s.boundary == "periodic" or s.wall_restitution >= 1.0)
+        mean = self._engine.counters()["kinetic_energy"] / s.n
+        if conserving and target < mean:
+            raise ValueError(
+                f"stop_when kinetic_energy = {target} can never be reached: the mean kinetic "
+                f"energy is {mean:.6g} and this scene does not lose energy (restitution 1"
+                f"{'' if s.boundary == 'periodic' else ', walls that do not absorb'}); give t_stop")
 
     def _sample_now(self, buf, k):
         """Write the current state as sample k (reads the state, processes no event)."""
@@ -203,18 +235,30 @@ _REASONS = {_core.STOP_TIME: "time", _core.STOP_COLLISIONS: "collisions",
             _core.STOP_BUDGET: "events"}
 
 
-def _check_memory(samples, doubles_per_sample):
-    """Refuse sample buffers larger than half the machine's memory, before allocating."""
-    need = 8.0 * samples * doubles_per_sample
-    try:
-        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return
-    if need > 0.5 * total:
-        raise MemoryError(
-            f"storing {samples} samples of positions/velocities needs {need / 2**30:.1f} GiB, "
-            f"more than half of this machine's {total / 2**30:.1f} GiB; sample less often or "
-            f"run with store=() and keep only the statistics")
+class _StallGuard:
+    """A run with no time limit and no event budget that stops on collisions or energy
+    must not spin forever where no collision can come (a lone particle in a periodic box,
+    particles on parallel lines): after this many events without a single collision it
+    raises.  A gas needs a handful of events (cell crossings) per collision; a very
+    dilute one many more, so the bound is generous."""
+
+    def __init__(self, sim):
+        self.sim = sim
+        self.limit = max(10**7, 1000 * sim._initial.n)
+        c = sim._engine.counters()
+        self.collisions = c["pair_collisions"] + c["wall_collisions"]
+        self.events = c["events"]
+
+    def check(self, criteria):
+        c = self.sim._engine.counters()
+        collisions = c["pair_collisions"] + c["wall_collisions"]
+        if collisions != self.collisions:
+            self.collisions, self.events = collisions, c["events"]
+        elif c["events"] - self.events >= self.limit:
+            raise NoProgressError(
+                f"no collision in {c['events'] - self.events} events (t = {c['time']:.6g}): the "
+                f"stop criteria {criteria} may never be met; give t_stop or stop_when['events']",
+                time=c["time"])
 
 
 class _ProgressBar:

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
+import granular
 from granular import Scene, Simulation
 
 import reference_edmd
@@ -351,3 +352,68 @@ def test_repeated_simulations_do_not_leak():
     for _ in range(200):
         Simulation(s).run(t_stop=0.01, store=())
     assert rss() - before < 20e6
+
+
+def test_unreachable_stops_raise_instead_of_running_forever():
+    """A run with no time limit must end: an energy target below the energy of an
+    elastic gas is refused at once; a collision target that no collision will ever meet
+    (a lone sphere flying through a periodic box) raises NoProgressError after a bounded
+    number of events (10^7, about a second)."""
+    gas = Scene.random(50, 0.02, seed=1)
+    with pytest.raises(ValueError, match="can never be reached"):
+        Simulation(gas).run(stop_when={"kinetic_energy": 0.01})
+    lone = Scene([[0.5, 0.5, 0.5]], [[1.0, 0.3, 0.2]], 0.01)
+    sim = Simulation(lone)
+    with pytest.raises(granular.NoProgressError, match="no collision"):
+        sim.run(stop_when={"collisions_per_particle": 1})
+    assert sim.stats["pair_collisions"] == 0 and sim.stats["cell_crossings"] >= 10**7
+    # with a time limit the same run is fine
+    assert sim.run(t_stop=sim.time + 1.0).stop_reason == "time"
+
+
+def test_bad_stop_and_sample_arguments():
+    sim = Simulation(Scene.random(50, 0.02, seed=1))
+    with pytest.raises(ValueError, match="must be numbers"):
+        sim.run(stop_when={"collisions_per_particle": float("nan")})
+    with pytest.raises(ValueError, match="whole number"):
+        sim.run(stop_when={"events": 1.5})
+    with pytest.raises(ValueError, match="whole number"):
+        sim.run(stop_when={"events": -1})
+    with pytest.raises(ValueError, match="one-dimensional"):
+        sim.run(1.0, sample_times=[[0.0, 0.5], [0.6, 1.0]])
+
+
+@pytest.mark.parametrize("xi", [1.0, 0.7])
+def test_stats_pressure_is_the_time_average(xi):
+    """stats['pressure'] uses the time integral of the kinetic energy kept by the
+    engine.  Against the trajectory's trapezoid over dense samples: the kinetic energy
+    is piecewise constant and (for xi < 1) falls monotonically, so the trapezoid's
+    error is at most (K_0 - K_end) * dt / 2 in the integral; for xi = 1 the two agree
+    to rounding."""
+    s = Scene.random(400, 0.03, restitution=xi, seed=21)
+    sim = Simulation(s)
+    times = np.linspace(0.0, 4.0, 4001)
+    tr = sim.run(t_stop=4.0, sample_times=times, store=())
+    c = sim.stats
+    p_traj = tr.pressure()
+    k = tr.kinetic_energy
+    bound = (k[0] - k[-1]) * (times[1] - times[0]) / 2  # error of the kinetic integral
+    dp = 2.0 * bound / times[-1] / (s.dim * s.volume)
+    assert abs(c["pressure"] - p_traj) <= dp + 1e-12 * p_traj
+    if xi < 1:  # the current kinetic energy (the old formula) would be far off
+        p_now = (2 * c["kinetic_energy"] + c["virial"] / c["time"]) / (s.dim * s.volume)
+        assert abs(p_now - p_traj) > 100 * (dp + 1e-12 * p_traj)
+
+
+def test_collapse_keeps_the_samples_taken_before_it():
+    """The error carries the trajectory up to the collapse: three disks in a line with
+    xi below 7 - 4 sqrt 3 collapse at t = 0.1 (tests/test_scene.py)."""
+    s = Scene([[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]], [[1, 0], [0, 0], [-1, 0]], 0.05,
+              boundary="walls", restitution=0.05)
+    times = np.linspace(0.0, 10.0, 1001)
+    with pytest.raises(granular.InelasticCollapseError) as info:
+        Simulation(s).run(t_stop=10.0, sample_times=times)
+    tr = info.value.trajectory
+    assert tr.stop_reason == "error"
+    assert 0 < len(tr.times) < len(times) and tr.times[-1] <= info.value.time
+    np.testing.assert_array_equal(tr.positions[0], s.positions)
