@@ -26,6 +26,11 @@ def test_failure_maps_pin_each_failure_mode():
     assert plain[(0.1, 0.9)]["status"] in ("ok", "tc")
     assert all(c["status"] != "collapse" for c in tc)  # the TC model lets every run finish
     assert all(c["seconds"] < 60 for c in cells)  # bounded work, never a hang
+    # a run stopped by the event budget is neither ok nor tc: it did not reach its goal.
+    # 4000 events per particle suffice for every cell here; 10 suffice for none
+    assert "budget" not in {c["status"] for c in cells}
+    starved = speed_accuracy.collapse_map(quick=True, contact_durations=(1e-4,), events_per_particle=10)
+    assert {c["status"] for c in starved} == {"budget"}
 
 
 def test_speed_accuracy_cli_quick(tmp_path):
@@ -40,6 +45,12 @@ def test_speed_accuracy_cli_quick(tmp_path):
     assert {p["gas"] for p in data["points"]} == {"granular", "molecular"}
     for p in data["points"]:
         assert p["seconds"] > 0 and np.isfinite(p["msd_error"]) and np.isfinite(p["slope_error"])
+    # per gas: Euler-Maruyama up to gamma0 dt = 1.9, just short of its limit; the exact
+    # scheme at the same steps and past the limit
+    for gas in ("granular", "molecular"):
+        em, exact = ({round(p["gamma_dt"], 6) for p in data["points"] if p["gas"] == gas and p["method"] == m}
+                     for m in ("em", "exact"))
+        assert max(em) == 1.9 and em < exact and max(exact) > 2
     for name in ("speed_accuracy.png", "em_stability.png", "collapse_map.png", "dense_cost.png"):
         assert (tmp_path / name).stat().st_size > 5000
     dense = data["dense_cost"]
