@@ -137,13 +137,13 @@ static int EDMD_init(EDMDObject *self, PyObject *args, PyObject *kw)
 {
     static char *names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                             "periodic", "wall_restitution", "restitution",
-                            "contact_duration", "cell_factor", NULL};
+                            "contact_duration", "cell_factor", "big_ratio", NULL};
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi;
     int periodic;
-    double wall_e, xi, tc, cell_factor;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpdddd", names, &opos, &ovel, &orad,
+    double wall_e, xi, tc, cell_factor, big_ratio = 3.0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpdddd|d", names, &opos, &ovel, &orad,
                                      &omass, &olo, &ohi, &periodic, &wall_e, &xi, &tc,
-                                     &cell_factor))
+                                     &cell_factor, &big_ratio))
         return -1;
     if (self->sim) {
         PyErr_SetString(PyExc_RuntimeError, "EDMD is already initialised");
@@ -178,6 +178,7 @@ static int EDMD_init(EDMDObject *self, PyObject *args, PyObject *kw)
     cfg.restitution = xi;
     cfg.contact_duration = tc;
     cfg.cell_factor = cell_factor;
+    cfg.big_ratio = big_ratio;
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
     int status;
     Py_BEGIN_ALLOW_THREADS

@@ -17,8 +17,14 @@
  *  - at large N what remains is memory latency: particles are renumbered in cell order
  *    now and then (reorder), the next event's particle and a pair's partner are
  *    prefetched, and the big arrays sit on huge pages where the OS offers them.
- * Invariant: for every pair of particles in adjacent cells, the earliest collision on
- * their current straight lines is no earlier than the queue key of one of the two. */
+ *  - a few particles much larger than the rest (a tracer) would make every cell as wide
+ *    as they are and every scan O(N); instead they stay out of the grid's lists: each
+ *    small particle's scan also checks every big one, and a big one scans the block of
+ *    cells within its reach, R = ceil((r_big + r_small_max) / w) cells each way, and on
+ *    crossing a cell wall the newly reached layer of that block.
+ * Invariant: for every pair of particles within reach (adjacent cells; a big particle's
+ * block), the earliest collision on their current straight lines is no earlier than the
+ * queue key of one of the two. */
 #define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
 #define _POSIX_C_SOURCE 200112L /* posix_memalign */
 #include <math.h>
@@ -29,6 +35,9 @@
 #include "edmd.h"
 #include "hugemem.h"
 #include "calendar.h"
+
+/* Every small particle's scan checks every big one, so only a few may be big. */
+#define GR_BIG_MAX 16
 
 typedef struct {
     double t_coll;   /* predicted pair or wall collision, +inf if none */
@@ -53,6 +62,10 @@ struct gr_edmd {
     gr_event *ev;
     gr_cq queue;
     int32_t *id_of;   /* the caller's index of each internal particle (see reorder) */
+    uint8_t *is_big;  /* 1 for a particle kept out of the cell lists */
+    int32_t n_big;
+    int32_t big[GR_BIG_MAX]; /* the big particles' internal indices */
+    double r_small;   /* largest radius among the particles in the cell lists */
     void *scratch;    /* n * stride doubles, for reordering */
     int64_t next_reorder;
 
@@ -168,6 +181,7 @@ void gr_edmd_free(gr_edmd *s)
     free(s->image);
     free(s->ev);
     free(s->id_of);
+    free(s->is_big);
     free(s->scratch);
     gr_cq_free(&s->queue);
     free(s->cc);
@@ -182,17 +196,24 @@ void gr_edmd_free(gr_edmd *s)
     free(s);
 }
 
-/* Choose the cell grid: cells at least cell_factor largest diameters wide, and not more
- * cells than a few per particle (a dilute gas in a big box must not allocate a huge
- * empty grid; wider cells are always correct, only slower to scan). */
-static int build_grid(gr_edmd *s, double sigma_max, gr_error *err)
+static int cmp_radius(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Cells per axis: at least cell_factor * sigma wide, and not more cells than a few per
+ * particle (a dilute gas in a big box must not allocate a huge empty grid; wider cells
+ * are always correct, only slower to scan). */
+static double grid_dims(const gr_edmd *s, double sigma, double k[3])
 {
     const int d = s->dim;
-    const double wmin = sigma_max * s->cfg.cell_factor;
+    const double wmin = sigma * s->cfg.cell_factor;
     const double cap = 8.0 * (double)s->n + 64.0;
-    double k[3] = {1.0, 1.0, 1.0}, total = 1.0;
+    double total = 1.0;
+    k[0] = k[1] = k[2] = 1.0;
     for (int a = 0; a < d; a++) {
-        k[a] = floor(s->L[a] / wmin); /* cells at least wmin wide */
+        k[a] = floor(s->L[a] / wmin);
         if (!(k[a] >= 1.0)) k[a] = 1.0;
         if (k[a] > 1e9) k[a] = 1e9;
         total *= k[a];
@@ -208,6 +229,56 @@ static int build_grid(gr_edmd *s, double sigma_max, gr_error *err)
             total *= k[a];
         }
     }
+    return total;
+}
+
+/* Which particles stay out of the grid: those wider than big_ratio times the median
+ * diameter, if there are at most GR_BIG_MAX of them and the grid of the others is fine
+ * enough that a big particle's block of 2 R + 1 cells, plus a cell, is less than the box
+ * on every axis: a periodic block then never meets itself, and any particle in it is
+ * less than half a box away, so the nearest image is the one within reach.
+ * Sets is_big, big, n_big and r_small.  Returns 0 or GR_ERR_NOMEM. */
+static int choose_big(gr_edmd *s, const double *radius)
+{
+    const int32_t n = s->n;
+    double rmax = 0.0;
+    for (int32_t i = 0; i < n; i++) rmax = radius[i] > rmax ? radius[i] : rmax;
+    s->r_small = rmax;
+    s->n_big = 0;
+    if (!(s->cfg.big_ratio < INFINITY) || n < 2) return GR_OK;
+    double *sorted = malloc((size_t)n * sizeof *sorted);
+    if (!sorted) return GR_ERR_NOMEM;
+    memcpy(sorted, radius, (size_t)n * sizeof *sorted);
+    qsort(sorted, (size_t)n, sizeof *sorted, cmp_radius);
+    const double cut = s->cfg.big_ratio * sorted[n / 2];
+    int32_t count = 0;
+    double r_small = 0.0;
+    for (int32_t i = 0; i < n; i++) {
+        if (sorted[i] > cut) count++;
+        else r_small = sorted[i];
+    }
+    free(sorted);
+    if (count == 0 || count > GR_BIG_MAX) return GR_OK;
+    double k[3];
+    grid_dims(s, 2.0 * r_small, k);
+    for (int a = 0; a < s->dim; a++) {
+        double reach = ceil((rmax + r_small) / (s->L[a] / k[a]));
+        if (!(2.0 * reach + 3.0 <= k[a])) return GR_OK;
+    }
+    for (int32_t i = 0; i < n; i++)
+        if (radius[i] > cut) {
+            s->is_big[i] = 1;
+            s->big[s->n_big++] = i;
+        }
+    s->r_small = r_small;
+    return GR_OK;
+}
+
+static int build_grid(gr_edmd *s, double sigma_max, gr_error *err)
+{
+    const int d = s->dim;
+    double k[3];
+    double total = grid_dims(s, sigma_max, k);
     if (total > (double)(INT32_MAX / 2)) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, total, "too many cells for the particle count");
         return GR_ERR_VALUE;
@@ -287,6 +358,10 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
                      "contact duration must be finite and >= 0");
         return GR_ERR_VALUE;
     }
+    if (!(cfg->big_ratio >= 1.0)) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->big_ratio, "big_ratio must be >= 1 (inf: none)");
+        return GR_ERR_VALUE;
+    }
     if (!(cfg->cell_factor >= 1.0 && isfinite(cfg->cell_factor))) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->cell_factor,
                      "cell_factor must be >= 1");
@@ -364,13 +439,15 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->next = gr_big_alloc((size_t)n * sizeof *s->next);
     s->prev = gr_big_alloc((size_t)n * sizeof *s->prev);
     s->id_of = malloc((size_t)n * sizeof *s->id_of);
+    s->is_big = calloc((size_t)n, sizeof *s->is_big);
     if (n >= GR_REORDER_MIN_N) s->scratch = malloc((size_t)n * s->stride * sizeof(double));
     int status = GR_OK;
     if (!s->P || !s->mass || !s->count || !s->image || !s->ev || !s->cc || !s->next || !s->prev ||
-        !s->id_of || (n >= GR_REORDER_MIN_N && !s->scratch))
+        !s->id_of || !s->is_big || (n >= GR_REORDER_MIN_N && !s->scratch))
         status = GR_ERR_NOMEM;
     if (status == GR_OK) status = gr_cq_init(&s->queue, n);
-    if (status == GR_OK) status = build_grid(s, sigma_max, err);
+    if (status == GR_OK) status = choose_big(s, radius);
+    if (status == GR_OK) status = build_grid(s, 2.0 * s->r_small, err);
     if (status != GR_OK) {
         gr_edmd_free(s);
         return status;
@@ -449,7 +526,9 @@ static int reorder(gr_edmd *s)
     PERMUTE(s->image, int64_t, (size_t)d);
     PERMUTE(s->cc, int32_t, (size_t)d);
     PERMUTE(s->id_of, int32_t, 1);
+    PERMUTE(s->is_big, uint8_t, 1);
 #undef PERMUTE
+    for (int32_t b = 0; b < s->n_big; b++) s->big[b] = newpos[s->big[b]];
     /* gr_event is larger than a record in 2D; permute it through the event array itself
      * by cycles would be slower to read; use the scratch in two halves if needed. */
     {
@@ -473,6 +552,7 @@ static int reorder(gr_edmd *s)
     for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;
     memset(s->occ, 0, ((size_t)s->ncells + 63) / 64 * sizeof *s->occ);
     for (int32_t i = n - 1; i >= 0; i--) { /* lists in increasing index order */
+        if (s->is_big[i]) continue;
         int32_t c = 0;
         for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->cc[(size_t)i * d + a];
         cell_insert(s, i, c);

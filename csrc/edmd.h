@@ -33,7 +33,10 @@ typedef struct {
     double wall_restitution;  /* walls: v' = e_w * (v reflected) (thesis 2.22); > 0 */
     double restitution;       /* xi in [0, 1] for pair collisions */
     double contact_duration;  /* TC model t_c >= 0; 0 turns it off */
-    double cell_factor;       /* cell width / largest diameter, >= 1 (speed knob) */
+    double cell_factor;       /* cell width / largest diameter in the grid, >= 1 (speed knob) */
+    double big_ratio;         /* particles more than this times the median diameter wide
+                               * (at most GR_BIG_MAX of them) stay out of the cell grid
+                               * (>= 1; +inf: none) -- a speed knob, see edmd.c */
 } gr_edmd_config;
 
 typedef struct {

@@ -84,6 +84,15 @@ static inline void FN(move)(double *p, double t)
     T(p) = t;
 }
 
+/* A pair that collided with each other at this very instant cannot approach again in
+ * exact arithmetic (the normal relative velocity became -xi times the old one); any
+ * approach left is rounding, e.g. after xi = 0. */
+static inline int FN(rebound_now)(const gr_edmd *s, int32_t i, int32_t j, double t, double dt)
+{
+    return dt == 0.0 && s->ev[i].last == j && s->ev[j].last == i && s->ev[i].t_last == t &&
+           s->ev[j].t_last == t;
+}
+
 /* Pair collisions of i (record p, clock at t) with the particles of one cell, seen
  * through an image shift (NULL: none); keeps the earliest in *best / *partner.  `best` is
  * relative to t and is also the horizon for the early exit in gr_pair_beats. */
@@ -102,14 +111,72 @@ static inline void FN(scan_cell)(const gr_edmd *s, int32_t i, const double *p, i
         }
         double dt;
         if (!gr_pair_beats(DIM, dr, dv, ri + R(q), *best, &dt)) continue;
-        /* A pair that collided with each other at this very instant cannot approach
-         * again in exact arithmetic (the normal relative velocity became -xi times the
-         * old one); any approach left is rounding, e.g. after xi = 0. */
-        if (dt == 0.0 && s->ev[i].last == j && s->ev[j].last == i && s->ev[i].t_last == t &&
-            s->ev[j].t_last == t)
-            continue;
+        if (FN(rebound_now)(s, i, j, t, dt)) continue;
         *best = dt;
         *partner = j;
+    }
+}
+
+/* The pair (i, j), j seen through the nearest periodic image (the one that touches:
+ * contact distances are below half the box), for scans that involve a big particle. */
+static inline void FN(scan_one)(const gr_edmd *s, int32_t i, const double *p, int32_t j,
+                                double *best, int32_t *partner)
+{
+    if (j == i) return;
+    const double *q = rec(s, j);
+    double dtj = T(p) - T(q), dr[DIM], dv[DIM];
+    for (int a = 0; a < DIM; a++) {
+        dr[a] = X(q)[a] + V(q)[a] * dtj - X(p)[a];
+        if (s->cfg.periodic) {
+            if (dr[a] > 0.5 * s->L[a]) dr[a] -= s->L[a];
+            else if (dr[a] < -0.5 * s->L[a]) dr[a] += s->L[a];
+        }
+        dv[a] = V(q)[a] - V(p)[a];
+    }
+    double dt;
+    if (!gr_pair_beats(DIM, dr, dv, R(p) + R(q), *best, &dt)) return;
+    if (FN(rebound_now)(s, i, j, T(p), dt)) return;
+    *best = dt;
+    *partner = j;
+}
+
+/* The cells within reach of big particle i (clock at t): the block of R cells each way
+ * (axis < 0), or the layer of it newly reached after crossing along `axis` in direction
+ * `dir`.  choose_big() keeps the block narrower than the box, so a periodic block never
+ * meets itself. */
+static void FN(scan_block)(const gr_edmd *s, int32_t i, int axis, int dir, double *best,
+                           int32_t *partner)
+{
+    const double *p = rec(s, i);
+    const int32_t *c = s->cc + (size_t)i * DIM;
+    int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int a = 0; a < DIM; a++) {
+        int32_t reach = (int32_t)ceil((R(p) + s->r_small) / s->w[a]);
+        lo[a] = a == axis ? c[a] + dir * reach : c[a] - reach;
+        hi[a] = a == axis ? lo[a] : c[a] + reach;
+        if (!s->cfg.periodic) {
+            if (lo[a] < 0) lo[a] = 0;
+            if (hi[a] > s->nc[a] - 1) hi[a] = s->nc[a] - 1;
+            if (lo[a] > hi[a]) return; /* the layer lies beyond a wall */
+        }
+    }
+    int32_t q[3] = {0, 0, 0};
+    for (int32_t k2 = lo[DIM - 1]; k2 <= hi[DIM - 1]; k2++) {
+        q[DIM - 1] = (k2 % s->nc[DIM - 1] + s->nc[DIM - 1]) % s->nc[DIM - 1];
+#if DIM == 3
+        for (int32_t k1 = lo[1]; k1 <= hi[1]; k1++) {
+            q[1] = (k1 % s->nc[1] + s->nc[1]) % s->nc[1];
+#else
+        {
+#endif
+            for (int32_t k0 = lo[0]; k0 <= hi[0]; k0++) {
+                q[0] = (k0 % s->nc[0] + s->nc[0]) % s->nc[0];
+                int32_t cell = FN(cell_of)(s, q);
+                if (!cell_occupied(s, cell)) continue;
+                for (int32_t j = s->head[cell]; j >= 0; j = s->next[j])
+                    FN(scan_one)(s, i, p, j, best, partner);
+            }
+        }
     }
 }
 
@@ -125,7 +192,9 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
     int32_t partner = -1;
     int interior = 1;
     for (int a = 0; a < DIM; a++) interior &= (c[a] >= 1) & (c[a] <= s->nc[a] - 2);
-    if (interior) {
+    if (s->n_big && s->is_big[i]) {
+        FN(scan_block)(s, i, axis, dir, &best, &partner);
+    } else if (interior) {
         const int32_t base = FN(cell_of)(s, c);
         const int32_t *off = axis < 0 ? s->off_all : s->off_layer[2 * axis + (dir > 0)];
         const int count = axis < 0 ? (DIM == 3 ? 27 : 9) : (DIM == 3 ? 9 : 3);
@@ -147,6 +216,7 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
             if (cell_occupied(s, nb[k].cell))
                 FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
     }
+    for (int32_t b = 0; b < s->n_big; b++) FN(scan_one)(s, i, p, s->big[b], &best, &partner);
     if (partner >= 0) {
         e->t_coll = T(p) + best;
         e->partner = partner;
@@ -251,8 +321,10 @@ static int FN(do_cross)(gr_edmd *s, int32_t i, double t)
         s->image[(size_t)i * DIM + a]--;
     }
     c[a] = q;
-    cell_remove(s, i, old);
-    cell_insert(s, i, FN(cell_of)(s, c));
+    if (!s->is_big[i]) {
+        cell_remove(s, i, old);
+        cell_insert(s, i, FN(cell_of)(s, c));
+    }
     s->crossings++;
     FN(predict_cross)(s, i);
     FN(scan)(s, i, a, dir);
@@ -392,7 +464,29 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
             int32_t q = f < 0.0 ? 0 : f >= s->nc[a] ? s->nc[a] - 1 : (int32_t)f;
             c[a] = q;
         }
-        cell_insert(s, i, FN(cell_of)(s, c));
+        if (!s->is_big[i]) cell_insert(s, i, FN(cell_of)(s, c));
+    }
+    /* Overlaps of the big particles with everyone, O(N) each. */
+    for (int32_t b = 0; b < s->n_big; b++) {
+        const int32_t i = s->big[b];
+        const double *p = rec(s, i);
+        for (int32_t j = 0; j < n; j++) {
+            if (j == i || (s->is_big[j] && j < i)) continue;
+            const double *q = rec(s, j);
+            double d2 = 0.0;
+            for (int a = 0; a < DIM; a++) {
+                double d = X(q)[a] - X(p)[a];
+                if (s->cfg.periodic) d -= s->L[a] * nearbyint(d / s->L[a]);
+                d2 += d * d;
+            }
+            double sigma = (R(p) + R(q)) * (1.0 - 1e-10);
+            if (d2 < sigma * sigma) {
+                int32_t lo = i < j ? i : j, hi = i < j ? j : i;
+                gr_error_set(err, GR_ERR_OVERLAP, lo, hi, 0.0, R(p) + R(q) - sqrt(d2),
+                             "in the initial configuration");
+                return GR_ERR_OVERLAP;
+            }
+        }
     }
     /* Overlaps, O(N) through the cells.  Pairs touching to within a relative 1e-10 are
      * accepted (a configuration built at contact rounds either way); if they approach,

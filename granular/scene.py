@@ -196,13 +196,13 @@ class Scene:
                 f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
                 f"temperature={self.temperature:.4g})")
 
-    def _engine(self, cell_factor=1.0):
+    def _engine(self, cell_factor=1.0, big_ratio=3.0):
         from . import _core
 
         return _core.EDMD(self.positions, self.velocities, self.radii, self.masses,
                           self.lower, self.upper, self.boundary == "periodic",
                           self.wall_restitution, self.restitution, self.contact_duration,
-                          float(cell_factor))
+                          float(cell_factor), float(big_ratio))
 
     # -- constructors ---------------------------------------------------------------
     @classmethod
@@ -305,16 +305,26 @@ def _draw_velocities(rng, n, dim, masses, speed, temperature, remove_drift):
 
 
 def _place_rsa(rng, radii, lo, hi, periodic, max_rounds=200):
-    """Random sequential addition in batches, with a k-d tree for the neighbour search.
-    Returns None if it does not finish (too dense)."""
+    """Random sequential addition in batches, with k-d trees for the neighbour search.
+    Returns None if it does not finish (too dense).
+
+    A few particles much larger than the rest (a tracer) would make every neighbour
+    query as wide as they are; they are checked against everyone directly instead, and
+    the trees reach only as far as two of the others can touch."""
     from scipy.spatial import cKDTree
 
     n, dim = len(radii), len(lo)
     L = hi - lo
-    rmax = float(radii.max())
+    is_big = radii > 3.0 * np.median(radii)
+    if is_big.sum() > 16:
+        is_big[:] = False
+    r_small = float(radii[~is_big].max())
     order = np.argsort(-radii, kind="stable")  # big ones first: they are the hard ones
     placed = np.empty((0, dim))
     placed_r = np.empty(0)
+    placed_big = np.empty(0, dtype=bool)
+    box = L if periodic else None
+    shift = lambda x: np.mod(x - lo, L) if periodic else x  # noqa: E731
     todo = order
     for _ in range(max_rounds):
         if len(todo) == 0:
@@ -323,22 +333,31 @@ def _place_rsa(rng, radii, lo, hi, periodic, max_rounds=200):
         inset = np.zeros((len(todo), 1)) if periodic else r[:, None]
         cand = lo + inset + rng.random((len(todo), dim)) * (L - 2 * inset)
         ok = np.ones(len(todo), dtype=bool)
-        box = L if periodic else None
-        shift = lambda x: np.mod(x - lo, L) if periodic else x  # noqa: E731
-        if len(placed):
-            tree = cKDTree(shift(placed), boxsize=box)
-            for k, nbrs in enumerate(tree.query_ball_point(shift(cand), r + rmax)):
-                if nbrs:
-                    d = _distance(cand[k], placed[nbrs], L, periodic)
-                    ok[k] = np.all(d >= r[k] + placed_r[nbrs])
+        # against the particles placed before: the big ones directly, the rest by tree
+        small = ~placed_big
+        for b in np.flatnonzero(~small):
+            ok &= _distance(placed[b], cand, L, periodic) >= placed_r[b] + r
+        if small.any():
+            tree = cKDTree(shift(placed[small]), boxsize=box)
+            ps, pr = placed[small], placed_r[small]
+            for k, nbrs in enumerate(tree.query_ball_point(shift(cand), r + r_small)):
+                if nbrs and ok[k]:
+                    ok[k] = np.all(_distance(cand[k], ps[nbrs], L, periodic) >= r[k] + pr[nbrs])
         # among the candidates themselves: the earlier one of a clashing pair wins
+        cand_big = is_big[todo]
+        for a in np.flatnonzero(cand_big):
+            if ok[a]:
+                clash = _distance(cand[a], cand, L, periodic) < r[a] + r
+                clash[:a + 1] = False
+                ok &= ~clash
         tree = cKDTree(shift(cand), boxsize=box)
-        for a, b in sorted(tree.query_pairs(2 * rmax)):
-            if ok[a] and ok[b]:
+        for a, b in sorted(tree.query_pairs(2 * r_small)):
+            if ok[a] and ok[b] and not (cand_big[a] or cand_big[b]):
                 if _distance(cand[a], cand[b][None], L, periodic)[0] < r[a] + r[b]:
                     ok[b] = False
         placed = np.concatenate([placed, cand[ok]])
         placed_r = np.concatenate([placed_r, r[ok]])
+        placed_big = np.concatenate([placed_big, cand_big[ok]])
         todo = todo[~ok]
     if len(todo):
         return None

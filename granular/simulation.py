@@ -28,15 +28,19 @@ class Simulation:
     ----------
     scene : Scene
     cell_factor : float >= 1
-        Cell width in largest diameters (a speed knob; the result does not depend on it
-        beyond rounding).
+        Cell width in largest diameters of the particles in the cell grid (a speed knob;
+        the result does not depend on it beyond rounding).
+    big_ratio : float >= 1
+        Up to 16 particles wider than ``big_ratio`` times the median diameter (a large
+        tracer) stay out of the cell grid, so that they do not make every cell as wide
+        as they are; ``math.inf`` puts everyone in the grid.  A speed knob too.
     """
 
-    def __init__(self, scene, *, cell_factor=1.0):
+    def __init__(self, scene, *, cell_factor=1.0, big_ratio=3.0):
         if not isinstance(scene, Scene):
             raise TypeError(f"Simulation needs a granular.Scene, got {type(scene).__name__}")
         self._initial = scene
-        self._engine = scene._engine(cell_factor)
+        self._engine = scene._engine(cell_factor, big_ratio)
 
     # -- state ----------------------------------------------------------------------
     @property
