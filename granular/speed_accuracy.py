@@ -309,7 +309,7 @@ def _charts(out, points, refs, stab, cells, dense):
     colors = {"ok": "tab:green", "tc": "tab:blue", "budget": "tab:orange", "collapse": "tab:red"}
     for ax, tc in zip(axes[0], tcs):
         for c in (c for c in cells if c["contact_duration"] == tc):
-            ax.scatter(c["eta"], c["xi"], s=300, marker="s", color=colors[c["status"]])
+            ax.scatter(c["eta"], c["xi"], s=700, marker="s", color=colors[c["status"]])
             ax.annotate(c["status"], (c["eta"], c["xi"]), ha="center", va="center", fontsize=6, color="w")
         for status, color in colors.items():
             ax.scatter([], [], s=60, marker="s", color=color, label=status)
