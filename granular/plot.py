@@ -1,11 +1,37 @@
 """Figures: each function draws onto the given axes (or new ones) and returns them.
 
-matplotlib is imported only when a function is called.  Units follow the package:
-lengths in box lengths, k_B = 1 (temperature is energy), mass 1 unless given.
+matplotlib is imported only when a function is called.
+
+Units follow the package (DESIGN.md) and every axis says which it shows:
+
+- ``L``: the length unit of the scene's coordinates -- the box edge in the thesis' unit
+  box;
+- ``m``: the particle mass (1 unless given);
+- ``epsilon``: the energy unit; k_B = 1, so a temperature is an energy in the same unit
+  (``T = 2 <E_kin> / d``);
+- time in the unit those imply, ``L sqrt(m / epsilon)``; speeds in ``sqrt(epsilon / m)``;
+  MSDs in ``L^2``; diffusivities in ``L^2`` per time unit, ``L sqrt(epsilon / m)``.
+
+Ratios and counts are marked dimensionless.
 """
 from __future__ import annotations
 
 import numpy as np
+
+
+# Axis labels with their units (mathtext).
+TIME = r"time $t$ [$L\sqrt{m/\varepsilon}$]"
+LAG_OR_TIME = r"time $t$ or lag $\Delta$ [$L\sqrt{m/\varepsilon}$]"
+ENERGY = r"kinetic energy $E$ [$\varepsilon$]"
+RELATIVE_ENERGY = r"$E(t)/E(0) - 1$ (dimensionless)"
+COLLISIONS = "collisions per particle (dimensionless count)"
+SPEED = r"speed $v$ [$\sqrt{\varepsilon/m}$]"
+SPEED_DENSITY = r"probability density [$\sqrt{m/\varepsilon}$]"
+TEMPERATURE = r"granular temperature $T$ [$\varepsilon$; $k_B = 1$]"
+MSD = r"MSD $\langle |x(t) - x(0)|^2 \rangle$ [$L^2$]"
+MSD_AND_TAMSD = r"MSD, time-averaged MSD [$L^2$]"
+DIFFUSIVITY = r"diffusivity $D(t)$ [$L\sqrt{\varepsilon/m}$]"
+POSITION = r"${}$ [$L$]"
 
 
 def _axes(ax):
@@ -23,8 +49,8 @@ def energy(times, kinetic_energy, ax=None, label=None, relative=True):
     e = np.asarray(kinetic_energy, dtype=np.float64)
     y = e / e[0] - 1 if relative else e
     ax.plot(times, y, label=label)
-    ax.set_xlabel("time t")
-    ax.set_ylabel(r"$E(t)/E(0) - 1$" if relative else "kinetic energy E")
+    ax.set_xlabel(TIME)
+    ax.set_ylabel(RELATIVE_ENERGY if relative else ENERGY)
     if label:
         ax.legend()
     return ax
@@ -34,8 +60,8 @@ def collisions_per_particle(times, collisions, ax=None, label=None):
     """Mean collisions per particle against time (thesis Figs 4.3-4.4)."""
     ax = _axes(ax)
     ax.plot(times, collisions, label=label)
-    ax.set_xlabel("time t")
-    ax.set_ylabel("collisions per particle")
+    ax.set_xlabel(TIME)
+    ax.set_ylabel(COLLISIONS)
     if label:
         ax.legend()
     return ax
@@ -55,8 +81,8 @@ def speed_distribution(velocities, temperature=None, mass=1.0, bins=40, ax=None,
     ax.bar(centres, dens, width=width, alpha=0.5, label=label, yerr=err, ecolor="0.4")
     s = np.linspace(0.0, top, 300)
     ax.plot(s, theory.maxwell_boltzmann_pdf(s, T, mass, dim), "k--", label=f"Maxwell-Boltzmann ({dim}D)")
-    ax.set_xlabel("speed v")
-    ax.set_ylabel("probability density")
+    ax.set_xlabel(SPEED)
+    ax.set_ylabel(SPEED_DENSITY)
     ax.legend()
     return ax
 
@@ -79,8 +105,8 @@ def haff(times, temperature, tau0, temperature0=None, ax=None, label="simulation
             label=rf"Haff, $\tau_0$ = {tau0:.3g}")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time t")
-    ax.set_ylabel("granular temperature T")
+    ax.set_xlabel(TIME)
+    ax.set_ylabel(TEMPERATURE)
     ax.legend()
     return ax
 
@@ -101,8 +127,8 @@ def msd(times, values, error=None, theory_values=None, ax=None, label="simulatio
     if loglog:
         ax.set_xscale("log")
         ax.set_yscale("log")
-    ax.set_xlabel("time t")
-    ax.set_ylabel(r"MSD $\langle |x(t) - x(0)|^2 \rangle$")
+    ax.set_xlabel(TIME)
+    ax.set_ylabel(MSD)
     ax.legend()
     return ax
 
@@ -117,8 +143,8 @@ def diffusivity(times, values, theory_values=None, ax=None, label="simulation"):
         ax.plot(t[keep], np.asarray(theory_values)[keep], "k--", label="theory")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time t")
-    ax.set_ylabel("diffusivity D(t)")
+    ax.set_xlabel(TIME)
+    ax.set_ylabel(DIFFUSIVITY)
     ax.legend()
     return ax
 
@@ -133,8 +159,8 @@ def msd_vs_tamsd(times, msd_values, lags, tamsd_values, ax=None, label=""):
     ax.plot(lags, tamsd_values, "o", ms=3, label=f"time-averaged MSD {label}".strip())
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time t / lag")
-    ax.set_ylabel("MSD")
+    ax.set_xlabel(LAG_OR_TIME)
+    ax.set_ylabel(MSD_AND_TAMSD)
     ax.legend()
     return ax
 
@@ -153,4 +179,6 @@ def snapshot(positions, radii, lower, upper, ax=None, color="C0"):
     ax.set_xlim(lower[0], upper[0])
     ax.set_ylim(lower[1], upper[1])
     ax.set_aspect("equal")
+    ax.set_xlabel(POSITION.format("x"))
+    ax.set_ylabel(POSITION.format("y"))
     return ax

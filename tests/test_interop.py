@@ -1,4 +1,7 @@
-"""MDAnalysis export: its EinsteinMSD agrees with granular's TAMSD; written files read back."""
+"""MDAnalysis export: EinsteinMSD of an exported simulation agrees with granular's TAMSD;
+written files read back."""
+import math
+
 import numpy as np
 import pytest
 
@@ -13,18 +16,41 @@ def walk(T=120, N=40, d=3, seed=0):
     return np.arange(T) * 0.25, x
 
 
-def test_einstein_msd_agrees_with_tamsd():
-    """MDAnalysis' EinsteinMSD (windowed, all lags) is the TAMSD.  Its coordinates are
-    float32: relative rounding 6e-8 per coordinate, so squared displacements of O(1)
-    positions differ by ~1e-7 absolute; tolerance 1e-5 relative for MSDs of O(0.01-1)."""
+def test_einstein_msd_of_an_exported_simulation_agrees_with_tamsd(tmp_path):
+    """An EDMD trajectory (uniform sample times, unwrapped positions) written to TRR by
+    ``interop.write_trajectory`` and read back by MDAnalysis: its EinsteinMSD (windowed,
+    every lag) equals granular's TAMSD of the same trajectory within float32 rounding.
+
+    Rounding bound, u = 2^-24 (float32 unit roundoff): a coordinate x passes three
+    roundings -- to float32, the writer's angstrom -> nm scaling (x 0.1, itself 1.5e-8
+    off in float32), the reader's nm -> angstrom -- so it comes back within
+    eps = 4 u max|x|.  A displacement Delta is then off by at most 2 eps per component,
+    its square by at most 4 eps sum_a |Delta_a| + 3 (2 eps)^2 <= 4 sqrt(3) eps |Delta|
+    + 12 eps^2, and the average over pairs and particles, with <|Delta|> <= sqrt(TAMSD),
+    by at most 4 sqrt(3) eps sqrt(TAMSD) + 12 eps^2.  Everything after reading is float64
+    (MDAnalysis' differences of float32 values are exact; granular's FFT TAMSD of
+    start-relative positions rounds at ~1e-16 relative).  Lag times come from the
+    file's float32 frame times: relative error <= 2 u.  Anything but the rounding -- a
+    lost, reordered or wrapped frame, a wrong time -- is far outside these bounds."""
     from MDAnalysis.analysis.msd import EinsteinMSD
 
-    t, x = walk()
-    u = interop.to_universe(t, x)
+    s = Scene.random(100, 0.02, seed=7)
+    times = np.linspace(0.0, 4.0, 81)  # ~4 collisions per particle: ballistic to collisional
+    tr = Simulation(s).run(t_stop=times[-1], sample_times=times, store=("positions",))
+    path = interop.write_trajectory(tmp_path / "gas.trr", tr.times, tr.positions, box=[1, 1, 1])
+    u = mda.Universe.empty(s.n, trajectory=False)
+    u.load_new(path)
+    assert u.trajectory.n_frames == len(times)
     res = EinsteinMSD(u, select="all", msd_type="xyz", fft=False).run()
-    lags = np.arange(1, len(t))
-    ours = analysis.tamsd(x, lags)
-    np.testing.assert_allclose(res.results.timeseries[1:], ours, rtol=1e-5)
+
+    lags = np.arange(1, len(times))
+    ours = analysis.tamsd(tr.positions, lags)
+    theirs = res.results.timeseries[1:]
+    eps = 4 * 2.0**-24 * np.abs(tr.positions).max()
+    bound = 4 * math.sqrt(3) * eps * np.sqrt(ours) + 12 * eps**2
+    assert np.all(np.abs(theirs - ours) <= bound), np.max(np.abs(theirs - ours) / bound)
+    np.testing.assert_allclose(res.results.delta_t_values[1:], times[lags], rtol=2 * 2.0**-24)
+    assert ours[-1] > 100 * ours[0]  # not a trivial trajectory: it moved
 
 
 def test_universe_of_a_simulation_and_a_written_trr(tmp_path):

@@ -3,6 +3,7 @@
 Tolerances: statistical ones come from the sample sizes (stated at each assert); where an
 approximate theory is the reference (Carnahan-Starling, Henderson, Enskog), its own
 accuracy at that density is the tolerance."""
+import functools
 import math
 
 import numpy as np
@@ -88,6 +89,33 @@ def test_trajectory_pressure_and_enskog_collision_rate():
     assert rate == pytest.approx(enskog, rel=0.015)
 
 
+def test_two_dimensional_enskog_collision_rate():
+    """Hard disks at area fraction 0.3: the collision rate per particle is Enskog's 2D
+    frequency 2 sqrt(pi) g2 sigma n sqrt(T/m) (theory.collision_frequency, dim=2) -- exact
+    in equilibrium given the true contact value, here Henderson's
+    g2 = (1 - 7 eta/16) / (1 - eta)^2.  Its accuracy at eta = 0.3: it differs from the
+    hard-disk virial series through B10 (Clisby & McCoy, J. Stat. Phys. 122, 15 (2006))
+    by 0.06% (the series' truncated tail ~0.02%): margin 0.2%.  Statistics: ~2e5 pair
+    collisions, Poisson relative error 1/sqrt(count) = 0.22% (an upper bound: the count's
+    Fano factor over blocks of the run measures 0.6-0.8, energy being conserved); 5 sigma.
+    Tolerance 0.2% + 5 * 0.22% = 1.3%; measured +0.26%.  A 3D geometry factor or the 3D
+    contact value would be off by tens of percent."""
+    from granular import theory
+
+    n, eta = 2000, 0.3
+    r = radius_for(n, eta, 2)
+    s = Scene.random(n, r, dim=2, temperature=1.0, seed=25)
+    sim = Simulation(s)
+    sim.run(stop_when={"collisions_per_particle": 20}, store=())  # equilibrate positions
+    omega = float(theory.collision_frequency(s.density, r, s.temperature, dim=2))
+    t0 = sim.time
+    span = 200.0 / omega  # 200 collisions per particle, 2e5 pair collisions
+    tr = sim.run(t_stop=t0 + span, sample_times=[t0, t0 + span], store=())
+    count = int(tr.pair_collisions[-1] - tr.pair_collisions[0])
+    rate = 2 * count / (n * span)
+    assert rate == pytest.approx(omega, rel=0.002 + 5 / math.sqrt(count))
+
+
 def test_wall_pressure_equals_the_bulk_pressure_in_a_dilute_box():
     """In a walled box the momentum given to the walls per unit time and per unit of the
     area the centres reach is the bulk pressure n_c T Z, with n_c = N / (L - 2r)^3 and
@@ -103,50 +131,127 @@ def test_wall_pressure_equals_the_bulk_pressure_in_a_dilute_box():
     assert tr.wall_pressure() / (n_c * s.temperature) == pytest.approx(1 + 4 * eta * g2, rel=0.01)
 
 
-def _equilibrated(n, r, seed):
-    sim = Simulation(Scene.random(n, r, seed=seed))
+# -- granular gases: Haff's law and the MSD, against theory over independent runs ---------
+#
+# The thesis' standard gas (N = 1000, r = 0.025 L, eta = 0.065, unit periodic box) in
+# RUNS independent runs.  Each test averages a per-run ratio ours / theory over the runs
+# and takes the run-to-run standard error SE = std(ddof=1) / sqrt(RUNS) (thesis
+# 2.120-2.122) measured from those runs.  The theory is approximate, so the assert is
+#     |mean ratio - 1| <= margin + K SE,
+# i.e. within K sigma of theory * (1 +- margin), with the margin the theory's own
+# systematic accuracy (cited at each test) and K = 4.79 the one-sided 0.1% point of
+# Student's t with RUNS - 1 = 7 degrees of freedom (the SE is itself estimated).
+
+RUNS = 8
+K_SIGMA = float(stats.t.ppf(0.999, RUNS - 1))
+THESIS_N, THESIS_R = 1000, 0.025
+
+# Haff's tau0 (2.45) is Enskog's cooling rate of a Maxwellian gas without velocity
+# correlations; both approximations become exact as xi -> 1 and are O(1 - xi) below it.
+# The thesis' own comparison (section 4.1.3, discussion of Fig. 4.10; N = 1000, eta =
+# 0.065) finds the measured temperature above Haff's, increasingly so as xi falls: at
+# xi = 0.5, t = 1, T ~ 0.1 T0 with an excess ~0.01 -- 10% in T, i.e. tau0 7.3% longer.
+# Per unit of 1 - xi that is 0.146, hence the margin 0.15 (1 - xi) (1.5%, 3%, 7.5% at
+# xi = 0.9, 0.8, 0.5).  Kawahara & Nakanishi (J. Phys. Soc. Jpn. 73, 68 (2004)) find
+# the same sign in large 3D simulations: velocity correlations make the homogeneous
+# cooling state cool more slowly than the independent-collision (Enskog) rate; the
+# Sonine a2 correction of the Maxwellian rate, (1 + 3 a2 / 16) with van Noije-Ernst's
+# a2, is below 1% for xi >= 0.5.
+def haff_margin(xi):
+    return 0.15 * (1.0 - xi)
+
+
+# Enskog's D_E (2.50) for molecular hard spheres at eta = 0.065: correlated collisions
+# make the true self-diffusion larger -- Speedy's fit to the MD data (Mol. Phys. 62, 509
+# (1987)) gives D / D_E = 1.055 there, and the thesis (App. F) measured a long-time
+# slope 0.364 against 6 D0 = 0.350 (+4%) for this very gas; the finite box lowers D by
+# ~3% (Yeh-Hummer hydrodynamic correction with Enskog's viscosity at N = 1000).  Margin
+# 6%.  For xi < 1 the Maxwellian D0 (2.52) carries the same O(1 - xi) approximations as
+# tau0 (the thesis, section 4.2 "Diffusivity", Figs 4.15-4.16: agreement worsening as xi
+# falls): margin 0.06 + haff_margin(xi).
+def diffusion_margin(xi):
+    return 0.06 + haff_margin(xi)
+
+
+@functools.lru_cache(maxsize=None)
+def thesis_gas(k):
+    """Run k of the thesis' standard gas, equilibrated as a molecular gas (20 collisions
+    per particle from fixed speeds sqrt(2): T0 = 2/3).  Scenes are immutable, so the Haff
+    and MSD tests share them."""
+    sim = Simulation(Scene.random(THESIS_N, THESIS_R, seed=[30, k]))
     sim.run(stop_when={"collisions_per_particle": 20}, store=())
     return sim.scene
+
+
+def assert_within_theory(ratios, margin):
+    """mean over runs of ours / theory lies within K_SIGMA run-to-run standard errors of
+    1 +- margin (margin may be an array over times)."""
+    from granular import analysis
+
+    mean, se = analysis.ensemble_mean(np.asarray(ratios))
+    bad = np.abs(mean - 1) > margin + K_SIGMA * se
+    assert not np.any(bad), (
+        f"ours/theory = {np.round(np.atleast_1d(mean)[np.atleast_1d(bad)], 4)} +- "
+        f"{np.round(np.atleast_1d(se)[np.atleast_1d(bad)], 4)} (SE over {RUNS} runs), "
+        f"margin {np.round(np.broadcast_to(margin, np.shape(mean))[bad], 4)}, K = {K_SIGMA:.2f}")
 
 
 @pytest.mark.parametrize("xi", [0.9, 0.8, 0.5])
 def test_granular_gas_cools_by_haffs_law(xi):
     """Homogeneous cooling from an equilibrated molecular gas (thesis 4.1.3, Fig. 4.10):
-    the fitted tau0 agrees with (2.45).  Tolerance 4% for xi >= 0.8 and 10% at xi = 0.5:
-    (2.45) is the Maxwellian (Enskog) value, and the non-Gaussian velocity distribution
-    of the cooling state (Sonine coefficient a2) plus velocity correlations shift it by a
-    few percent, growing with 1 - xi; the fit's own statistical error is below 0.5%."""
+    tau0 fitted to T(t) over 10 tau0 in each of 8 runs against (2.45).  Measured (these
+    seeds): +1.0%, +1.7%, +6.1% at xi = 0.9, 0.8, 0.5 with run-to-run SE 0.23%, 0.30%,
+    0.85%; tolerance haff_margin(xi) + 4.79 SE = 2.6%, 4.4%, 11.6%."""
     from granular import analysis, theory
 
-    n = 2000
-    r = 0.025 * (n / 1000) ** (-1 / 3)  # the thesis' eta = 0.065
-    s = _equilibrated(n, r, seed=31).replace(restitution=xi)
-    c = theory.langevin_coefficients(n, r, 1.0, xi, s.temperature)
-    times = np.linspace(0, 10 * c.tau0, 41)
-    tr = Simulation(s).run(t_stop=times[-1], sample_times=times, store=())
-    tau0, err = analysis.fit_haff_tau0(tr.times, tr.temperature)
-    assert err < 0.005 * tau0
-    assert tau0 == pytest.approx(c.tau0, rel=0.04 if xi >= 0.8 else 0.10)
+    ratios = []
+    for k in range(RUNS):
+        s = thesis_gas(k).replace(restitution=xi)
+        c = theory.langevin_coefficients(s.n, THESIS_R, 1.0, xi, s.temperature)
+        times = np.linspace(0, 10 * c.tau0, 41)
+        tr = Simulation(s).run(t_stop=times[-1], sample_times=times, store=())
+        tau0, _ = analysis.fit_haff_tau0(tr.times, tr.temperature)
+        ratios.append(tau0 / c.tau0)
+    assert_within_theory(ratios, haff_margin(xi))
 
 
-@pytest.mark.parametrize("xi", [1.0, 0.8])
-def test_msd_follows_theory(xi):
-    """Ensemble MSD of the thesis' standard gas (Figs 4.11-4.12) against (2.68)/(2.79)
-    from t = 0.01 to 30: the ballistic start within 2% (statistics of 2000 particles),
-    later within the accuracy of the Enskog-level theory: its D0 underestimates the
-    self-diffusion of hard spheres by ~5% at eta = 0.065 (correlated collisions; the
-    thesis also found its molecular long-time slope 4% above theory, App. F), and for
-    xi = 0.8 the Maxwellian tau0 (3% low, see the Haff test) and velocity correlations
-    that grow with inelasticity add to that: 8% for xi = 1, 15% for xi = 0.8 (we
-    measure +6% and +13% at t = 30)."""
+def msd_margin(times, c, xi):
+    """The theory's systematic margin at each time: the relative errors of D0 and tau0
+    propagated through (2.68)/(2.79) by their logarithmic sensitivities
+    |d ln MSD / d ln D0| (T0 fixed, so gamma0 = T0 / (m D0) moves with it) and
+    |d ln MSD / d ln tau0|.  Zero in the ballistic limit (MSD = 3 T0 t^2 exactly), the
+    full margin of D0 once diffusive."""
     from granular import theory
 
-    n = 2000
-    r = 0.025 * (n / 1000) ** (-1 / 3)
-    s = _equilibrated(n, r, seed=32).replace(restitution=xi)
-    times = np.concatenate([[0.0], np.logspace(-2, np.log10(30.0), 25)])
-    tr = Simulation(s).run(t_stop=30.0, sample_times=times, store=("positions",))
-    c = theory.langevin_coefficients(n, r, 1.0, xi, s.temperature)
-    ratio = tr.msd()[1:] / theory.msd_granular(times[1:], c.D0, c.gamma0, c.tau0)
-    assert np.all(np.abs(ratio[:3] - 1) < 0.02)
-    assert np.all(np.abs(ratio - 1) < (0.08 if xi == 1.0 else 0.15))
+    h = 1e-6
+    base = np.log(theory.msd_granular(times, c.D0, c.gamma0, c.tau0))
+    s_d = (np.log(theory.msd_granular(times, c.D0 * (1 + h), c.gamma0 / (1 + h), c.tau0))
+           - base) / h
+    margin = np.abs(s_d) * diffusion_margin(xi)
+    if xi < 1:
+        s_tau = (np.log(theory.msd_granular(times, c.D0, c.gamma0, c.tau0 * (1 + h))) - base) / h
+        margin = margin + np.abs(s_tau) * haff_margin(xi)
+    return margin
+
+
+@pytest.mark.parametrize("xi,t_stop", [(1.0, 5.0), (0.8, 30.0)])
+def test_msd_follows_theory(xi, t_stop):
+    """Ensemble MSD of the thesis' standard gas (Figs 4.11-4.12) against (2.68)/(2.79) at 25
+    log-spaced times from 0.01 (ballistic) to t_stop (xi = 1: 57 velocity relaxation times
+    1/gamma0, deep in the diffusive regime; xi = 0.8: 31 tau0, the logarithmic regime),
+    in 8 runs.  Tolerance at each time: msd_margin (0.2-0.3% at t = 0.01, nearly
+    ballistic; at t_stop 0.98 * 6% = 5.9% for xi = 1, 0.97 * 9% + 0.74 * 3% = 10.9% for
+    xi = 0.8) plus
+    4.79 run-to-run SE (0.13-0.16% at t = 0.01; 0.8% and 1.6% at t_stop): 0.9-1.1% at
+    t = 0.01, 9.7% and 18.6% at t_stop.  Measured at t_stop (these seeds): +5.4% (xi = 1,
+    D above Enskog's as the margin says), +9.1% (xi = 0.8)."""
+    from granular import theory
+
+    times = np.concatenate([[0.0], np.logspace(-2, np.log10(t_stop), 25)])
+    ratios = []
+    for k in range(RUNS):
+        s = thesis_gas(k).replace(restitution=xi)
+        tr = Simulation(s).run(t_stop=t_stop, sample_times=times, store=("positions",))
+        c = theory.langevin_coefficients(s.n, THESIS_R, 1.0, xi, s.temperature)
+        ratios.append(tr.msd()[1:] / theory.msd_granular(times[1:], c.D0, c.gamma0, c.tau0))
+    assert_within_theory(ratios, msd_margin(times[1:], c, xi))

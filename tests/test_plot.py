@@ -1,4 +1,4 @@
-"""Every plot renders to PNG and returns its axes."""
+"""Every plot renders to PNG, returns its axes and labels its axes with units."""
 import numpy as np
 import pytest
 
@@ -24,6 +24,9 @@ def test_all_plots_render(tmp_path):
     ]
     for k, ax in enumerate(figs):
         assert hasattr(ax, "plot")
+        # labelled units: every axis names its unit (L, m, epsilon, or dimensionless)
+        for label in (ax.get_xlabel(), ax.get_ylabel()):
+            assert "[" in label or "dimensionless" in label, f"plot {k}: no unit in {label!r}"
         ax.figure.savefig(tmp_path / f"f{k}.png")
         assert (tmp_path / f"f{k}.png").stat().st_size > 1000
     fig, ax = plt.subplots()

@@ -100,7 +100,9 @@ def test_contact_value_and_equation_of_state():
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_haff_law_solves_its_cooling_equation(dim):
-    """dT/dt = -(1 - xi^2) omega(T) T / d integrated numerically gives T0 / (1 + t/tau0)^2."""
+    """dT/dt = -(1 - xi^2) omega(T) T / d integrated numerically gives T0 / (1 + t/tau0)^2.
+    This is self-consistency of haff_tau0 with collision_frequency; the 2D frequency itself
+    is checked against EDMD in test_physics_edmd.test_two_dimensional_enskog_collision_rate."""
     n, xi, T0 = 1000.0, 0.7, 0.9
     r = 0.02 if dim == 3 else 0.01
     rhs = lambda t, T: -(1 - xi**2) * theory.collision_frequency(n, r, T, dim=dim) * T / dim
