@@ -1,6 +1,7 @@
 """Scenes: the state a simulation starts from, as a validated value object."""
 from __future__ import annotations
 
+import itertools
 import math
 import os
 
@@ -11,7 +12,17 @@ BOUNDARIES = ("periodic", "walls")
 # Random sequential addition jams near these packing fractions (3D ~0.38, 2D ~0.55);
 # above a safe fraction of them Scene.random places on a lattice and melts it instead.
 _RSA_LIMIT = {2: 0.40, 3: 0.28}
+# The lattice is melted by elastic collisions in blocks of this many per particle until
+# no lattice order is left (at most _LATTICE_MELT_MAX), below the packing fraction where
+# the fluid freezes (hard spheres 0.494, hard disks ~0.70: above it the equilibrium state
+# is not a homogeneous fluid, and a defective lattice is what is left).
 _LATTICE_MELT_COLLISIONS = 20.0
+_LATTICE_MELT_MAX = 1000.0
+_FREEZING = {2: 0.70, 3: 0.494}
+# Lattice order Q (see _lattice_order) below which the melt counts as done: N for the
+# lattice, the mean of S(G) over the stars in a fluid: about 1 (S <= 2.85 below freezing,
+# Hansen-Verlet); 3 leaves residual order well below what tests/test_scene.py detects.
+_MELTED_ORDER = 3.0
 # What the engine holds per particle (record, event, queue entry, cell links, counters,
 # image counters, reorder scratch, cells and buckets), rounded up from edmd.c/calendar.c.
 _ENGINE_BYTES_PER_PARTICLE = 400
@@ -214,8 +225,11 @@ class Scene:
         Positions: random sequential addition (accepting uniform candidates that overlap
         nothing), also across periodic images.  Above packing fractions where that jams
         (about 0.28 in 3D, 0.40 in 2D) particles start on a lattice that an elastic EDMD
-        run melts into an equilibrium fluid; very dense scenes (past the lattice's own
-        limit) raise ValueError.
+        run melts, in blocks of 20 collisions per particle until no lattice order is left
+        (at most 1000), into an equilibrium fluid.  Above freezing (0.494 in 3D, ~0.70 in
+        2D) the equilibrium state is not a homogeneous fluid and the scene stays a
+        defective lattice after 20 collisions per particle.  Very dense scenes (past the
+        lattice's own limit) raise ValueError.
 
         Velocities: with ``speed`` (default sqrt(2), the thesis' choice) every particle
         gets that speed in an isotropic random direction -- a normalised Gaussian vector.
@@ -260,15 +274,22 @@ class Scene:
             positions = _place_rsa(rng_pos, radii, lo, hi, periodic)
             if positions is not None:
                 return cls(positions, velocities, radii, masses, **common)
-        positions = _place_lattice(rng_pos, radii, lo, hi, periodic)
-        # Melt the lattice: elastic collisions with thermal velocities, then keep the
-        # positions and give the scene the velocities asked for.
+        positions, G = _place_lattice(rng_pos, radii, lo, hi, periodic)
+        # Melt the lattice: elastic collisions with thermal velocities until no lattice
+        # order is left, then keep the positions and give the scene the velocities asked for.
         from .simulation import Simulation
 
         melt_v = _draw_velocities(rng_melt, n, dim, masses, None, 1.0, n > 1)
         hot = cls(positions, melt_v, radii, masses, box=(lo, hi), boundary=boundary)
         sim = Simulation(hot)
-        sim.run(stop_when={"collisions_per_particle": _LATTICE_MELT_COLLISIONS})
+        melt = _LATTICE_MELT_COLLISIONS
+        while True:
+            sim.run(stop_when={"collisions_per_particle": melt}, store=())
+            if eta >= _FREEZING[dim] or melt >= _LATTICE_MELT_MAX or n < 50:
+                break
+            if _lattice_order(sim.scene.positions, G) < _MELTED_ORDER:
+                break
+            melt += _LATTICE_MELT_COLLISIONS
         return cls(sim.scene.positions, velocities, radii, masses, **common)
 
     @classmethod
@@ -373,9 +394,19 @@ def _distance(x, ys, L, periodic):
     return np.sqrt((d * d).sum(axis=1))
 
 
+def _lattice_order(positions, G):
+    """Q = N <|rho_G|^2> over reciprocal-lattice vectors G, rho_G = mean_j exp(i G.r_j):
+    exactly N on the lattice's sites, the structure factor S(G) (a few at most) times a
+    unit-mean random factor in a fluid."""
+    rho = np.exp(1j * positions @ G.T).mean(axis=0)
+    return len(positions) * float(np.mean(np.abs(rho) ** 2))
+
+
 def _place_lattice(rng, radii, lo, hi, periodic):
     """n sites drawn at random from the densest simple lattice that fits: face-centred
-    cubic in 3D (packing up to 0.74 when full), triangular in 2D (up to 0.91)."""
+    cubic in 3D (packing up to 0.74 when full), triangular in 2D (up to 0.91).  Returns
+    the positions and reciprocal-lattice vectors G (rows) for ``_lattice_order``: the
+    stars {111}, {200}, {220} of the cubic cell in 3D, the first star in 2D."""
     n, dim = len(radii), len(lo)
     L = hi - lo
     sigma = 2 * float(radii.max()) * (1 + 1e-9)
@@ -387,6 +418,10 @@ def _place_lattice(rng, radii, lo, hi, periodic):
         cell = inner / k
         sites = ((grid[:, None, :] + basis[None, :, :]).reshape(-1, 3) + 0.25) * cell
         nearest = cell.min() / math.sqrt(2)
+        hkl = [g for g in itertools.product(range(-2, 3), repeat=3)
+               if sum(x * x for x in g) in (3, 4, 8) and len({x % 2 for x in g}) == 1
+               and g > tuple(-x for x in g)]
+        G = 2 * math.pi * np.array(hkl, dtype=float) / cell
     else:
         # rows of kx sites, every other row shifted by half a spacing; ky even so the
         # shift is periodic; pick kx for the largest nearest-neighbour distance
@@ -404,9 +439,12 @@ def _place_lattice(rng, radii, lo, hi, periodic):
         nearest, kx, ky, ax, ay = best
         i, j = np.meshgrid(np.arange(kx), np.arange(ky), indexing="ij")
         sites = np.stack([(i + 0.25 + 0.5 * (j % 2)) * ax, (j + 0.25) * ay], -1).reshape(-1, 2)
+        # basis a1 = (ax, 0), a2 = (ax/2, ay); reciprocal b1, b2 and b1 + b2
+        b1, b2 = 2 * math.pi * np.array([1 / ax, -0.5 / ay]), 2 * math.pi * np.array([0.0, 1 / ay])
+        G = np.array([b1, b2, b1 + b2])
     if nearest < sigma:
         raise ValueError(
             f"{n} particles of radius {radii.max():g} do not fit in this box even on a "
             f"{'face-centred cubic' if dim == 3 else 'triangular'} lattice")
     pick = rng.choice(len(sites), size=n, replace=False)
-    return lo + (0.0 if periodic else sigma / 2) + sites[pick]
+    return lo + (0.0 if periodic else sigma / 2) + sites[pick], G
