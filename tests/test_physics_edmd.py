@@ -162,8 +162,10 @@ def haff_margin(xi):
 
 
 # Enskog's D_E (2.50) for molecular hard spheres at eta = 0.065: correlated collisions
-# make the true self-diffusion larger -- Speedy's fit to the MD data (Mol. Phys. 62, 509
-# (1987)) gives D / D_E = 1.055 there, and the thesis (App. F) measured a long-time
+# make the true self-diffusion larger -- by about 5% there on Speedy's fit to the MD data
+# (Mol. Phys. 62, 509 (1987); the value was taken from memory of the fit, not re-derived
+# here, which is why the margin below is set by the thesis' own measurement too), and the
+# thesis (App. F) measured a long-time
 # slope 0.364 against 6 D0 = 0.350 (+4%) for this very gas; the finite box lowers D by
 # ~3% (Yeh-Hummer hydrodynamic correction with Enskog's viscosity at N = 1000).  Margin
 # 6%.  For xi < 1 the Maxwellian D0 (2.52) carries the same O(1 - xi) approximations as
