@@ -1,9 +1,21 @@
-"""The command line: the demo and the benchmark run and write what they promise."""
+"""The command line: the demo, the benchmark and the reproduction run and write what they
+promise, and their numbers agree with theory within tolerances derived from the run count.
+
+A statistical check passes when ``|ours - theory| <= t * error + margin * |theory|``: the
+error is the standard error of a mean over K independent runs, t the Student-t quantile
+with K - 1 degrees of freedom for a two-sided false-alarm rate of 1e-4 per check (K = 20:
+t = 4.9), and the margin the theory's own known systematic accuracy, cited where it is set.
+"""
 import json
+import math
+import re
 import subprocess
 import sys
 
 import pytest
+from scipy import stats
+
+FALSE_ALARM = 1e-4  # per check, two-sided
 
 
 def run(*args, cwd):
@@ -11,18 +23,60 @@ def run(*args, cwd):
                           text=True, timeout=600, check=True)
 
 
+def assert_agrees(what, ours, error, runs, theory, margin):
+    t = stats.t.ppf(1 - FALSE_ALARM / 2, runs - 1)
+    tolerance = t * error + margin * abs(theory)
+    assert abs(ours - theory) <= tolerance, (
+        f"{what}: {ours:.6g} +- {error:.2g} ({runs} runs) vs theory {theory:.6g}; tolerance "
+        f"{tolerance:.3g} = {t:.2f} standard errors + {margin:.0%} of theory")
+
+
+# The theory's systematic accuracy, relative.
+# Haff's tau0 (2.45) is the Maxwellian (Enskog) value: tests/test_physics_edmd.py
+# (test_granular_gas_cools_by_haffs_law) states its accuracy as 4% for xi >= 0.8 and 10% at
+# xi = 0.5, growing with 1 - xi, as the thesis saw ("computed values somewhat higher than
+# theory" at low xi, section 4.1.3).  At xi = 0.3, beyond that test, the 10% of xi = 0.5
+# scaled by 1 - xi^2 (the fraction of the normal relative energy a collision dissipates):
+# 12%.  (The full reproduction, N = 1000 to t = 100, measures +6% at 0.5 and +11% at 0.3.)
+HAFF_TAU0 = {0.8: 0.04, 0.5: 0.10, 0.3: 0.12}  # 0.8: for every xi >= 0.8
+# Enskog's D0 underestimates self-diffusion by ~5% at eta = 0.065 (the thesis' molecular slope
+# is 4% above it, App. F) and for xi = 0.8 the Maxwellian tau0 adds to that: the margins of
+# tests/test_physics_edmd.py::test_msd_follows_theory.
+MSD = {1.0: 0.08, 0.8: 0.15}
+# Euler-Maruyama at dt = 0.01 biases the stationary <v^2> by 2 / (2 - gamma0 dt) - 1
+# (granular.langevin), 6.1% for the largest gamma0 here, the thesis' 11.44 at xi = 1 (the
+# quick system's are smaller); the MSD and the time-averaged MSD by at most that.
+EULER_MARUYAMA = 2 / (2 - 11.44 * 0.01) - 1
+REPRODUCE_MARGINS = {
+    # finite N: the speeds of N particles sharing a fixed energy, and the standard deviation
+    # over N particles (ddof = 0), shift <v> and std(v) by less than 0.4% for the quick sizes
+    # (N = 250 in 3D, 400 in 2D: the Beta distribution of one particle's share of the energy)
+    "table4.1.": 0.01,
+    "haff.tau0.xi0.99": HAFF_TAU0[0.8], "haff.tau0.xi0.5": HAFF_TAU0[0.5], "haff.tau0.xi0.3": HAFF_TAU0[0.3],
+    "msd.slope.xi1": MSD[1.0], "msd.slope.xi0.8": MSD[0.8],
+    "sde.": EULER_MARUYAMA,
+    "ergodicity.": EULER_MARUYAMA,
+}
+
+
 def test_demo_quick(tmp_path):
-    """The demo's granular gas cools by Haff's law (within 10% of (2.40) at t_end, the
-    accuracy of the Maxwellian tau0 compounded over 10 tau0) and its molecular gas keeps
-    its temperature to rounding."""
+    """The demo's molecular gas keeps its temperature to rounding; its granular gas cools by
+    Haff's law and both MSDs follow (2.68)/(2.79), within the demo's own error bars plus the
+    theory's accuracy: tau0 to 4% at xi = 0.8 becomes at most 8% in T ~ (1 + t/tau0)^-2;
+    the MSD margins as for the reproduction."""
     out = run("demo", "--quick", "--out", str(tmp_path / "demo"), cwd=tmp_path)
     assert "granular demo" in out.stdout
+    for name in ("demo.png", "msd.png", "temperature.png", "speeds.png"):
+        assert (tmp_path / "demo" / name).stat().st_size > 10_000
     rows = {r["gas"]: r for r in json.loads((tmp_path / "demo" / "summary.json").read_text())}
-    assert (tmp_path / "demo" / "demo.png").stat().st_size > 10_000
     mol, gran = rows["molecular"], rows["granular"]
+    assert mol["runs"] >= 10 and gran["runs"] >= 10
     assert mol["T_end"] == pytest.approx(mol["T_end_theory"], rel=1e-12)
-    assert gran["T_end"] == pytest.approx(gran["T_end_theory"], rel=0.10)
-    assert mol["msd_end"] == pytest.approx(mol["msd_end_theory"], rel=0.15)
+    assert_agrees("granular T(t_end)", gran["T_end"], gran["T_end_error"], gran["runs"], gran["T_end_theory"],
+                  2 * HAFF_TAU0[0.8])
+    for r in (mol, gran):
+        assert_agrees(f"{r['gas']} MSD(t_end)", r["msd_end"], r["msd_end_error"], r["runs"],
+                      r["msd_end_theory"], MSD[r["xi"]])
 
 
 def test_bench_quick_json(tmp_path):
@@ -40,10 +94,10 @@ def test_bench_quick_json(tmp_path):
 
 
 def test_reproduce_quick(tmp_path):
-    """Chapter 4 at small sizes: every figure and row is there, and the rows that theory
-    fixes exactly fall within five standard errors of it (errors from the run count);
-    Haff's tau0 within 12% (the Maxwellian theory's own accuracy, see
-    test_physics_edmd); the UDSBM time average well below its ensemble MSD."""
+    """Chapter 4 at small sizes: every figure and row is there; every row that is a mean
+    over runs agrees with theory within its error bars and the theory's stated accuracy
+    (REPRODUCE_MARGINS), energy is conserved to rounding, and report.md's verdicts are the
+    ones the numbers give."""
     run("reproduce", "--quick", "--out", "rep", cwd=tmp_path)
     rows = {r["id"]: r for r in json.loads((tmp_path / "rep" / "summary.json").read_text())}
     required = ["energy.drift.xi1", "msd.slope.xi1", "msd.slope.xi0.8", "ergodicity.langevin",
@@ -51,18 +105,23 @@ def test_reproduce_quick(tmp_path):
         + [f"haff.tau0.xi{x}" for x in ("0.99", "0.5", "0.3")]
     assert set(required) <= set(rows)
     for r in rows.values():
-        assert set(r) == {"id", "quantity", "ours", "ours_error", "thesis", "theory"}
+        assert set(r) == {"id", "quantity", "ours", "ours_error", "runs", "thesis", "theory"}
+        assert r["theory"] is not None
+    # double rounding (1e-16 per collision) over the quick run's ~1e4 collisions per run
     assert rows["energy.drift.xi1"]["ours"] < 1e-13
-    for d in ("2d", "3d"):
-        r = rows[f"table4.1.{d}.mean"]
-        assert abs(r["ours"] - r["theory"]) < 5 * r["ours_error"]
-    r = rows["ergodicity.langevin"]
-    assert abs(r["ours"] - 1) < 5 * r["ours_error"]
-    assert rows["ergodicity.udsbm"]["ours"] < 0.7
-    for x in ("0.99", "0.5", "0.3"):
-        r = rows[f"haff.tau0.xi{x}"]
-        assert r["ours"] == pytest.approx(r["theory"], rel=0.12)
+    statistical = [r for r in rows.values() if r["id"] != "energy.drift.xi1"]
+    for r in statistical:
+        assert r["runs"] >= 10, r["id"]
+        margin = next(m for prefix, m in REPRODUCE_MARGINS.items() if r["id"].startswith(prefix))
+        assert_agrees(r["id"], r["ours"], r["ours_error"], r["runs"], r["theory"], margin)
+
     report = (tmp_path / "rep" / "report.md").read_text()
-    assert "| table4.1.3d.mean |" in report
-    pngs = list((tmp_path / "rep").glob("*.png"))
-    assert len(pngs) >= 20
+    assert "| table4.1.3d.mean |" in report and "ours/theory - 1" in report
+    for r in statistical:
+        sentence = re.search(rf"^- `{re.escape(r['id'])}`.*$", report, re.M).group(0)
+        z = (r["ours"] - r["theory"]) / r["ours_error"]
+        verdict = "agrees within" if abs(z) <= 3 else "differs by"
+        assert f"theory {r['theory']:.4g}: {verdict}" in sentence, sentence
+    pngs = {p.name for p in (tmp_path / "rep").glob("*.png")}
+    assert len(pngs) >= 24 and "fig4_23_ergodicity_udsbm_tstop.png" in pngs
+    assert math.isfinite(rows["ergodicity.udsbm"]["theory"]) and rows["ergodicity.udsbm"]["theory"] < 1

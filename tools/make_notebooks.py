@@ -1,10 +1,12 @@
 """Build the notebooks (outputs stripped) from cell lists -- run once, commit the .ipynb."""
 import nbformat as nbf
 
-def nb(cells):
+def nb(name, cells):
+    """A notebook of markdown ("md:...") and code cells, with ids stable across rebuilds."""
     n = nbf.v4.new_notebook()
     n.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-    n.cells = [nbf.v4.new_markdown_cell(c[3:]) if c.startswith("md:") else nbf.v4.new_code_cell(c) for c in cells]
+    n.cells = [nbf.v4.new_markdown_cell(c[3:], id=f"{name[:2]}-{i}") if c.startswith("md:")
+               else nbf.v4.new_code_cell(c, id=f"{name[:2]}-{i}") for i, c in enumerate(cells)]
     return n
 
 setup = '''import os
@@ -36,39 +38,38 @@ plot.haff(traj.times, traj.temperature, tau0=c.tau0)''',
 ]
 
 repro = [
-"md:# The thesis' chapter 4, the story\nThe same functions as `python -m granular reproduce`, one section at a time. Each call runs the thesis' system with five times its number of runs (set `QUICK` to shrink it) and returns figure files and summary rows.",
+"md:# The thesis' chapter 4, the story\nThe same experiments as `python -m granular reproduce`, one at a time. `reproduce.figure(name, quick=...)` runs one of them on the thesis' system with five times its number of runs (`QUICK` shrinks it), writes its figures and returns their paths and its summary rows: our value with its standard error over the runs, the thesis' value and theory's. `reproduce.FIGURES` lists the names.",
 setup + "\nfrom granular import reproduce\nfrom IPython.display import Image, display",
-'''cfg = reproduce.Config(quick=QUICK)
-out = "reproduction"
-os.makedirs(out, exist_ok=True)
-rows = []''',
+"""out = "reproduction"
+rows = []
+list(reproduce.FIGURES)""",
 "md:## Verification: a head-on collision, energy conservation, collision counts (Figs 4.1-4.4)",
-'''for fn in (reproduce.fig_4_1, reproduce.fig_4_2_to_4_4):
-    names, r = fn(cfg, out)
-    rows += r
-    for name in names:
-        display(Image(os.path.join(out, name)))''',
+"""for name in ("4.1", "4.2-4.4"):
+    paths, new_rows = reproduce.figure(name, quick=QUICK, out=out)
+    rows += new_rows
+    display(*[Image(p) for p in paths])""",
 "md:## Speed distributions and Table 4.1 (Figs 4.5-4.7)",
-'''names, r = reproduce.fig_4_5_to_4_7(cfg, out)
-rows += r
-display(Image(os.path.join(out, names[1])))
-r''',
+"""paths, new_rows = reproduce.figure("4.5-4.7", quick=QUICK, out=out)
+rows += new_rows
+display(Image(paths[1]))
+new_rows""",
 "md:## Haff's law (Figs 4.8, 4.10) and 2D clustering (Fig. 4.9)",
-'''for fn in (reproduce.fig_4_8_and_4_10, reproduce.fig_4_9):
-    names, r = fn(cfg, out)
-    rows += r
-    for name in names:
-        display(Image(os.path.join(out, name)))''',
+"""for name in ("4.8+4.10", "4.9"):
+    paths, new_rows = reproduce.figure(name, quick=QUICK, out=out)
+    rows += new_rows
+    display(*[Image(p) for p in paths])""",
 "md:## Brownian motion: MSD, diffusivity and long-time slopes (Figs 4.11-4.16, F.1-F.2)",
-'''names, r = reproduce.fig_4_11_to_4_16_and_F(cfg, out)
-rows += r
-display(Image(os.path.join(out, names[2])))
-r''',
-"md:## Langevin and UDSBM, ergodicity (Figs 4.17-4.23)",
-'''names, r = reproduce.fig_4_17_to_4_23(cfg, out)
-rows += r
-display(Image(os.path.join(out, names[-2])))
-r''',
+"""paths, new_rows = reproduce.figure("4.11-4.16+F", quick=QUICK, out=out)
+rows += new_rows
+display(Image(paths[2]), Image(paths[-1]))
+new_rows""",
+"md:## Langevin and UDSBM, ergodicity (Figs 4.17-4.23)\nFig. 4.23: the time-averaged MSD of UDSBM for several t_stop, beside the ensemble MSD.",
+"""paths, new_rows = reproduce.figure("4.17-4.23", quick=QUICK, out=out)
+rows += new_rows
+display(Image(paths[3]), Image(paths[-1]))
+new_rows""",
+"md:All rows: ours against theory (`python -m granular reproduce` writes them to `summary.json` and a report).",
+"""[(r["id"], r["ours"], r["ours_error"], r["theory"]) for r in rows]""",
 ]
 
 lve = [
@@ -95,16 +96,29 @@ for ax, xi in zip(axes, (1.0, 0.8)):
 c = langevin.coefficients_from_scene(eq.replace(restitution=0.8))
 u = langevin.run(n, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=0.01, t_stop=t_stop, scheme="exact", initial="udsbm", tamsd_lags=lags, seed=4)
 plot.msd_vs_tamsd(u.times, u.msd, u.tamsd_lags, u.tamsd, label="UDSBM")''',
-"md:Ensembles of EDMD runs on all local cores (or a Dask cluster: pass `backend=distributed.Client(...)`), a sweep over xi:",
+"md:Ensembles of EDMD runs on all local cores (the default backend), a sweep over xi:",
 '''import functools
+runs = 4 if not QUICK else 2
 sweep = {}
 for xi in (1.0, 0.9, 0.8):
     make = functools.partial(granular.Scene.random, n, r, restitution=xi)
-    sweep[xi] = granular.ensemble(make, runs=4 if not QUICK else 2, seed=1, t_stop=times[-1], sample_times=times, quantities=("msd",), progress=False)
+    sweep[xi] = granular.ensemble(make, runs=runs, seed=1, t_stop=times[-1], sample_times=times, quantities=("msd",), progress=False)
 ax = None
 for xi, res in sweep.items():
     ax = plot.msd(times, res.mean["msd"], error=res.error["msd"], ax=ax, label=f"xi = {xi}")''',
+"md:The same code on a Dask cluster: pass a `distributed.Client` as the backend. A `LocalCluster` of two worker processes stands in here for a real cluster (`Client(\"scheduler-address:8786\")`). Run r always gets `SeedSequence(seed).spawn(runs)[r]`, so the numbers are the ones the local cores gave.",
+'''from distributed import Client, LocalCluster
+
+cluster = LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0")
+client = Client(cluster)
+on_dask = {}
+for xi in sweep:
+    make = functools.partial(granular.Scene.random, n, r, restitution=xi)
+    on_dask[xi] = granular.ensemble(make, runs=runs, seed=1, backend=client, t_stop=times[-1], sample_times=times, quantities=("msd",), progress=False)
+client.close()
+cluster.close()
+print("same numbers as on local cores:", all(np.array_equal(on_dask[xi].mean["msd"], sweep[xi].mean["msd"]) for xi in sweep))''',
 ]
 
 for name, cells in (("01_quickstart", quick), ("02_thesis_reproduction", repro), ("03_langevin_vs_edmd", lve)):
-    nbf.write(nb(cells), f"notebooks/{name}.ipynb")
+    nbf.write(nb(name, cells), f"notebooks/{name}.ipynb")
