@@ -331,7 +331,9 @@ def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progr
         ``SeedSequence(seed).spawn(P)[p].spawn(runs)[r]``, so a point gives the same
         results as ``ensemble(model[p], runs, seed=SeedSequence(seed).spawn(P)[p])``.
     backend : "processes" (default: all local cores), "serial", "threads", or a
-        ``dask.distributed.Client`` (a real cluster, or a ``LocalCluster``)
+        ``dask.distributed.Client`` (a real cluster, or a ``LocalCluster``).  Worker
+        processes import the calling script, so in a script call ``ensemble`` under
+        ``if __name__ == "__main__":`` (as for any process pool; notebooks need nothing).
     workers : int, optional
         Local worker count (default: all cores).
     progress : bool, optional

@@ -221,13 +221,14 @@ def dense_cost(quick=False):
 
 
 def scene_costs(quick=False):
-    """What modelling choices cost, measured: 2D vs 3D, walls vs periodic, small N, and
-    storing trajectories vs accumulating statistics."""
+    """What modelling choices cost, measured: 2D vs 3D, walls vs periodic, small N, a large
+    tracer kept out of the cell grid or not, and storing trajectories vs accumulating
+    statistics."""
     rows = []
     coll = 100.0 if not quick else 10.0
 
-    def per_collision(scene, **run):
-        sim = Simulation(scene)
+    def per_collision(scene, big_ratio=3.0, **run):
+        sim = Simulation(scene, big_ratio=big_ratio)
         sim.run(stop_when={"collisions_per_particle": 5}, store=())
         b = sim.stats
         t0 = clock()
@@ -245,6 +246,14 @@ def scene_costs(quick=False):
     for small in (20, 100):
         rows.append(dict(case=f"3D periodic, eta 0.1, N = {small}", ns_per_collision=per_collision(
             Scene.random(small, (0.1 / (small * 4 / 3 * math.pi)) ** (1 / 3), seed=1))))
+    # one tracer of radius 0.1 among spheres of radius 0.008 (eta 0.065 in all)
+    small = 2000 if not quick else 500
+    r_small = ((0.065 - 4 / 3 * math.pi * 0.1**3) / (small * 4 / 3 * math.pi)) ** (1 / 3)
+    radii = np.r_[0.1, np.full(small, r_small)]
+    tracer = Scene.random(small + 1, radii, mass=(radii / r_small) ** 3, seed=1)
+    for big_ratio, how in ((3.0, "kept out of the cell grid"), (math.inf, "in cells as wide as it")):
+        rows.append(dict(case=f"3D, one tracer {0.1 / r_small:.1f}x wider than {small} others, {how}",
+                         ns_per_collision=per_collision(tracer, big_ratio=big_ratio)))
     s = Scene.random(1000, R, seed=1)
     for store in ((), ("positions", "velocities")):
         sim = Simulation(s)
