@@ -44,18 +44,23 @@ class CountingClient:
         return getattr(self._client, name)
 
 
+def _assert_identical(x, y):
+    """Two EnsembleResults agree bit for bit: every run's arrays, the means and errors."""
+    for a, b in zip(x.runs, y.runs):
+        for k in a:
+            np.testing.assert_array_equal(a[k], b[k])
+    for k in x.mean:
+        np.testing.assert_array_equal(x.mean[k], y.mean[k])
+        np.testing.assert_array_equal(x.error[k], y.error[k])
+
+
 def test_same_seed_same_results_on_every_backend(dask_client):
     kw = dict(runs=4, seed=7, quantities=("temperature", "collisions_per_particle"), **RUN)
     serial = granular.ensemble(ensemble_tasks.small_gas, backend="serial", **kw)
     for backend in ("processes", "threads", dask_client):
         other = granular.ensemble(ensemble_tasks.small_gas, backend=backend, workers=2, **kw)
         assert other.count == 4
-        for a, b in zip(serial.runs, other.runs):
-            for k in a:
-                np.testing.assert_array_equal(a[k], b[k])
-        for k in serial.mean:
-            np.testing.assert_array_equal(serial.mean[k], other.mean[k])
-            np.testing.assert_array_equal(serial.error[k], other.error[k])
+        _assert_identical(serial, other)
     np.testing.assert_array_equal(serial.times, RUN["sample_times"])
 
 
@@ -108,12 +113,7 @@ def test_a_sweep_gives_each_point_as_run_alone_with_its_child_seed():
     for point, child, res in zip(points, np.random.SeedSequence(11).spawn(2), sweep):
         alone = granular.ensemble(point, 3, seed=child, backend="serial", **kw)
         assert res.count == alone.count == 3 and not res.failures
-        for a, b in zip(alone.runs, res.runs):
-            for k in a:
-                np.testing.assert_array_equal(a[k], b[k])
-        for k in alone.mean:
-            np.testing.assert_array_equal(alone.mean[k], res.mean[k])
-            np.testing.assert_array_equal(alone.error[k], res.error[k])
+        _assert_identical(alone, res)
     elastic, inelastic = (res.mean["temperature"] for res in sweep)
     np.testing.assert_allclose(elastic, elastic[0], rtol=1e-9)
     assert inelastic[-1] < 0.99 * inelastic[0]
