@@ -65,6 +65,61 @@ static exact_coef exact_for(double g, double D, double dt)
     return e;
 }
 
+/* What one step needs besides the particle's state. */
+typedef struct {
+    uint64_t key;
+    double dt, g0, D0, tau0, b0;
+    int udsbm, em;
+    exact_coef ex0;
+    const exact_coef *table; /* the exact scheme's UDSBM coefficients per step, or NULL */
+} step_params;
+
+/* Steps from+1 .. to of particle i (the step numbered k goes from t = (k-1) dt to k dt and
+ * draws the randoms of (key, k-1, i)).  Always inlined with a constant d, so that each
+ * dimension gets its own unrolled loop. */
+#if defined(__GNUC__) || defined(__clang__)
+#define GR_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define GR_ALWAYS_INLINE inline
+#endif
+
+static GR_ALWAYS_INLINE void run_steps(
+    const int d, const step_params *p, int64_t i, int64_t from, int64_t to, double *xi, double *vi)
+{
+    const double dt = p->dt;
+    for (int64_t step = from + 1; step <= to; step++) {
+        gr_stream rs = gr_stream_at(p->key, (uint64_t)(step - 1), (uint64_t)i);
+        if (p->em) {
+            double a_coef = 1.0 - p->g0 * dt, b = p->b0;
+            if (p->udsbm) { /* gamma(t_n), D(t_n) at the start of the step (2.110) */
+                const double t = (double)(step - 1) * dt;
+                double s = 1.0 / (1.0 + t / p->tau0);
+                a_coef = 1.0 - p->g0 * s * dt;
+                b = p->b0 * s * sqrt(s);
+            }
+            for (int a = 0; a < d; a++) {
+                double z = gr_normal(&rs);
+                xi[a] += vi[a] * dt;
+                vi[a] = a_coef * vi[a] + b * z;
+            }
+        } else {
+            exact_coef e = p->ex0;
+            if (p->table) {
+                e = p->table[step - 1];
+            } else if (p->udsbm) { /* coefficients frozen at the midpoint of the step,
+                                    * computed exactly as the table does */
+                double s = 1.0 / (1.0 + ((double)(step - 1) + 0.5) * dt / p->tau0);
+                e = exact_for(p->g0 * s, p->D0 * s, dt);
+            }
+            for (int a = 0; a < d; a++) {
+                double z1 = gr_normal(&rs), z2 = gr_normal(&rs);
+                xi[a] += vi[a] * e.drift + e.kx * z1 + e.sx * z2;
+                vi[a] = e.c * vi[a] + e.sv * z1;
+            }
+        }
+    }
+}
+
 int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
                int64_t n_steps, double *x, double *v, gr_sde_output *out, gr_error *err)
 {
@@ -94,6 +149,7 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
         }
     }
 
+    const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, udsbm, cfg->scheme == GR_SDE_EM, ex0, table};
     for (int64_t local = 0; local < count; local++) {
         const int64_t i = first + local;
         double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0};
@@ -111,39 +167,10 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
             slot_end[l] = 0;
             slot_store[l] = 0;
         }
-        /* step 0: the start is a sample and a window start for every lag */
-        for (int64_t step = 0;; step++) {
-            if (step > 0) {
-                gr_stream rs = gr_stream_at(cfg->key, (uint64_t)(step - 1), (uint64_t)i);
-                const double t = (double)(step - 1) * dt;
-                if (cfg->scheme == GR_SDE_EM) {
-                    double a_coef = 1.0 - g0 * dt, b = b0;
-                    if (udsbm) { /* gamma(t_n), D(t_n) at the start of the step (2.110) */
-                        double s = 1.0 / (1.0 + t / tau0);
-                        a_coef = 1.0 - g0 * s * dt;
-                        b = b0 * s * sqrt(s);
-                    }
-                    for (int a = 0; a < d; a++) {
-                        double z = gr_normal(&rs);
-                        xi[a] += vi[a] * dt;
-                        vi[a] = a_coef * vi[a] + b * z;
-                    }
-                } else {
-                    exact_coef e = ex0;
-                    if (table) {
-                        e = table[step - 1];
-                    } else if (udsbm) { /* coefficients frozen at the midpoint of the step,
-                                         * computed exactly as the table does */
-                        double s = 1.0 / (1.0 + ((double)(step - 1) + 0.5) * dt / tau0);
-                        e = exact_for(g0 * s, D0 * s, dt);
-                    }
-                    for (int a = 0; a < d; a++) {
-                        double z1 = gr_normal(&rs), z2 = gr_normal(&rs);
-                        xi[a] += vi[a] * e.drift + e.kx * z1 + e.sx * z2;
-                        vi[a] = e.c * vi[a] + e.sv * z1;
-                    }
-                }
-            }
+        /* Bookkeeping (samples, TAMSD windows) happens at few steps; between them the
+         * particle is stepped in a tight loop.  Step 0, the start, is a sample and a
+         * window start for every lag. */
+        for (int64_t step = 0;;) {
             while (ks < out->n_samples && out->sample_steps[ks] == step) {
                 for (int a = 0; a < d; a++) {
                     out->x2[ks * d + a] += xi[a] * xi[a];
@@ -152,6 +179,8 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
                 }
                 ks++;
             }
+            int64_t next = n_steps; /* the next step that needs bookkeeping */
+            if (ks < out->n_samples && out->sample_steps[ks] < next) next = out->sample_steps[ks];
             double *r = out->ring;
             for (int64_t l = 0; l < out->n_lags; l++) {
                 const int64_t stride = out->lag_stride[l], len = out->lag_len[l];
@@ -168,9 +197,19 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
                     next_store[l] += stride;
                     if (++slot_store[l] == len) slot_store[l] = 0;
                 }
+                if (next_end[l] < next) next = next_end[l];
+                if (next_store[l] < next) next = next_store[l];
                 r += len * d;
             }
             if (step == n_steps) break;
+            /* steps step+1 .. next, each with its own dimension so that the axis loops
+             * unroll */
+            switch (d) {
+            case 1: run_steps(1, &sp, i, step, next, xi, vi); break;
+            case 2: run_steps(2, &sp, i, step, next, xi, vi); break;
+            default: run_steps(3, &sp, i, step, next, xi, vi); break;
+            }
+            step = next;
         }
         for (int a = 0; a < d; a++) {
             if (!isfinite(xi[a]) || !isfinite(vi[a])) {
