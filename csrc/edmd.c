@@ -36,7 +36,8 @@
 #include "hugemem.h"
 #include "calendar.h"
 
-/* Every small particle's scan checks every big one, so only a few may be big. */
+/* Every small particle's scan checks every big one, so only a few may be big (the same
+ * limit as _BIG_MAX in granular/scene.py). */
 #define GR_BIG_MAX 16
 
 typedef struct {

@@ -76,10 +76,42 @@ class LangevinResult:
             return theory.msd_langevin(t, self.D0, self.gamma0, self.dim, v0_sq=self.v0_sq)
         return theory.msd_udsbm(t, self.D0, self.gamma0, self.tau0, self.dim, v0_sq=self.v0_sq)
 
+    def theory_tamsd(self, lags=None):
+        """The expected time-averaged MSD of this run at its lags (or at ``lags``), as the
+        engine measures it: see ``theory_tamsd``."""
+        return theory_tamsd(self.tamsd_lags if lags is None else lags, gamma0=self.gamma0,
+                            D0=self.D0, tau0=self.tau0, dt=self.dt, t_stop=self.t_stop,
+                            dim=self.dim, v0_sq=self.v0_sq)
+
     def __repr__(self):
         return (f"LangevinResult(model={self.model!r}, scheme={self.scheme!r}, n={self.n}, "
                 f"dim={self.dim}, dt={self.dt}, t_stop={self.t_stop}, samples={len(self.times)}, "
                 f"lags={len(self.tamsd_lags)})")
+
+
+def theory_tamsd(lags, *, gamma0, D0, dt, t_stop, tau0=math.inf, dim=3, v0_sq=None):
+    """The expected time-averaged MSD of a run, total over ``dim``: for each lag the mean,
+    over the windows the engine averages (starting every ``sde_lag_stride`` steps from 0
+    while they end by ``t_stop``), of the mean squared displacement over the window --
+    ``theory.msd_langevin`` from the velocity variance reached at the window's start for
+    the Langevin model (tau0 = inf), ``theory.udsbm_increment_msd`` for UDSBM.
+    ``v0_sq`` is the initial mean squared velocity per component (None: thermal, or App.
+    C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD."""
+    from . import theory
+
+    n_steps = int(round(t_stop / dt))
+    out = []
+    for lag in np.atleast_1d(np.asarray(lags, dtype=np.float64)):
+        k = int(round(lag / dt))
+        starts = np.arange(0, n_steps - k + 1, _core.sde_lag_stride(k)) * dt
+        if math.isinf(tau0):
+            thermal = D0 * gamma0
+            v_sq = thermal if v0_sq is None else thermal + (v0_sq - thermal) * np.exp(-2 * gamma0 * starts)
+            incr = theory.msd_langevin(lag, D0, gamma0, dim, v0_sq=v_sq)
+        else:
+            incr = theory.udsbm_increment_msd(lag, starts, D0, gamma0, tau0, dim, v0_sq=v0_sq)
+        out.append(float(np.mean(incr)))
+    return np.array(out)
 
 
 def _positive(name, value):

@@ -40,7 +40,6 @@ import time
 import numpy as np
 
 from . import analysis, langevin, plot, theory
-from ._core import sde_lag_stride
 from .ensemble import ensemble
 from .scene import Scene
 from .simulation import Simulation
@@ -329,32 +328,6 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
 
 # -- 4.2: Langevin models ----------------------------------------------------------------------
 
-def _udsbm_tamsd(lags, t_stop, dt, c, v0_sq, dim=3):
-    """The expected time-averaged MSD of UDSBM as ``langevin.run`` measures it: the mean of
-    E|x(s + lag) - x(s)|^2 over the engine's window starts s (every ``sde_lag_stride`` steps).
-
-    Per dimension, with w = 1 + s/tau0, W = 1 + (s + lag)/tau0 and a = gamma0 tau0: the mean
-    squared velocity is ``vc / w^2 + (v0_sq - vc) / w^(2a)`` (vc = App. C's ``udsbm_v0_sq``)
-    and the velocity correlation ``<v(s) v(s')> = <v^2>(s) (w / w')^a``; integrated twice,
-    ``E dx^2 = 2 tau0^2 / (a - 1) [vc (ln(W/w) - (1 - (w/W)^(a-1)) / (a - 1)) + (v0_sq - vc)
-    ((W^(2-2a) - w^(2-2a)) / (2 - 2a) + (W^(1-a) - w^(1-a)) W^(1-a) / (a - 1))]``,
-    which at s = 0 is ``theory.msd_udsbm``.
-    """
-    a, tau0 = c.gamma0 * c.tau0, c.tau0
-    vc = theory.udsbm_v0_sq(c.D0, c.gamma0, tau0)
-    n_steps = int(round(t_stop / dt))
-    out = []
-    for lag in lags:
-        k = int(round(lag / dt))
-        s = np.arange(0, n_steps - k + 1, sde_lag_stride(k)) * dt
-        w, W = 1 + s / tau0, 1 + (s + k * dt) / tau0
-        stationary = vc * (np.log(W / w) - (1 - (w / W) ** (a - 1)) / (a - 1))
-        transient = (v0_sq - vc) * ((W ** (2 - 2 * a) - w ** (2 - 2 * a)) / (2 - 2 * a)
-                                    + (W ** (1 - a) - w ** (1 - a)) * W ** (1 - a) / (a - 1))
-        out.append(np.mean(2 * dim * tau0**2 / (a - 1) * (stationary + transient)))
-    return np.array(out)
-
-
 def _fig_4_17_to_4_23(cfg, out):
     """Langevin and UDSBM by Euler-Maruyama (4.17-4.20) and ergodicity (4.21-4.23)."""
     names, rows = [], []
@@ -413,7 +386,9 @@ def _fig_4_17_to_4_23(cfg, out):
             lags = np.unique(np.append(lags, lag_ref))
         r = run(xi, 0.01, t_stop, lags=lags, samples=np.unique(np.append(t_samples[t_samples <= t_stop], lags)))
         lags = r.mean["tamsd_lags"]
-        tamsd_th = msd_theory(xi, lags) if xi == 1 else _udsbm_tamsd(lags, t_stop, 0.01, coeff[xi], v0_sq)
+        c = coeff[xi]
+        tamsd_th = langevin.theory_tamsd(lags, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=0.01,
+                                         t_stop=t_stop, v0_sq=v0_sq)
         return r, lags, tamsd_th
 
     def ratio_row(label, xi, r, lags, tamsd_th):

@@ -23,6 +23,11 @@ _FREEZING = {2: 0.70, 3: 0.494}
 # lattice, the mean of S(G) over the stars in a fluid: about 1 (S <= 2.85 below freezing,
 # Hansen-Verlet); 3 leaves residual order well below what tests/test_scene.py detects.
 _MELTED_ORDER = 3.0
+# Up to _BIG_MAX particles wider than BIG_RATIO times the median diameter (a tracer) are
+# kept out of neighbour searches sized for the others: in the engine's cell grid
+# (Simulation's big_ratio; csrc/edmd.c, GR_BIG_MAX) and in random placement.
+BIG_RATIO = 3.0
+_BIG_MAX = 16
 # What the engine holds per particle (record, event, queue entry, cell links, counters,
 # image counters, reorder scratch, cells and buckets), rounded up from edmd.c/calendar.c.
 _ENGINE_BYTES_PER_PARTICLE = 400
@@ -207,7 +212,7 @@ class Scene:
                 f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
                 f"temperature={self.temperature:.4g})")
 
-    def _engine(self, cell_factor=1.0, big_ratio=3.0):
+    def _engine(self, cell_factor=1.0, big_ratio=BIG_RATIO):
         from . import _core
 
         return _core.EDMD(self.positions, self.velocities, self.radii, self.masses,
@@ -287,7 +292,8 @@ class Scene:
             sim.run(stop_when={"collisions_per_particle": melt}, store=())
             if eta >= _FREEZING[dim] or melt >= _LATTICE_MELT_MAX or n < 50:
                 break
-            if _lattice_order(sim.scene.positions, G) < _MELTED_ORDER:
+            # unwrapped positions: G is a reciprocal vector of the periodic box too
+            if _lattice_order(sim.unwrapped_positions, G) < _MELTED_ORDER:
                 break
             melt += _LATTICE_MELT_COLLISIONS
         return cls(sim.scene.positions, velocities, radii, masses, **common)
@@ -336,8 +342,8 @@ def _place_rsa(rng, radii, lo, hi, periodic, max_rounds=200):
 
     n, dim = len(radii), len(lo)
     L = hi - lo
-    is_big = radii > 3.0 * np.median(radii)
-    if is_big.sum() > 16:
+    is_big = radii > BIG_RATIO * np.median(radii)
+    if is_big.sum() > _BIG_MAX:
         is_big[:] = False
     r_small = float(radii[~is_big].max())
     order = np.argsort(-radii, kind="stable")  # big ones first: they are the hard ones

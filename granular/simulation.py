@@ -7,7 +7,7 @@ import numpy as np
 
 from . import _core
 from .errors import GranularError, NoProgressError
-from .scene import Scene, _check_memory
+from .scene import BIG_RATIO, Scene, _check_memory
 from .trajectory import Trajectory
 
 _STOP_KEYS = ("collisions_per_particle", "kinetic_energy", "events")
@@ -36,7 +36,7 @@ class Simulation:
         as they are; ``math.inf`` puts everyone in the grid.  A speed knob too.
     """
 
-    def __init__(self, scene, *, cell_factor=1.0, big_ratio=3.0):
+    def __init__(self, scene, *, cell_factor=1.0, big_ratio=BIG_RATIO):
         if not isinstance(scene, Scene):
             raise TypeError(f"Simulation needs a granular.Scene, got {type(scene).__name__}")
         self._initial = scene
@@ -154,7 +154,7 @@ class Simulation:
         _check_memory(8.0 * count * self._initial.n * self._initial.dim * len(store),
                       f"storing {count} samples of {' and '.join(store)} (sample less often, "
                       f"or run with store=() and keep only the statistics)")
-        buf = self._buffers(len(times) + final_sample, store)
+        buf = self._buffers(count, store)
 
         # the C loop fills the first len(times) samples; a final one may follow
         views = {k: (None if v is None else v[:len(times)]) for k, v in buf.items()}
@@ -166,14 +166,15 @@ class Simulation:
                 chunk = int(min(_CHUNK, budget - done))
                 before = self._engine.counters()["events"]
                 code, nxt = self._engine.advance(t_end, cpp, kin, chunk, times, nxt, **views)
-                done += self._engine.counters()["events"] - before
+                after = self._engine.counters()
+                done += after["events"] - before
                 if bar is not None:
                     bar.update(self)
                 if code != _core.STOP_BUDGET:
                     reason = _REASONS[code]
                     break
                 if stall is not None:
-                    stall.check(crit)
+                    stall.check(after, crit)
         except (GranularError, KeyboardInterrupt) as exc:
             # keep what was sampled: every sample time up to the engine's clock is written
             k = int(np.searchsorted(times, self.time, side="right"))
@@ -247,14 +248,13 @@ class _StallGuard:
     dilute one many more, so the bound is generous."""
 
     def __init__(self, sim):
-        self.sim = sim
         self.limit = max(10**7, 1000 * sim._initial.n)
         c = sim._engine.counters()
         self.collisions = c["pair_collisions"] + c["wall_collisions"]
         self.events = c["events"]
 
-    def check(self, criteria):
-        c = self.sim._engine.counters()
+    def check(self, c, criteria):
+        """c: the engine's counters now."""
         collisions = c["pair_collisions"] + c["wall_collisions"]
         if collisions != self.collisions:
             self.collisions, self.events = collisions, c["events"]

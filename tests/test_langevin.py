@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import granular
-from granular import _core, langevin, theory
+from granular import langevin, theory
 
 G0, D0 = 9.26, 0.072          # the thesis' standard gas, xi = 0.8 (theory.langevin_coefficients)
 TAU0 = 0.972
@@ -139,24 +139,11 @@ def test_exact_step_moments():
         assert abs(kurt - 3) < 5 * math.sqrt(24 / n)
 
 
-def udsbm_tamsd(r):
-    """Expected TAMSD of a UDSBM run from App. C's start, (2.115)-(2.119) with the VACF
-    (2.111): since the VACF is v_C^2 s1^(a-2) s2^-a (s = 1 + t/tau0), the mean squared
-    increment over [t', t' + lag] is the MSD (2.113) at lag / (1 + t'/tau0).  Averaged
-    over the run's windows, which start every sde_lag_stride(lag) steps from 0."""
-    out = []
-    n_steps = int(round(r.t_stop / r.dt))
-    for lag in r.tamsd_lags:
-        k = int(round(lag / r.dt))
-        starts = np.arange(0, n_steps - k + 1, _core.sde_lag_stride(k)) * r.dt
-        out.append(np.mean(theory.msd_udsbm(lag / (1 + starts / r.tau0), r.D0, r.gamma0, r.tau0)))
-    return np.array(out)
-
-
 def test_tamsd_equals_msd_for_langevin_but_not_for_udsbm():
     """Ergodicity (thesis 2.114-2.119, Figs 4.21-4.23): for the Langevin model the
     time-averaged MSD equals the ensemble MSD; for UDSBM it equals (2.115) evaluated with
-    the UDSBM increments, far below the ensemble MSD.  Tolerance: 5 standard errors of the
+    the UDSBM increments over the run's windows (``theory_tamsd``, itself checked in
+    test_theory), far below the ensemble MSD.  Tolerance: 5 standard errors of the
     particle average of the TAMSD (particles are independent: the std of the per-particle
     TAMSD over sqrt(n)); the exact scheme's frozen UDSBM coefficients err by
     O(dt^2 / tau0^2) = 1e-4 relative, far below that."""
@@ -169,7 +156,7 @@ def test_tamsd_equals_msd_for_langevin_but_not_for_udsbm():
     u = langevin.run(n, gamma0=G0, D0=D0, tau0=TAU0, dt=0.01, t_stop=100.0, scheme="exact",
                      initial="udsbm", tamsd_lags=lags, seed=6)
     se = u.tamsd_per_particle.std(0, ddof=1) / math.sqrt(n)
-    np.testing.assert_array_less(np.abs(u.tamsd - udsbm_tamsd(u)), 5 * se)
+    np.testing.assert_array_less(np.abs(u.tamsd - u.theory_tamsd()), 5 * se)
     # non-ergodic: the ensemble MSD lies many standard errors above the time average
     np.testing.assert_array_less(5 * se, u.theory_msd(lags) - u.tamsd)
 

@@ -12,11 +12,11 @@ from granular import theory
 D0, G0, TAU0 = 0.07, 9.0, 1.5
 
 
-def msd_from_vacf(vacf, t, dim=3):
-    """MSD = 2 int_0^t dt1 int_t1^t dt2 <v(t1) v(t2)> (2.59), per dimension times dim;
-    adaptive quadrature, relative accuracy ~1e-10."""
+def msd_from_vacf(vacf, t, dim=3, start=0.0):
+    """MSD over [start, t] = 2 int_start^t dt1 int_t1^t dt2 <v(t1) v(t2)> (2.59), per
+    dimension times dim; adaptive quadrature, relative accuracy ~1e-10."""
     inner = lambda t1: integrate.quad(lambda t2: vacf(t1, t2), t1, t, epsabs=0, epsrel=1e-12, limit=200)[0]
-    return dim * 2 * integrate.quad(inner, 0, t, epsabs=0, epsrel=1e-11, limit=200)[0]
+    return dim * 2 * integrate.quad(inner, start, t, epsabs=0, epsrel=1e-11, limit=200)[0]
 
 
 @pytest.mark.parametrize("t", [1e-3, 0.05, 0.7, 6.0])
@@ -45,6 +45,26 @@ def test_msd_with_other_initial_speeds(t):
                           + (v0 - vs_u) * phi(t1) * phi(t2))
     assert theory.msd_langevin(t, D0, G0, v0_sq=v0) == pytest.approx(msd_from_vacf(lang, t), rel=1e-8)
     assert theory.msd_udsbm(t, D0, G0, TAU0, v0_sq=v0) == pytest.approx(msd_from_vacf(uds, t), rel=1e-8)
+
+
+@pytest.mark.parametrize("start,lag", [(0.0, 0.5), (0.3, 0.05), (2.0, 0.7), (10.0, 4.0)])
+def test_udsbm_increment_msd_is_the_double_integral_over_its_window(start, lag):
+    """What a time average of UDSBM collects: the displacement over [start, start + lag],
+    against the VACF (2.111) plus a start's transient integrated over that window; with
+    App. C's start the increments scale, msd_udsbm(lag / (1 + start/tau0)); at start 0 it
+    is msd_udsbm."""
+    v0 = 0.3
+    a = G0 * TAU0
+    vs = theory.udsbm_v0_sq(D0, G0, TAU0)
+    phi = lambda s: (1 + s / TAU0) ** (-a)
+    uds = lambda t1, t2: (vs * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)
+                          + (v0 - vs) * phi(t1) * phi(t2))
+    got = theory.udsbm_increment_msd(lag, start, D0, G0, TAU0, v0_sq=v0)
+    assert got == pytest.approx(msd_from_vacf(uds, start + lag, start=start), rel=1e-8)
+    assert theory.udsbm_increment_msd(lag, start, D0, G0, TAU0) == pytest.approx(
+        theory.msd_udsbm(lag / (1 + start / TAU0), D0, G0, TAU0), rel=1e-10)
+    assert theory.udsbm_increment_msd(lag, 0.0, D0, G0, TAU0, v0_sq=v0) == pytest.approx(
+        theory.msd_udsbm(lag, D0, G0, TAU0, v0_sq=v0), rel=1e-10)
 
 
 def test_msd_limits_and_numerical_stability():
