@@ -143,10 +143,28 @@ static void spill(gr_cq *q)
     }
 }
 
-static int cmp_double(const void *a, const void *b)
+/* The k-th smallest of x[0 .. m-1] (k < m), reordering x: Hoare's selection, O(m) on
+ * average.  A full sort of the sample cost more than the rest of a rebuild at small N. */
+static double select_kth(double *x, int m, int k)
 {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
+    int lo = 0, hi = m - 1;
+    while (lo < hi) {
+        double pivot = x[lo + (hi - lo) / 2];
+        int a = lo, b = hi;
+        while (a <= b) {
+            while (x[a] < pivot) a++;
+            while (pivot < x[b]) b--;
+            if (a <= b) {
+                double t = x[a];
+                x[a++] = x[b];
+                x[b--] = t;
+            }
+        }
+        if (k <= b) hi = b;
+        else if (k >= a) lo = a;
+        else break; /* b < k < a: x[k] equals the pivot */
+    }
+    return x[k];
 }
 
 /* Start the calendar afresh at the smallest key, with a width from the keys' spread:
@@ -173,8 +191,9 @@ static void rebuild(gr_cq *q)
         for (int32_t id = 0; id < n && m < GR_CQ_SAMPLE; id += stride)
             if (isfinite(q->item[id].t)) sample[m++] = q->item[id].t - tmin;
         if (m > 0) {
-            qsort(sample, (size_t)m, sizeof *sample, cmp_double);
-            double spread = sample[m / 2] > 0.0 ? 2.0 * sample[m / 2] : sample[m - 1];
+            double median = select_kth(sample, m, m / 2), largest = sample[0];
+            for (int k = 1; k < m; k++) largest = sample[k] > largest ? sample[k] : largest;
+            double spread = median > 0.0 ? 2.0 * median : largest;
             w = GR_CQ_PER_BUCKET * spread / nf;
         }
     }
