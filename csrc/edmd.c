@@ -40,16 +40,22 @@
  * limit as _BIG_MAX in granular/scene.py). */
 #define GR_BIG_MAX 16
 
+/* Everything an event reads and writes about one particle besides its position record,
+ * in one cache line: at large N each separate array would be one more miss per event. */
 typedef struct {
     double t_coll;   /* predicted pair or wall collision, +inf if none */
     double t_cross;  /* next cell crossing, +inf if none */
+    double t_last;   /* time of this particle's last collision (TC model, collapse) */
+    int64_t count;   /* this particle's collisions, pair and wall */
     int64_t pcount;  /* partner's collision counter when predicted */
     int32_t partner; /* >= 0: particle; -1: none; <= -2: wall -(2 + 2*axis + side) */
-    int32_t cross;   /* 2*axis + (1 if moving up) */
     int32_t last;    /* partner of the last collision (a wall as in `partner`), -1 none */
-    double t_last;   /* time of this particle's last collision (TC model, collapse) */
-    int32_t streak;  /* consecutive collisions each within eps_t of the previous one */
+    int32_t c[3];    /* cell coordinates (the first dim used) */
+    int8_t cross;    /* 2*axis + (1 if moving up), -1 none */
+    int8_t streak;   /* consecutive collisions each within eps_t of the previous one,
+                      * saturating (only "more than GR_COLLAPSE_STREAK" matters) */
 } gr_event;
+typedef char gr_event_fills_one_line[sizeof(gr_event) == 64 ? 1 : -1];
 
 struct gr_edmd {
     gr_edmd_config cfg;
@@ -58,7 +64,6 @@ struct gr_edmd {
     double L[3];
     double *P;        /* n * stride, 64-byte aligned */
     double *mass;
-    int64_t *count;   /* collisions (pair and wall) per particle */
     int64_t *image;   /* n * dim periodic image counters */
     gr_event *ev;
     gr_cq queue;
@@ -74,7 +79,6 @@ struct gr_edmd {
     int nc[3];
     double w[3];
     int32_t ncells;
-    int32_t *cc;          /* n * dim cell coordinates */
     int32_t *head, *next, *prev;
     /* One bit per cell, set iff the cell holds a particle.  Most cells of a dilute gas
      * are empty (cells are one diameter wide: ~8 per particle at packing 0.065), and at
@@ -178,14 +182,12 @@ void gr_edmd_free(gr_edmd *s)
     if (!s) return;
     free(s->P);
     free(s->mass);
-    free(s->count);
     free(s->image);
     free(s->ev);
     free(s->id_of);
     free(s->is_big);
     free(s->scratch);
     gr_cq_free(&s->queue);
-    free(s->cc);
     free(s->head);
     free(s->occ);
     free(s->next);
@@ -433,17 +435,15 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     size_t bytes = ((size_t)n * s->stride * sizeof(double) + 63) / 64 * 64;
     s->P = gr_big_alloc(bytes); /* records on cache-line boundaries: a 3D record is one line */
     s->mass = gr_big_alloc((size_t)n * sizeof *s->mass);
-    s->count = gr_big_alloc((size_t)n * sizeof *s->count);
     s->image = calloc((size_t)n * d, sizeof *s->image);
     s->ev = gr_big_alloc((size_t)n * sizeof *s->ev);
-    s->cc = gr_big_alloc((size_t)n * d * sizeof *s->cc);
     s->next = gr_big_alloc((size_t)n * sizeof *s->next);
     s->prev = gr_big_alloc((size_t)n * sizeof *s->prev);
     s->id_of = malloc((size_t)n * sizeof *s->id_of);
     s->is_big = calloc((size_t)n, sizeof *s->is_big);
     if (n >= GR_REORDER_MIN_N) s->scratch = malloc((size_t)n * s->stride * sizeof(double));
     int status = GR_OK;
-    if (!s->P || !s->mass || !s->count || !s->image || !s->ev || !s->cc || !s->next || !s->prev ||
+    if (!s->P || !s->mass || !s->image || !s->ev || !s->next || !s->prev ||
         !s->id_of || !s->is_big || (n >= GR_REORDER_MIN_N && !s->scratch))
         status = GR_ERR_NOMEM;
     if (status == GR_OK) status = gr_cq_init(&s->queue, n);
@@ -465,9 +465,8 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         p[2 * d] = 0.0;
         p[2 * d + 1] = radius[i];
         s->mass[i] = mass[i];
-        s->count[i] = 0;
         msum += mass[i];
-        s->ev[i] = (gr_event){.t_coll = INFINITY, .t_cross = INFINITY, .pcount = 0, .partner = -1,
+        s->ev[i] = (gr_event){.t_coll = INFINITY, .t_cross = INFINITY, .count = 0, .pcount = 0, .partner = -1,
                               .cross = -1, .t_last = -INFINITY, .streak = 0, .last = -1};
         s->id_of[i] = i;
     }
@@ -505,7 +504,7 @@ static int reorder(gr_edmd *s)
     }
     for (int32_t i = 0; i < n; i++) {
         int32_t c = 0;
-        for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->cc[(size_t)i * d + a];
+        for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->ev[i].c[a];
         newpos[i] = c; /* the cell, for now */
         start[c + 1]++;
     }
@@ -523,9 +522,7 @@ static int reorder(gr_edmd *s)
     } while (0)
     PERMUTE(s->P, double, (size_t)s->stride);
     PERMUTE(s->mass, double, 1);
-    PERMUTE(s->count, int64_t, 1);
     PERMUTE(s->image, int64_t, (size_t)d);
-    PERMUTE(s->cc, int32_t, (size_t)d);
     PERMUTE(s->id_of, int32_t, 1);
     PERMUTE(s->is_big, uint8_t, 1);
 #undef PERMUTE
@@ -555,7 +552,7 @@ static int reorder(gr_edmd *s)
     for (int32_t i = n - 1; i >= 0; i--) { /* lists in increasing index order */
         if (s->is_big[i]) continue;
         int32_t c = 0;
-        for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->cc[(size_t)i * d + a];
+        for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->ev[i].c[a];
         cell_insert(s, i, c);
     }
     s->next_reorder = s->events + (int64_t)GR_REORDER_EVENTS_PER_N * n;

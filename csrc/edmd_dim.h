@@ -70,8 +70,6 @@ static inline void FN(prefetch)(const gr_edmd *s, int32_t i)
 {
     GR_PREFETCH(rec(s, i));
     GR_PREFETCH(&s->ev[i]);
-    GR_PREFETCH(s->cc + (size_t)i * DIM);
-    GR_PREFETCH(&s->count[i]);
     GR_PREFETCH(&s->next[i]);
     GR_PREFETCH(&s->prev[i]);
     gr_cq_prefetch(&s->queue, i);
@@ -148,7 +146,7 @@ static void FN(scan_block)(const gr_edmd *s, int32_t i, int axis, int dir, doubl
                            int32_t *partner)
 {
     const double *p = rec(s, i);
-    const int32_t *c = s->cc + (size_t)i * DIM;
+    const int32_t *c = s->ev[i].c;
     int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int a = 0; a < DIM; a++) {
         int32_t reach = (int32_t)ceil((R(p) + s->r_small) / s->w[a]);
@@ -186,7 +184,7 @@ static void FN(scan_block)(const gr_edmd *s, int32_t i, int axis, int dir, doubl
 static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
 {
     const double *p = rec(s, i);
-    const int32_t *c = s->cc + (size_t)i * DIM;
+    const int32_t *c = s->ev[i].c;
     gr_event *e = &s->ev[i];
     double best = e->t_coll - T(p);
     int32_t partner = -1;
@@ -220,7 +218,7 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
     if (partner >= 0) {
         e->t_coll = T(p) + best;
         e->partner = partner;
-        e->pcount = s->count[partner];
+        e->pcount = s->ev[partner].count;
     }
 }
 
@@ -228,7 +226,7 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
 static inline void FN(predict_cross)(gr_edmd *s, int32_t i)
 {
     const double *p = rec(s, i);
-    const int32_t *c = s->cc + (size_t)i * DIM;
+    const int32_t *c = s->ev[i].c;
     double best = INFINITY;
     int32_t code = -1;
     for (int a = 0; a < DIM; a++) {
@@ -250,7 +248,7 @@ static inline void FN(predict_cross)(gr_edmd *s, int32_t i)
         }
     }
     s->ev[i].t_cross = T(p) + best;
-    s->ev[i].cross = code;
+    s->ev[i].cross = (int8_t)code;
 }
 
 static inline void FN(schedule)(gr_edmd *s, int32_t i)
@@ -296,7 +294,7 @@ static void FN(predict)(gr_edmd *s, int32_t i)
 static inline int FN(streak)(gr_edmd *s, int32_t i, double t)
 {
     gr_event *e = &s->ev[i];
-    if (t - e->t_last <= s->eps_t) e->streak++;
+    if (t - e->t_last <= s->eps_t) e->streak += e->streak < INT8_MAX;
     else e->streak = 0;
     e->t_last = t;
     return e->streak > GR_COLLAPSE_STREAK;
@@ -306,7 +304,7 @@ static int FN(do_cross)(gr_edmd *s, int32_t i, double t)
 {
     double *p = rec(s, i);
     gr_event *e = &s->ev[i];
-    int32_t *c = s->cc + (size_t)i * DIM;
+    int32_t *c = s->ev[i].c;
     const int a = e->cross >> 1, dir = (e->cross & 1) ? 1 : -1;
     FN(move)(p, t);
     int32_t old = FN(cell_of)(s, c);
@@ -371,8 +369,8 @@ static int FN(do_pair)(gr_edmd *s, int32_t i, int32_t j, double t, gr_error *err
     s->kinetic += FN(kinetic_of)(s, i) + FN(kinetic_of)(s, j) - before;
     s->virial += vir;
     s->pair++;
-    s->count[i]++;
-    s->count[j]++;
+    s->ev[i].count++;
+    s->ev[j].count++;
     int collapse_i = FN(streak)(s, i, t), collapse_j = FN(streak)(s, j, t);
     s->ev[i].last = j;
     s->ev[j].last = i;
@@ -411,7 +409,7 @@ static int FN(do_wall)(gr_edmd *s, int32_t i, int wall, double t, gr_error *err)
     s->wall_impulse += s->mass[i] * (fabs(vn) + fabs(V(p)[a]));
     s->kinetic += FN(kinetic_of)(s, i) - before;
     s->wall++;
-    s->count[i]++;
+    s->ev[i].count++;
     s->ev[i].last = -2 - wall;
     if (FN(streak)(s, i, t)) {
         gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), -1, t, (double)GR_COLLAPSE_STREAK,
@@ -458,7 +456,7 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
     const int32_t n = s->n;
     for (int32_t i = 0; i < n; i++) {
         const double *p = rec(s, i);
-        int32_t *c = s->cc + (size_t)i * DIM;
+        int32_t *c = s->ev[i].c;
         for (int a = 0; a < DIM; a++) {
             double f = floor((X(p)[a] - s->cfg.lo[a]) / s->w[a]);
             int32_t q = f < 0.0 ? 0 : f >= s->nc[a] ? s->nc[a] - 1 : (int32_t)f;
@@ -494,7 +492,7 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
     FN(nbr) nb[DIM == 3 ? 27 : 9];
     for (int32_t i = 0; i < n; i++) {
         const double *p = rec(s, i);
-        int count = FN(neighbours)(s, s->cc + (size_t)i * DIM, -1, 0, nb);
+        int count = FN(neighbours)(s, s->ev[i].c, -1, 0, nb);
         for (int k = 0; k < count; k++) {
             for (int32_t j = s->head[nb[k].cell]; j >= 0; j = s->next[j]) {
                 if (j <= i) continue;
@@ -571,7 +569,7 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
         if (e->t_cross < e->t_coll) {
             status = FN(do_cross)(s, i, te);
         } else if (e->partner >= 0) {
-            if (s->count[e->partner] != e->pcount) { /* partner collided since: stale */
+            if (s->ev[e->partner].count != e->pcount) { /* partner collided since: stale */
                 s->invalid++;
                 FN(move)(rec(s, i), te);
                 FN(predict)(s, i);
