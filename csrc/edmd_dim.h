@@ -17,35 +17,37 @@ typedef struct {
     double shift[DIM];
 } FN(nbr);
 
-/* The cells adjacent to cell coordinates c (itself included), with the image shift to add
- * to positions found there.  With axis >= 0 only the layer at offset dir along that axis
- * (the cells that become adjacent when crossing in that direction).  Returns the count. */
+/* The occupied cells adjacent to cell coordinates c (itself included), with the image
+ * shift to add to positions found there.  With axis >= 0 only the layer at offset dir
+ * along that axis (the cells that become adjacent when crossing in that direction).
+ * Returns the count.  The general way, for cells at the box edge. */
 static inline int FN(neighbours)(const gr_edmd *s, const int32_t *c, int axis, int dir,
                                  FN(nbr) *out)
 {
-    int k = 0;
+    int lo[3], hi[3], k = 0;
+    for (int a = 0; a < 3; a++) {
+        lo[a] = a == axis ? dir : -1;
+        hi[a] = a == axis ? dir : 1;
+    }
 #if DIM == 3
-    for (int d2 = -1; d2 <= 1; d2++) {
-        if (axis == 2 && d2 != dir) continue;
-        int32_t q2 = s->nb_cell[2][3 * c[2] + d2 + 1];
+    for (int d2 = lo[2]; d2 <= hi[2]; d2++) {
+        const int32_t q2 = s->nb_cell[2][3 * c[2] + d2 + 1];
         if (q2 < 0) continue;
-        double sh2 = s->nb_shift[2][3 * c[2] + d2 + 1];
+        const double sh2 = s->nb_shift[2][3 * c[2] + d2 + 1];
 #else
     {
         const int32_t q2 = 0;
 #endif
-        for (int d1 = -1; d1 <= 1; d1++) {
-            if (axis == 1 && d1 != dir) continue;
-            int32_t q1 = s->nb_cell[1][3 * c[1] + d1 + 1];
+        for (int d1 = lo[1]; d1 <= hi[1]; d1++) {
+            const int32_t q1 = s->nb_cell[1][3 * c[1] + d1 + 1];
             if (q1 < 0) continue;
-            double sh1 = s->nb_shift[1][3 * c[1] + d1 + 1];
-            for (int d0 = -1; d0 <= 1; d0++) {
-                if (axis == 0 && d0 != dir) continue;
-                int32_t q0 = s->nb_cell[0][3 * c[0] + d0 + 1];
-                if (q0 < 0) continue;
-                out[k].cell = (q2 * s->nc[1] + q1) * s->nc[0] + q0;
+            const int32_t row = (q2 * s->nc[1] + q1) * s->nc[0];
+            for (int d0 = lo[0]; d0 <= hi[0]; d0++) {
+                const int32_t q0 = s->nb_cell[0][3 * c[0] + d0 + 1];
+                if (q0 < 0 || !cell_occupied(s, row + q0)) continue;
+                out[k].cell = row + q0;
                 out[k].shift[0] = s->nb_shift[0][3 * c[0] + d0 + 1];
-                out[k].shift[1] = sh1;
+                out[k].shift[1] = s->nb_shift[1][3 * c[1] + d1 + 1];
 #if DIM == 3
                 out[k].shift[2] = sh2;
 #endif
@@ -211,8 +213,7 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
         FN(nbr) nb[DIM == 3 ? 27 : 9];
         int count = FN(neighbours)(s, c, axis, dir, nb);
         for (int k = 0; k < count; k++)
-            if (cell_occupied(s, nb[k].cell))
-                FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
+            FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
     }
     for (int32_t b = 0; b < s->n_big; b++) FN(scan_one)(s, i, p, s->big[b], &best, &partner);
     if (partner >= 0) {
