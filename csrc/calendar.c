@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200112L /* posix_memalign */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "calendar.h"
 #include "common.h"
@@ -199,7 +200,7 @@ static void rebuild(gr_cq *q)
     }
     q->inv_w = 1.0 / w;
     if (!(w > 0.0) || !isfinite(q->inv_w)) q->inv_w = 1.0; /* all keys equal: any width */
-    for (int32_t b = 0; b < q->nb; b++) q->head[b] = -1;
+    memset(q->head, 0xff, (size_t)q->nb * sizeof *q->head); /* every byte 0xff: -1 */
     q->over = -1;
     q->n_list = q->n_over = 0;
     q->n_near = 0;
