@@ -466,8 +466,9 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         p[2 * d + 1] = radius[i];
         s->mass[i] = mass[i];
         msum += mass[i];
-        s->ev[i] = (gr_event){.t_coll = INFINITY, .t_cross = INFINITY, .count = 0, .pcount = 0, .partner = -1,
-                              .cross = -1, .t_last = -INFINITY, .streak = 0, .last = -1};
+        s->ev[i] = (gr_event){.t_coll = INFINITY, .t_cross = INFINITY, .t_last = -INFINITY,
+                              .count = 0, .pcount = 0, .partner = -1, .last = -1, .cross = -1,
+                              .streak = 0};
         s->id_of[i] = i;
     }
     s->kinetic = 0.5 * v2m;
