@@ -254,7 +254,7 @@ void gr_cq_update(gr_cq *q, int32_t id, double t)
     else if (t != INFINITY) place(q, id);
 }
 
-int32_t gr_cq_top(gr_cq *q, double *t)
+int32_t gr_cq_top_slow(gr_cq *q, double *t)
 {
     if (q->nan_id >= 0) {
         *t = NAN;

@@ -57,9 +57,20 @@ int gr_cq_init(gr_cq *q, int32_t n);
 void gr_cq_free(gr_cq *q);
 /* Set the key of id (+inf: no event). */
 void gr_cq_update(gr_cq *q, int32_t id, double t);
+/* gr_cq_top when the near heap is empty, a NaN key is pending or a rebuild is due. */
+int32_t gr_cq_top_slow(gr_cq *q, double *t);
+
 /* The id with the smallest key (-1 if every key is +inf) and that key in *t; a NaN key
- * comes first.  Does not remove it, but may move the calendar forward or rebuild it. */
-int32_t gr_cq_top(gr_cq *q, double *t);
+ * comes first.  Does not remove it, but may move the calendar forward or rebuild it.
+ * Inline for the common case, the root of a non-empty near heap. */
+static inline int32_t gr_cq_top(gr_cq *q, double *t)
+{
+    if (q->n_near > 0 && q->nan_id < 0 && q->changes < q->rebuild_at) {
+        *t = q->near[0].t;
+        return q->near[0].id;
+    }
+    return gr_cq_top_slow(q, t);
+}
 /* The id most likely to be on top once the current top's key has changed (the
  * runner-up of the near heap, or the first id of the next bucket), -1 if none at hand:
  * a hint for prefetching, no promise. */

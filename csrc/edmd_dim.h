@@ -191,7 +191,8 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
     double best = e->t_coll - T(p);
     int32_t partner = -1;
     int interior = 1;
-    for (int a = 0; a < DIM; a++) interior &= (c[a] >= 1) & (c[a] <= s->nc[a] - 2);
+    for (int a = 0; a < DIM; a++) /* 1 <= c[a] <= nc[a] - 2, in one unsigned comparison */
+        interior &= (uint32_t)(c[a] - 1) < (uint32_t)(s->nc[a] - 2);
     if (s->n_big && s->is_big[i]) {
         FN(scan_block)(s, i, axis, dir, &best, &partner);
     } else if (interior) {
@@ -518,13 +519,27 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
     return GR_OK;
 }
 
+/* The time of the next sample due, +inf if none. */
+static inline double FN(next_sample)(const gr_edmd_samples *smp)
+{
+    return smp && smp->next < smp->count ? smp->times[smp->next] : INFINITY;
+}
+
 static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
     const double t_stop = stop->t_stop;
     const int64_t n = s->n;
+    const double collisions = stop->collisions_per_particle * (double)n;
+    const double kinetic = stop->kinetic_energy * (double)n;
     /* events at one instant beyond this are a pile-up (every particle crossing a cell
      * wall at once, as a moving lattice does, is still well below it) */
     const int64_t pileup = 16 * n + 1000;
+    /* Before this time no sample is due and the run does not stop for time: most events
+     * then need one comparison for both. */
+    double t_gate = fmin(FN(next_sample)(smp), t_stop);
+    /* The collision and energy criteria change only with a collision; they are tested
+     * after the first event of the call and after every collision. */
+    int check = 1;
     for (int64_t k = 0;; k++) {
         if (k >= stop->max_events) return GR_STOP_BUDGET;
         if (s->scratch && s->events >= s->next_reorder) {
@@ -537,17 +552,20 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
             gr_error_set(err, GR_ERR_NONFINITE, uid(s, i), -1, s->t, te, "an event time");
             return GR_ERR_NONFINITE;
         }
-        while (smp && smp->next < smp->count && smp->times[smp->next] <= te &&
-               smp->times[smp->next] <= t_stop) {
-            double ts = smp->times[smp->next];
-            FN(write_sample)(s, smp, ts);
-            set_clock(s, ts);
+        if (te >= t_gate) {
+            while (smp && smp->next < smp->count && smp->times[smp->next] <= te &&
+                   smp->times[smp->next] <= t_stop) {
+                double ts = smp->times[smp->next];
+                FN(write_sample)(s, smp, ts);
+                set_clock(s, ts);
+            }
+            if (te > t_stop) {
+                set_clock(s, t_stop);
+                return GR_STOP_TIME;
+            }
+            if (te == INFINITY) return GR_STOP_IDLE;
+            t_gate = fmin(FN(next_sample)(smp), t_stop);
         }
-        if (te > t_stop) {
-            set_clock(s, t_stop);
-            return GR_STOP_TIME;
-        }
-        if (te == INFINITY) return GR_STOP_IDLE;
         if (te <= s->t_prev_event) {
             if (++s->same_instant > pileup) {
                 gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), uid(s, s->ev[i].partner), te, (double)pileup,
@@ -577,13 +595,17 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
                 continue;
             }
             status = FN(do_pair)(s, i, e->partner, te, err);
+            check = 1;
         } else {
             status = FN(do_wall)(s, i, -2 - e->partner, te, err);
+            check = 1;
         }
         if (status != GR_OK) return status;
-        if ((double)(2 * s->pair + s->wall) >= stop->collisions_per_particle * (double)n)
-            return GR_STOP_COLLISIONS;
-        if (s->kinetic <= stop->kinetic_energy * (double)n) return GR_STOP_ENERGY;
+        if (check) {
+            check = 0;
+            if ((double)(2 * s->pair + s->wall) >= collisions) return GR_STOP_COLLISIONS;
+            if (s->kinetic <= kinetic) return GR_STOP_ENERGY;
+        }
     }
 }
 
