@@ -227,27 +227,23 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
 /* Next cell crossing of i from its current position, cell and velocity. */
 static inline void FN(predict_cross)(gr_edmd *s, int32_t i)
 {
+    /* Without branches on the signs of the velocity: they differ from one event to the
+     * next at random, and a mispredicted branch costs more than the arithmetic. */
     const double *p = rec(s, i);
     const int32_t *c = s->ev[i].c;
     double best = INFINITY;
     int32_t code = -1;
     for (int a = 0; a < DIM; a++) {
-        double v = V(p)[a], bound;
-        if (v > 0.0) {
-            if (!s->cfg.periodic && c[a] == s->nc[a] - 1) continue;
-            bound = s->cfg.lo[a] + (c[a] + 1) * s->w[a];
-        } else if (v < 0.0) {
-            if (!s->cfg.periodic && c[a] == 0) continue;
-            bound = s->cfg.lo[a] + c[a] * s->w[a];
-        } else {
-            continue;
-        }
-        double dt = (bound - X(p)[a]) / v;
-        if (dt < 0.0) dt = 0.0; /* rounding left it a hair past the boundary */
-        if (dt < best) {
-            best = dt;
-            code = 2 * a + (v > 0.0);
-        }
+        const double v = V(p)[a];
+        const int up = v > 0.0;
+        /* a wall has no cell behind it */
+        const int open = s->cfg.periodic | (up & (c[a] < s->nc[a] - 1)) | (!up & (c[a] > 0));
+        const double bound = s->cfg.lo[a] + (c[a] + up) * s->w[a];
+        double dt = (bound - X(p)[a]) / (v != 0.0 ? v : 1.0);
+        dt = dt < 0.0 ? 0.0 : dt; /* rounding left it a hair past the boundary */
+        dt = (v != 0.0) & open ? dt : INFINITY;
+        code = dt < best ? 2 * a + up : code;
+        best = dt < best ? dt : best;
     }
     s->ev[i].t_cross = T(p) + best;
     s->ev[i].cross = (int8_t)code;
