@@ -80,6 +80,7 @@ struct gr_edmd {
     double w[3];
     int32_t ncells;
     int32_t *head, *next, *prev;
+    int prefetch_heads;   /* the heads take more than GR_HEADS_CACHED bytes */
     /* One bit per cell, set iff the cell holds a particle.  Most cells of a dilute gas
      * are empty (cells are one diameter wide: ~8 per particle at packing 0.065), and at
      * large N the head array is far out of cache; the bits are 32 times smaller, so a
@@ -117,6 +118,12 @@ struct gr_edmd {
  * the cache anyway and skip it. */
 #define GR_REORDER_MIN_N 4096
 #define GR_REORDER_EVENTS_PER_N 16
+
+/* Cell heads beyond this many bytes are taken as out of cache, and scans ask for the
+ * occupied cells' heads ahead.  In cache the extra loop only costs (cachegrind, 2D
+ * N = 1e4 with 196 kB of heads: 0.4 fewer mispredicted branches per event without it);
+ * at 3D N = 1e5 (3.2 MB) it saves time. */
+#define GR_HEADS_CACHED ((size_t)1 << 20)
 
 /* Prefetching: at large N the particle an event touches is a cache miss in every
  * per-particle array; asking for them one event ahead (and for a pair's partner before
@@ -294,6 +301,7 @@ static int build_grid(gr_edmd *s, double sigma_max, gr_error *err)
         s->ncells *= s->nc[a];
     }
     s->head = gr_big_alloc((size_t)s->ncells * sizeof *s->head);
+    s->prefetch_heads = (size_t)s->ncells * sizeof *s->head > GR_HEADS_CACHED;
     s->occ = calloc(((size_t)s->ncells + 63) / 64, sizeof *s->occ);
     if (!s->head || !s->occ) return GR_ERR_NOMEM;
     for (int32_t c = 0; c < s->ncells; c++) s->head[c] = -1;

@@ -20,42 +20,43 @@ typedef struct {
 /* The occupied cells adjacent to cell coordinates c (itself included), with the image
  * shift to add to positions found there.  With axis >= 0 only the layer at offset dir
  * along that axis (the cells that become adjacent when crossing in that direction).
- * Returns the count.  The general way, for cells at the box edge. */
+ * Returns the count.  The general way, for cells at the box edge: every candidate cell
+ * is looked at in a loop of fixed length and kept or not without a branch, because
+ * which of them are occupied, or beyond a wall, is as good as random. */
 static inline int FN(neighbours)(const gr_edmd *s, const int32_t *c, int axis, int dir,
                                  FN(nbr) *out)
 {
-    int lo[3], hi[3], k = 0;
-    for (int a = 0; a < 3; a++) {
-        lo[a] = a == axis ? dir : -1;
-        hi[a] = a == axis ? dir : 1;
-    }
+    /* the offsets along each axis: -1, 0, 1, or along `axis` only dir (three times) */
+    int d[3][3];
+    for (int a = 0; a < 3; a++)
+        for (int k = 0; k < 3; k++) d[a][k] = a == axis ? dir : k - 1;
+    const int n2 = DIM == 3 && axis != 2 ? 3 : 1, n1 = axis != 1 ? 3 : 1, n0 = axis != 0 ? 3 : 1;
+    int m = 0;
+    for (int k2 = 0; k2 < n2; k2++) {
 #if DIM == 3
-    for (int d2 = lo[2]; d2 <= hi[2]; d2++) {
-        const int32_t q2 = s->nb_cell[2][3 * c[2] + d2 + 1];
-        if (q2 < 0) continue;
-        const double sh2 = s->nb_shift[2][3 * c[2] + d2 + 1];
+        const int32_t q2 = s->nb_cell[2][3 * c[2] + d[2][k2] + 1];
+        const double sh2 = s->nb_shift[2][3 * c[2] + d[2][k2] + 1];
 #else
-    {
         const int32_t q2 = 0;
 #endif
-        for (int d1 = lo[1]; d1 <= hi[1]; d1++) {
-            const int32_t q1 = s->nb_cell[1][3 * c[1] + d1 + 1];
-            if (q1 < 0) continue;
-            const int32_t row = (q2 * s->nc[1] + q1) * s->nc[0];
-            for (int d0 = lo[0]; d0 <= hi[0]; d0++) {
-                const int32_t q0 = s->nb_cell[0][3 * c[0] + d0 + 1];
-                if (q0 < 0 || !cell_occupied(s, row + q0)) continue;
-                out[k].cell = row + q0;
-                out[k].shift[0] = s->nb_shift[0][3 * c[0] + d0 + 1];
-                out[k].shift[1] = s->nb_shift[1][3 * c[1] + d1 + 1];
+        for (int k1 = 0; k1 < n1; k1++) {
+            const int32_t q1 = s->nb_cell[1][3 * c[1] + d[1][k1] + 1];
+            const double sh1 = s->nb_shift[1][3 * c[1] + d[1][k1] + 1];
+            for (int k0 = 0; k0 < n0; k0++) {
+                const int32_t q0 = s->nb_cell[0][3 * c[0] + d[0][k0] + 1];
+                const int inside = (q0 >= 0) & (q1 >= 0) & (q2 >= 0); /* not beyond a wall */
+                const int32_t cell = inside ? (q2 * s->nc[1] + q1) * s->nc[0] + q0 : 0;
+                out[m].cell = cell;
+                out[m].shift[0] = s->nb_shift[0][3 * c[0] + d[0][k0] + 1];
+                out[m].shift[1] = sh1;
 #if DIM == 3
-                out[k].shift[2] = sh2;
+                out[m].shift[2] = sh2;
 #endif
-                k++;
+                m += inside & cell_occupied(s, cell);
             }
         }
     }
-    return k;
+    return m;
 }
 
 static inline int32_t FN(cell_of)(const gr_edmd *s, const int32_t *c)
@@ -199,8 +200,10 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
         const int32_t base = FN(cell_of)(s, c);
         const int32_t *off = axis < 0 ? s->off_all : s->off_layer[2 * axis + (dir > 0)];
         const int count = axis < 0 ? (DIM == 3 ? 27 : 9) : (DIM == 3 ? 9 : 3);
-        /* the occupied cells' heads first, all at once: at large N they are misses,
-         * and the chained loads of the scan would otherwise wait for them one by one */
+        /* in a grid too large for the cache, the occupied cells' heads first, all at
+         * once: they are misses, and the chained loads of the scan would otherwise wait
+         * for them one by one (in a small grid the loop costs more than it saves: its
+         * length, the number of occupied cells, is a branch mispredicted often) */
         int32_t full[27];
         int m = 0;
         for (int k = 0; k < count; k++) {
@@ -208,7 +211,8 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
             full[m] = cell;
             m += cell_occupied(s, cell);
         }
-        for (int k = 0; k < m; k++) GR_PREFETCH(&s->head[full[k]]);
+        if (s->prefetch_heads)
+            for (int k = 0; k < m; k++) GR_PREFETCH(&s->head[full[k]]);
         for (int k = 0; k < m; k++) FN(scan_cell)(s, i, p, full[k], NULL, &best, &partner);
     } else {
         FN(nbr) nb[DIM == 3 ? 27 : 9];
@@ -242,8 +246,9 @@ static inline void FN(predict_cross)(gr_edmd *s, int32_t i)
         double dt = (bound - X(p)[a]) / (v != 0.0 ? v : 1.0);
         dt = dt < 0.0 ? 0.0 : dt; /* rounding left it a hair past the boundary */
         dt = (v != 0.0) & open ? dt : INFINITY;
-        code = dt < best ? 2 * a + up : code;
-        best = dt < best ? dt : best;
+        const int32_t earlier = dt < best;
+        code += earlier * (2 * a + up - code); /* arithmetic: a select compiles to a branch */
+        best = earlier ? dt : best;
     }
     s->ev[i].t_cross = T(p) + best;
     s->ev[i].cross = (int8_t)code;
