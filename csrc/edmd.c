@@ -72,7 +72,7 @@ struct gr_edmd {
     int32_t n_big;
     int32_t big[GR_BIG_MAX]; /* the big particles' internal indices */
     double r_small;   /* largest radius among the particles in the cell lists */
-    void *scratch;    /* n * stride doubles, for reordering */
+    void *scratch;    /* room for n records or n events, for reordering */
     int64_t next_reorder;
 
     /* cell grid */
@@ -146,6 +146,21 @@ static inline void set_clock(gr_edmd *s, double t)
 }
 
 static inline double *rec(const gr_edmd *s, int32_t i) { return s->P + (size_t)i * s->stride; }
+
+/* The linear index of the cell at coordinates c (cell_of in edmd_dim.h, for any dim). */
+static inline int32_t cell_index(const gr_edmd *s, const int32_t *c)
+{
+    int32_t k = 0;
+    for (int a = s->dim - 1; a >= 0; a--) k = k * s->nc[a] + c[a];
+    return k;
+}
+
+/* The separation d along an axis of periodic length L seen through the nearest image
+ * (|d| < 3L/2, as between particles in the box). */
+static inline double nearest_image(double d, double L)
+{
+    return d > 0.5 * L ? d - L : d < -0.5 * L ? d + L : d;
+}
 
 /* The caller's index of internal particle i (negative codes pass through). */
 static inline int64_t uid(const gr_edmd *s, int32_t i) { return i < 0 ? -1 : s->id_of[i]; }
@@ -449,7 +464,9 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->prev = gr_big_alloc((size_t)n * sizeof *s->prev);
     s->id_of = malloc((size_t)n * sizeof *s->id_of);
     s->is_big = calloc((size_t)n, sizeof *s->is_big);
-    if (n >= GR_REORDER_MIN_N) s->scratch = malloc((size_t)n * s->stride * sizeof(double));
+    const size_t per = (size_t)s->stride * sizeof(double) > sizeof(gr_event)
+                           ? (size_t)s->stride * sizeof(double) : sizeof(gr_event);
+    if (n >= GR_REORDER_MIN_N) s->scratch = malloc((size_t)n * per);
     int status = GR_OK;
     if (!s->P || !s->mass || !s->image || !s->ev || !s->next || !s->prev ||
         !s->id_of || !s->is_big || (n >= GR_REORDER_MIN_N && !s->scratch))
@@ -512,8 +529,7 @@ static int reorder(gr_edmd *s)
         return GR_ERR_NOMEM;
     }
     for (int32_t i = 0; i < n; i++) {
-        int32_t c = 0;
-        for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->ev[i].c[a];
+        const int32_t c = cell_index(s, s->ev[i].c);
         newpos[i] = c; /* the cell, for now */
         start[c + 1]++;
     }
@@ -536,23 +552,15 @@ static int reorder(gr_edmd *s)
     PERMUTE(s->is_big, uint8_t, 1);
 #undef PERMUTE
     for (int32_t b = 0; b < s->n_big; b++) s->big[b] = newpos[s->big[b]];
-    /* gr_event is larger than a record in 2D; permute it through the event array itself
-     * by cycles would be slower to read; use the scratch in two halves if needed. */
     {
-        size_t ev_bytes = (size_t)n * sizeof(gr_event);
-        gr_event *tmp = ev_bytes <= (size_t)n * s->stride * sizeof(double) ? s->scratch : malloc(ev_bytes);
-        if (!tmp) {
-            free(newpos);
-            return GR_ERR_NOMEM;
-        }
+        gr_event *tmp = s->scratch;
         for (int32_t i = 0; i < n; i++) {
             gr_event e = s->ev[i];
             if (e.partner >= 0) e.partner = newpos[e.partner];
             if (e.last >= 0) e.last = newpos[e.last];
             tmp[newpos[i]] = e;
         }
-        memcpy(s->ev, tmp, ev_bytes);
-        if (tmp != s->scratch) free(tmp);
+        memcpy(s->ev, tmp, (size_t)n * sizeof *tmp);
     }
     gr_cq_renumber(&s->queue, newpos);
     free(newpos);
@@ -560,9 +568,7 @@ static int reorder(gr_edmd *s)
     memset(s->occ, 0, ((size_t)s->ncells + 63) / 64 * sizeof *s->occ);
     for (int32_t i = n - 1; i >= 0; i--) { /* lists in increasing index order */
         if (s->is_big[i]) continue;
-        int32_t c = 0;
-        for (int a = d - 1; a >= 0; a--) c = c * s->nc[a] + s->ev[i].c[a];
-        cell_insert(s, i, c);
+        cell_insert(s, i, cell_index(s, s->ev[i].c));
     }
     s->next_reorder = s->events + (int64_t)GR_REORDER_EVENTS_PER_N * n;
     return GR_OK;

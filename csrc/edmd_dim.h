@@ -130,10 +130,7 @@ static inline void FN(scan_one)(const gr_edmd *s, int32_t i, const double *p, in
     double dtj = T(p) - T(q), dr[DIM], dv[DIM];
     for (int a = 0; a < DIM; a++) {
         dr[a] = X(q)[a] + V(q)[a] * dtj - X(p)[a];
-        if (s->cfg.periodic) {
-            if (dr[a] > 0.5 * s->L[a]) dr[a] -= s->L[a];
-            else if (dr[a] < -0.5 * s->L[a]) dr[a] += s->L[a];
-        }
+        if (s->cfg.periodic) dr[a] = nearest_image(dr[a], s->L[a]);
         dv[a] = V(q)[a] - V(p)[a];
     }
     double dt;
@@ -351,10 +348,8 @@ static int FN(do_pair)(gr_edmd *s, int32_t i, int32_t j, double t, gr_error *err
     double dr[DIM];
     for (int a = 0; a < DIM; a++) {
         dr[a] = X(q)[a] - X(p)[a];
-        if (s->cfg.periodic) { /* contact distance < L/2, so the nearest image is the one */
-            if (dr[a] > 0.5 * s->L[a]) dr[a] -= s->L[a];
-            else if (dr[a] < -0.5 * s->L[a]) dr[a] += s->L[a];
-        }
+        /* contact distance < L/2, so the nearest image is the one */
+        if (s->cfg.periodic) dr[a] = nearest_image(dr[a], s->L[a]);
     }
     double xi = s->cfg.restitution;
     if (s->cfg.contact_duration > 0.0 && xi < 1.0 &&
@@ -479,7 +474,7 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
             double d2 = 0.0;
             for (int a = 0; a < DIM; a++) {
                 double d = X(q)[a] - X(p)[a];
-                if (s->cfg.periodic) d -= s->L[a] * nearbyint(d / s->L[a]);
+                if (s->cfg.periodic) d = nearest_image(d, s->L[a]);
                 d2 += d * d;
             }
             double sigma = (R(p) + R(q)) * (1.0 - 1e-10);
