@@ -227,20 +227,21 @@ def udsbm_increment_msd(lag, start, D0, gamma0, tau0, dim=3, v0_sq=None):
     Per dimension, with w = 1 + start/tau0, W = 1 + (start + lag)/tau0, a = gamma0 tau0 and
     vc = ``udsbm_v0_sq``: the mean squared velocity is ``vc / w^2 + (v0_sq - vc) / w^(2a)``
     and ``<v(s) v(s')> = <v^2>(s) (w / w')^a`` (VACF 2.111 plus the start's transient);
-    integrated twice, ``2 tau0^2 / (a - 1) [vc (ln(W/w) - (1 - (w/W)^(a-1)) / (a - 1))
-    + (v0_sq - vc) ((W^(2-2a) - w^(2-2a)) / (2 - 2a) + (W^(1-a) - w^(1-a)) W^(1-a) /
-    (a - 1))]``.  ``v0_sq = None``: App. C's start (vc), whose increments scale:
+    integrated twice, with u = ln(W/w) and b = a - 1, ``2 tau0^2 vc (b u + exp(-b u) - 1)
+    / b^2 + (v0_sq - vc) (tau0 w^-b (1 - exp(-b u)) / b)^2``, evaluated without the
+    cancellation of W^x - w^x at lags short against tau0 + start (u = log1p(lag / (tau0 +
+    start))).  ``v0_sq = None``: App. C's start (vc), whose increments scale:
     ``msd_udsbm(lag / w)``.
     """
-    a = gamma0 * tau0
+    b = gamma0 * tau0 - 1.0
     vc = udsbm_v0_sq(D0, gamma0, tau0)
     v0_sq = vc if v0_sq is None else v0_sq
     start = np.asarray(start, dtype=np.float64)
-    w, W = 1.0 + start / tau0, 1.0 + (start + lag) / tau0
-    stationary = vc * (np.log(W / w) - (1.0 - (w / W) ** (a - 1)) / (a - 1))
-    transient = (v0_sq - vc) * ((W ** (2 - 2 * a) - w ** (2 - 2 * a)) / (2 - 2 * a)
-                                + (W ** (1 - a) - w ** (1 - a)) * W ** (1 - a) / (a - 1))
-    return dim * 2.0 * tau0**2 / (a - 1) * (stationary + transient)
+    w = 1.0 + start / tau0
+    u = np.log1p(np.asarray(lag, dtype=np.float64) / (tau0 + start))
+    stationary = 2.0 * tau0**2 * vc * _x_plus_expm1(b * u) / b**2
+    transient = (v0_sq - vc) * (tau0 * w ** (-b) * u * _one_minus_exp_over(b * u)) ** 2
+    return dim * (stationary + transient)
 
 
 def msd_ballistic(t, temperature, mass=1.0, dim=3):

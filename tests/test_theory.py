@@ -67,6 +67,20 @@ def test_udsbm_increment_msd_is_the_double_integral_over_its_window(start, lag):
         theory.msd_udsbm(lag, D0, G0, TAU0, v0_sq=v0), rel=1e-10)
 
 
+def test_udsbm_increment_msd_at_lags_short_against_the_start():
+    """Lags down to 1e-10 of tau0 + start, where differences of powers of 1 + t/tau0 would
+    cancel to nothing: the increments still scale as msd_udsbm(lag / w) (which has no such
+    difference) and are ballistic, <v^2>(start) lag^2, to the leading order (relative
+    error ~ lag gamma0)."""
+    for start in (10.0, 1e3):
+        w = 1 + start / TAU0
+        for lag in (1e-8, 1e-6, 1e-4):
+            got = theory.udsbm_increment_msd(lag, start, D0, G0, TAU0)
+            assert got == pytest.approx(theory.msd_udsbm(lag / w, D0, G0, TAU0), rel=1e-12)
+            v2 = theory.udsbm_v0_sq(D0, G0, TAU0) / w**2
+            assert got == pytest.approx(3 * v2 * lag**2, rel=2 * G0 * lag / w)
+
+
 def test_msd_limits_and_numerical_stability():
     t = np.array([1e-12, 1e-9, 1e-6])
     T0_m = D0 * G0
