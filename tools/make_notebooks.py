@@ -117,7 +117,9 @@ for xi in sweep:
     on_dask[xi] = granular.ensemble(make, runs=runs, seed=1, backend=client, t_stop=times[-1], sample_times=times, quantities=("msd",), progress=False)
 client.close()
 cluster.close()
-print("same numbers as on local cores:", all(np.array_equal(on_dask[xi].mean["msd"], sweep[xi].mean["msd"]) for xi in sweep))''',
+same = all(np.array_equal(on_dask[xi].mean["msd"], sweep[xi].mean["msd"]) for xi in sweep)
+assert same, "the Dask cluster gave other numbers than the local cores"
+print("same numbers as on local cores:", same)''',
 ]
 
 for name, cells in (("01_quickstart", quick), ("02_thesis_reproduction", repro), ("03_langevin_vs_edmd", lve)):
