@@ -46,7 +46,9 @@ class CountingClient:
 
 def _assert_identical(x, y):
     """Two EnsembleResults agree bit for bit: every run's arrays, the means and errors."""
+    assert len(x.runs) == len(y.runs) and x.mean.keys() == y.mean.keys()
     for a, b in zip(x.runs, y.runs):
+        assert a.keys() == b.keys()
         for k in a:
             np.testing.assert_array_equal(a[k], b[k])
     for k in x.mean:
