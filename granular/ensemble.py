@@ -372,8 +372,8 @@ def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progr
     calls = [(task, p * runs + r, s)
              for p, task in enumerate(tasks) for r, s in enumerate(seeds[p])]
     reducers = [_PointReducer(point_seeds, keep_runs) for point_seeds in seeds]
+    pool_size = workers if workers is not None else os.cpu_count() or 1
     with _progress_bar(len(calls), progress) as bar:
-        _reduce_in_order(_results(calls, backend, workers or os.cpu_count() or 1),
-                         reducers, runs, bar)
+        _reduce_in_order(_results(calls, backend, pool_size), reducers, runs, bar)
     results = [r.result() for r in reducers]
     return results if sweep else results[0]

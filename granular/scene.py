@@ -25,7 +25,10 @@ _FREEZING = {2: 0.70, 3: 0.494}
 _MELTED_ORDER = 3.0
 # Up to _BIG_MAX particles wider than BIG_RATIO times the median diameter (a tracer) are
 # kept out of neighbour searches sized for the others: in the engine's cell grid
-# (Simulation's big_ratio; csrc/edmd.c, GR_BIG_MAX) and in random placement.
+# (Simulation's big_ratio; csrc/edmd.c, GR_BIG_MAX) and in random placement.  The two
+# may differ at the margin (the engine takes the upper median and also needs a grid fine
+# enough for a big particle's block): the rule decides how a search is done, not what it
+# finds.
 BIG_RATIO = 3.0
 _BIG_MAX = 16
 # What the engine holds per particle (record, event, queue entry, cell links, counters,
@@ -69,7 +72,7 @@ def _real(value, name):
         raise TypeError(f"{name} must be real numbers, got complex")
     if a.dtype.kind not in "biuf":
         raise TypeError(f"{name} must be numbers, got dtype {a.dtype}")
-    return a.astype(np.float64)
+    return a.astype(np.float64, copy=False)  # callers that keep it copy it (_array)
 
 
 def _array(value, name, shape):
@@ -365,8 +368,8 @@ def _place_rsa(rng, radii, lo, hi, periodic, max_rounds=200):
         for b in np.flatnonzero(~small):
             ok &= _distance(placed[b], cand, L, periodic) >= placed_r[b] + r
         if small.any():
-            tree = cKDTree(shift(placed[small]), boxsize=box)
             ps, pr = placed[small], placed_r[small]
+            tree = cKDTree(shift(ps), boxsize=box)
             for k, nbrs in enumerate(tree.query_ball_point(shift(cand), r + r_small)):
                 if nbrs and ok[k]:
                     ok[k] = np.all(_distance(cand[k], ps[nbrs], L, periodic) >= r[k] + pr[nbrs])

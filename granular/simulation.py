@@ -161,13 +161,14 @@ class Simulation:
         reason, nxt, done = "events", 0, 0
         bar = _progress_bar(progress, t_now, t_end, cpp)
         stall = _StallGuard(self) if unbounded else None
+        events = self._engine.counters()["events"]  # counters() sums over particles: once a chunk
         try:
             while budget - done > 0:
                 chunk = int(min(_CHUNK, budget - done))
-                before = self._engine.counters()["events"]
                 code, nxt = self._engine.advance(t_end, cpp, kin, chunk, times, nxt, **views)
                 after = self._engine.counters()
-                done += after["events"] - before
+                done += after["events"] - events
+                events = after["events"]
                 if bar is not None:
                     bar.update(self)
                 if code != _core.STOP_BUDGET:
