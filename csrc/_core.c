@@ -137,13 +137,13 @@ static int EDMD_init(EDMDObject *self, PyObject *args, PyObject *kw)
 {
     static char *names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                             "periodic", "wall_restitution", "restitution",
-                            "contact_duration", "cell_factor", "big_ratio", NULL};
+                            "contact_duration", "cell_factor", "big_ratio", "shell", NULL};
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi;
     int periodic;
-    double wall_e, xi, tc, cell_factor, big_ratio = 3.0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpdddd|d", names, &opos, &ovel, &orad,
+    double wall_e, xi, tc, cell_factor, big_ratio = 3.0, shell = 0.0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpdddd|dd", names, &opos, &ovel, &orad,
                                      &omass, &olo, &ohi, &periodic, &wall_e, &xi, &tc,
-                                     &cell_factor, &big_ratio))
+                                     &cell_factor, &big_ratio, &shell))
         return -1;
     if (self->sim) {
         PyErr_SetString(PyExc_RuntimeError, "EDMD is already initialised");
@@ -179,6 +179,7 @@ static int EDMD_init(EDMDObject *self, PyObject *args, PyObject *kw)
     cfg.contact_duration = tc;
     cfg.cell_factor = cell_factor;
     cfg.big_ratio = big_ratio;
+    cfg.shell = shell;
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
     int status;
     Py_BEGIN_ALLOW_THREADS
@@ -317,14 +318,14 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     if (!check_ready(self)) return NULL;
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
-    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii)}", "time", c.t,
+    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d}", "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
                          (long long)c.crossings, "stale_events", (long long)c.invalid,
                          "tc_elastic_collisions", (long long)c.elastic_tc, "virial", c.virial,
                          "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic,
                          "kinetic_time_integral", c.kinetic_time, "cells",
-                         c.ncell[0], c.ncell[1], c.ncell[2]);
+                         c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell);
 }
 
 static PyMethodDef EDMD_methods[] = {

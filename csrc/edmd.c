@@ -22,9 +22,19 @@
  *    small particle's scan also checks every big one, and a big one scans the block of
  *    cells within its reach, R = ceil((r_big + r_small_max) / w) cells each way, and on
  *    crossing a cell wall the newly reached layer of that block.
+ *  - in a dense gas a scan's 27 cells hold ~25 particles, of which only the ~8 nearest
+ *    can be hit before long.  There the engine can keep neighbour lists instead (Verlet
+ *    lists as in Smallenburg's EDMD): particle i lists everyone whose list centre lies
+ *    within r_i + r_j + 2 delta of its own, the centre being i's position when its list
+ *    was last built; leaving the sphere of radius delta about it is i's structural event
+ *    (in place of a cell crossing), which rebuilds i's list from the cells (that hold
+ *    centres, not positions) and mends its neighbours' lists, which stay symmetric.  Two
+ *    particles each within delta of their centres can only touch if listed, so
+ *    predictions scan the list: contiguous indices whose records load in parallel,
+ *    where a cell's linked list is a chain of dependent loads.
  * Invariant: for every pair of particles within reach (adjacent cells; a big particle's
- * block), the earliest collision on their current straight lines is no earlier than the
- * queue key of one of the two. */
+ * block; a neighbour list), the earliest collision on their current straight lines is no
+ * earlier than the queue key of one of the two. */
 #define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
 #define _POSIX_C_SOURCE 200112L /* posix_memalign */
 #include <math.h>
@@ -44,16 +54,17 @@
  * in one cache line: at large N each separate array would be one more miss per event. */
 typedef struct {
     double t_coll;   /* predicted pair or wall collision, +inf if none */
-    double t_cross;  /* next cell crossing, +inf if none */
+    double t_cross;  /* next cell crossing (lists: leaving the shell), +inf if none */
     double t_last;   /* time of this particle's last collision (TC model, collapse) */
     int64_t count;   /* this particle's collisions, pair and wall */
     int64_t pcount;  /* partner's collision counter when predicted */
     int32_t partner; /* >= 0: particle; -1: none; <= -2: wall -(2 + 2*axis + side) */
     int32_t last;    /* partner of the last collision (a wall as in `partner`), -1 none */
-    int32_t c[3];    /* cell coordinates (the first dim used) */
+    int32_t c[3];    /* cell coordinates (the first dim used; lists: of the centre) */
     int8_t cross;    /* 2*axis + (1 if moving up), -1 none */
     int8_t streak;   /* consecutive collisions each within eps_t of the previous one,
                       * saturating (only "more than GR_COLLAPSE_STREAK" matters) */
+    int16_t nn;      /* length of the neighbour list (list mode) */
 } gr_event;
 typedef char gr_event_fills_one_line[sizeof(gr_event) == 64 ? 1 : -1];
 
@@ -86,6 +97,19 @@ struct gr_edmd {
      * large N the head array is far out of cache; the bits are 32 times smaller, so a
      * scan learns which of its 27 cells to visit from lines it mostly has at hand. */
     uint64_t *occ;
+
+    /* neighbour lists (list mode, shell > 0; see the top of the file) */
+    double shell;         /* delta, absolute; 0: cell-crossing mode */
+    double exit2;         /* squared distance from the centre that ends a list's life */
+    double *centre;       /* n * (dim + 1): each list centre and the particle's radius */
+    /* n * nl_cap: i's neighbours from nl[i * nl_cap] on, ev[i].nn of them, each as
+     * (j << GR_NL_BITS) | image code: the shift that brings j next to i stays the same
+     * until one of them rebuilds, so scans need no nearest-image arithmetic */
+    int32_t *nl;
+    int32_t nl_cap;
+    int32_t *nl_near;     /* n: room for a rebuild's new neighbours */
+    int nl_broken;        /* a list could not grow: lists are incomplete, no more events */
+    double img[32][3];    /* image code -> shift, code = sum over axes of (s_a + 1) 3^a */
     int32_t *nb_cell[3];  /* [axis][3*c + d+1]: neighbouring coordinate or -1 */
     double *nb_shift[3];  /* [axis][3*c + d+1]: image shift in box lengths' units */
     /* Linear index offsets of the adjacent cells of a cell away from the box edge (the
@@ -188,6 +212,56 @@ static inline void cell_remove(gr_edmd *s, int32_t i, int32_t c)
 
 static int reorder(gr_edmd *s);
 
+/* Neighbour lists: rows of nl_cap entries, doubled when one overflows (rarely: the
+ * starting capacity holds a crystal's neighbours at the densest packing).  An entry
+ * keeps the image code in its low GR_NL_BITS bits, so list mode needs n < 2^26. */
+#define GR_NL_CAP_MAX 16384
+#define GR_NL_BITS 5
+#define GR_NL_MAX_N ((int64_t)1 << (31 - GR_NL_BITS))
+
+static int nl_grow(gr_edmd *s)
+{
+    const int32_t cap = 2 * s->nl_cap;
+    int32_t *nl = cap > GR_NL_CAP_MAX ? NULL : gr_big_alloc((size_t)s->n * (size_t)cap * sizeof *nl);
+    if (!nl) {
+        s->nl_broken = 1;
+        return GR_ERR_NOMEM;
+    }
+    for (int32_t i = 0; i < s->n; i++)
+        memcpy(nl + (size_t)i * cap, s->nl + (size_t)i * s->nl_cap,
+               (size_t)s->ev[i].nn * sizeof *nl);
+    free(s->nl);
+    s->nl = nl;
+    s->nl_cap = cap;
+    return GR_OK;
+}
+
+/* List i and j as neighbours of each other, j seen from i through image `code`. */
+static int nl_link(gr_edmd *s, int32_t i, int32_t j, int32_t code)
+{
+    if (s->ev[i].nn == s->nl_cap || s->ev[j].nn == s->nl_cap) {
+        int status = nl_grow(s);
+        if (status != GR_OK) return status;
+    }
+    const int32_t opposite = (s->dim == 3 ? 26 : 8) - code;
+    s->nl[(size_t)i * s->nl_cap + s->ev[i].nn++] = (j << GR_NL_BITS) | code;
+    s->nl[(size_t)j * s->nl_cap + s->ev[j].nn++] = (i << GR_NL_BITS) | opposite;
+    return GR_OK;
+}
+
+/* Take i off j's list (order within a list does not matter). */
+static inline void nl_unlink(gr_edmd *s, int32_t j, int32_t i)
+{
+    int32_t *row = s->nl + (size_t)j * s->nl_cap;
+    const int last = s->ev[j].nn - 1;
+    for (int k = 0; k <= last; k++)
+        if (row[k] >> GR_NL_BITS == i) {
+            row[k] = row[last];
+            s->ev[j].nn--;
+            return;
+        }
+}
+
 #define DIM 2
 #define FN(name) name##_2d
 #include "edmd_dim.h"
@@ -214,6 +288,9 @@ void gr_edmd_free(gr_edmd *s)
     free(s->occ);
     free(s->next);
     free(s->prev);
+    free(s->centre);
+    free(s->nl);
+    free(s->nl_near);
     for (int a = 0; a < 3; a++) {
         free(s->nb_cell[a]);
         free(s->nb_shift[a]);
@@ -393,6 +470,10 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
                      "cell_factor must be >= 1");
         return GR_ERR_VALUE;
     }
+    if (!(cfg->shell >= 0.0 && isfinite(cfg->shell))) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shell, "shell must be finite and >= 0");
+        return GR_ERR_VALUE;
+    }
     const int32_t n = (int32_t)cfg->n;
     double sigma_max = 0.0, sigma_min = INFINITY;
     for (int32_t i = 0; i < n; i++) {
@@ -472,8 +553,30 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         !s->id_of || !s->is_big || (n >= GR_REORDER_MIN_N && !s->scratch))
         status = GR_ERR_NOMEM;
     if (status == GR_OK) status = gr_cq_init(&s->queue, n);
-    if (status == GR_OK) status = choose_big(s, radius);
-    if (status == GR_OK) status = build_grid(s, 2.0 * s->r_small, err);
+    /* List mode, unless the box is too small for the shell: every pair within reach
+     * must be less than half a box apart for the nearest image to be the one that
+     * collides (list centres within sigma + 2 delta, positions within delta of them). */
+    s->shell = cfg->shell * sigma_max;
+    for (int a = 0; a < d; a++)
+        if (cfg->periodic && !(s->L[a] > 2.0 * (sigma_max + 4.0 * s->shell))) s->shell = 0.0;
+    if (n >= GR_NL_MAX_N) s->shell = 0.0;
+    if (s->shell > 0.0) {
+        /* leave a hair early: two particles each within delta (1 - 1e-9) of centres more
+         * than sigma + 2 delta apart stay apart by more than rounding */
+        s->exit2 = s->shell * (1.0 - 1e-9) * s->shell * (1.0 - 1e-9);
+        s->r_small = 0.5 * sigma_max; /* no big particles */
+        s->nl_cap = d == 3 ? 32 : 16;
+        s->centre = gr_big_alloc((size_t)n * (d + 1) * sizeof *s->centre);
+        s->nl = gr_big_alloc((size_t)n * s->nl_cap * sizeof *s->nl);
+        s->nl_near = malloc((size_t)n * sizeof *s->nl_near);
+        if (status == GR_OK && (!s->centre || !s->nl || !s->nl_near)) status = GR_ERR_NOMEM;
+        for (int code = 0; code < 32; code++)
+            for (int a = 0, k = code; a < 3; a++, k /= 3)
+                s->img[code][a] = a < d ? (double)(k % 3 - 1) * s->L[a] : 0.0;
+    } else if (status == GR_OK) {
+        status = choose_big(s, radius);
+    }
+    if (status == GR_OK) status = build_grid(s, 2.0 * s->r_small + 2.0 * s->shell, err);
     if (status != GR_OK) {
         gr_edmd_free(s);
         return status;
@@ -523,9 +626,11 @@ static int reorder(gr_edmd *s)
     if (!s->scratch) return GR_OK;
     int32_t *start = calloc((size_t)s->ncells + 1, sizeof *start);
     int32_t *newpos = malloc((size_t)n * sizeof *newpos);
-    if (!start || !newpos) {
+    int32_t *nl = s->shell > 0.0 ? gr_big_alloc((size_t)n * s->nl_cap * sizeof *nl) : NULL;
+    if (!start || !newpos || (s->shell > 0.0 && !nl)) {
         free(start);
         free(newpos);
+        free(nl);
         return GR_ERR_NOMEM;
     }
     for (int32_t i = 0; i < n; i++) {
@@ -550,7 +655,18 @@ static int reorder(gr_edmd *s)
     PERMUTE(s->image, int64_t, (size_t)d);
     PERMUTE(s->id_of, int32_t, 1);
     PERMUTE(s->is_big, uint8_t, 1);
+    if (s->shell > 0.0) PERMUTE(s->centre, double, (size_t)d + 1);
 #undef PERMUTE
+    if (nl) {
+        for (int32_t i = 0; i < n; i++) {
+            const int32_t *from = s->nl + (size_t)i * s->nl_cap;
+            int32_t *to = nl + (size_t)newpos[i] * s->nl_cap;
+            for (int k = 0; k < s->ev[i].nn; k++)
+                to[k] = newpos[from[k] >> GR_NL_BITS] << GR_NL_BITS | (from[k] & ((1 << GR_NL_BITS) - 1));
+        }
+        free(s->nl);
+        s->nl = nl;
+    }
     for (int32_t b = 0; b < s->n_big; b++) s->big[b] = newpos[s->big[b]];
     {
         gr_event *tmp = s->scratch;
@@ -576,6 +692,7 @@ static int reorder(gr_edmd *s)
 
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
+    if (s->nl_broken) return GR_ERR_NOMEM;
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
 }
 
@@ -622,4 +739,5 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     }
     c->kinetic = k;
     for (int a = 0; a < 3; a++) c->ncell[a] = s->nc[a];
+    c->shell = s->shell > 0.0 ? s->cfg.shell : 0.0;
 }

@@ -37,6 +37,9 @@ typedef struct {
     double big_ratio;         /* particles more than this times the median diameter wide
                                * (at most GR_BIG_MAX of them) stay out of the cell grid
                                * (>= 1; +inf: none) -- a speed knob, see edmd.c */
+    double shell;             /* > 0: neighbour lists with a shell this many largest
+                               * diameters thick (no big particles then); 0: cell
+                               * crossings -- a speed knob, see edmd.c */
 } gr_edmd_config;
 
 typedef struct {
@@ -68,7 +71,7 @@ typedef struct {
     int64_t events;         /* all events processed, cell crossings included */
     int64_t pair;           /* pair collisions */
     int64_t wall;           /* wall collisions */
-    int64_t crossings;      /* cell crossings */
+    int64_t crossings;      /* cell crossings, or neighbour-list rebuilds with lists */
     int64_t invalid;        /* events found stale on pop (partner collided since) */
     int64_t elastic_tc;     /* pair collisions made elastic by the TC model */
     double virial;          /* sum over pair collisions of r_ij . dp_j */
@@ -76,6 +79,8 @@ typedef struct {
     double kinetic;         /* total kinetic energy now */
     double kinetic_time;    /* integral over time of the total kinetic energy */
     int ncell[3];           /* cells per axis */
+    double shell;           /* the neighbour lists' shell in largest diameters, 0: none
+                             * (a box too small for the shell asked for has none) */
 } gr_edmd_counters;
 
 typedef struct gr_edmd gr_edmd;
@@ -89,7 +94,9 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
 void gr_edmd_free(gr_edmd *s);
 
 /* Process events.  Returns a GR_STOP_* reason, or GR_ERR_COLLAPSE / GR_ERR_NONFINITE
- * (the state stays consistent and inspectable after an error). */
+ * (the state stays consistent and inspectable after an error), or GR_ERR_NOMEM (a
+ * neighbour list could not grow: the state can be inspected, but every further call
+ * returns GR_ERR_NOMEM). */
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err);
 
 /* The state at the current time: positions wrapped into the box (pos), velocities, and

@@ -78,6 +78,7 @@ static inline int32_t FN(cell_of)(const gr_edmd *s, const int32_t *c)
         GR_PREFETCH(&(s)->next[(i)]);                                                    \
         GR_PREFETCH(&(s)->prev[(i)]);                                                    \
         GR_CQ_PREFETCH(&(s)->queue, (i));                                                \
+        if ((s)->nl) GR_PREFETCH((s)->nl + (size_t)(i) * (s)->nl_cap);                  \
     } while (0)
 
 static inline void FN(move)(double *p, double t)
@@ -227,6 +228,108 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
     }
 }
 
+/* List mode: pair collisions of i (clock at t) with its listed neighbours. */
+static void FN(scan_list)(gr_edmd *s, int32_t i)
+{
+    const double *p = rec(s, i);
+    gr_event *e = &s->ev[i];
+    const int32_t *row = s->nl + (size_t)i * s->nl_cap;
+    const double t = T(p), ri = R(p);
+    double best = e->t_coll - t;
+    int32_t partner = -1;
+    for (int k = 0; k < e->nn; k++) {
+        const int32_t j = row[k] >> GR_NL_BITS;
+        const double *q = rec(s, j), *shift = s->img[row[k] & ((1 << GR_NL_BITS) - 1)];
+        double dtj = t - T(q), dr[DIM], dv[DIM];
+        for (int a = 0; a < DIM; a++) {
+            dr[a] = X(q)[a] + V(q)[a] * dtj - X(p)[a] + shift[a];
+            dv[a] = V(q)[a] - V(p)[a];
+        }
+        double dt;
+        if (!gr_pair_beats(DIM, dr, dv, ri + R(q), best, &dt)) continue;
+        if (FN(rebound_now)(s, i, j, t, dt)) continue;
+        best = dt;
+        partner = j;
+    }
+    if (partner >= 0) {
+        e->t_coll = T(p) + best;
+        e->partner = partner;
+        e->pcount = s->ev[partner].count;
+    }
+}
+
+/* List mode: when i leaves the sphere of radius delta about its list centre. */
+static inline void FN(predict_exit)(gr_edmd *s, int32_t i)
+{
+    const double *p = rec(s, i);
+    const double *centre = s->centre + (size_t)i * (DIM + 1);
+    double a = 0.0, b = 0.0, c = -s->exit2;
+    for (int k = 0; k < DIM; k++) {
+        const double d = X(p)[k] - centre[k], v = V(p)[k];
+        a += v * v;
+        b += d * v;
+        c += d * d;
+    }
+    /* the larger root of a dt^2 + 2 b dt + c = 0 with c < 0, in the form without
+     * cancellation; c >= 0 is a hair outside by rounding: leave now */
+    double dt;
+    if (!(a > 0.0)) dt = INFINITY;
+    else if (c >= 0.0) dt = 0.0;
+    else {
+        const double q = sqrt(b * b - a * c);
+        dt = b > 0.0 ? -c / (b + q) : (q - b) / a;
+    }
+    s->ev[i].t_cross = T(p) + dt;
+}
+
+/* List mode: list i and every particle whose centre is within r_i + r_j + 2 delta of
+ * i's (only those numbered above i if `above`: building all lists at once). */
+static int FN(link_near)(gr_edmd *s, int32_t i, int above)
+{
+    const double *ci = s->centre + (size_t)i * (DIM + 1);
+    const double reach = ci[DIM] + 2.0 * s->shell;
+    FN(nbr) nb[DIM == 3 ? 27 : 9];
+    const int count = FN(neighbours)(s, s->ev[i].c, -1, 0, nb);
+    /* first the new neighbours, kept or not without a branch (about one candidate in
+     * six is kept: as good as random) */
+    int32_t m = 0, *near = s->nl_near;
+    for (int k = 0; k < count; k++) {
+        int32_t code = 0;
+        for (int a = DIM - 1; a >= 0; a--)
+            code = 3 * code + (nb[k].shift[a] > 0.0) - (nb[k].shift[a] < 0.0) + 1;
+        for (int32_t j = s->head[nb[k].cell]; j >= 0; j = s->next[j]) {
+            const double *cj = s->centre + (size_t)j * (DIM + 1);
+            double d2 = 0.0;
+            for (int a = 0; a < DIM; a++) {
+                const double d = cj[a] + nb[k].shift[a] - ci[a];
+                d2 += d * d;
+            }
+            const double cut = cj[DIM] + reach;
+            near[m] = (j << GR_NL_BITS) | code;
+            m += (d2 < cut * cut) & (j != i) & (!above | (j > i));
+        }
+    }
+    for (int32_t k = 0; k < m; k++) {
+        int status = nl_link(s, i, near[k] >> GR_NL_BITS, near[k] & ((1 << GR_NL_BITS) - 1));
+        if (status != GR_OK) return status;
+    }
+    return GR_OK;
+}
+
+/* List mode: make i's position (in the box) its list centre and file it in that cell. */
+static inline void FN(set_centre)(gr_edmd *s, int32_t i)
+{
+    const double *p = rec(s, i);
+    double *centre = s->centre + (size_t)i * (DIM + 1);
+    int32_t *c = s->ev[i].c;
+    centre[DIM] = R(p);
+    for (int a = 0; a < DIM; a++) {
+        centre[a] = X(p)[a];
+        double f = floor((X(p)[a] - s->cfg.lo[a]) / s->w[a]);
+        c[a] = f < 0.0 ? 0 : f >= s->nc[a] ? s->nc[a] - 1 : (int32_t)f;
+    }
+}
+
 /* Next cell crossing of i from its current position, cell and velocity. */
 static inline void FN(predict_cross)(gr_edmd *s, int32_t i)
 {
@@ -286,8 +389,13 @@ static void FN(predict)(gr_edmd *s, int32_t i)
             e->partner = -2 - wall;
         }
     }
-    FN(scan)(s, i, -1, 0);
-    FN(predict_cross)(s, i);
+    if (s->nl) {
+        FN(scan_list)(s, i);
+        FN(predict_exit)(s, i);
+    } else {
+        FN(scan)(s, i, -1, 0);
+        FN(predict_cross)(s, i);
+    }
     FN(schedule)(s, i);
 }
 
@@ -329,6 +437,42 @@ static int FN(do_cross)(gr_edmd *s, int32_t i, double t)
     FN(predict_cross)(s, i);
     FN(scan)(s, i, a, dir);
     FN(schedule)(s, i);
+    return GR_OK;
+}
+
+/* List mode: i (clock at t) has left its shell.  Its list is rebuilt about its present
+ * position, which is first brought back into a periodic box (between rebuilds a
+ * particle may stray up to delta beyond the box: pair tests take the nearest image). */
+static int FN(do_rebuild)(gr_edmd *s, int32_t i, double t)
+{
+    double *p = rec(s, i);
+    gr_event *e = &s->ev[i];
+    FN(move)(p, t);
+    const int32_t *row = s->nl + (size_t)i * s->nl_cap;
+    for (int k = 0; k < e->nn; k++) nl_unlink(s, row[k] >> GR_NL_BITS, i);
+    e->nn = 0;
+    if (s->cfg.periodic) {
+        for (int a = 0; a < DIM; a++) {
+            if (X(p)[a] >= s->cfg.hi[a]) {
+                X(p)[a] -= s->L[a];
+                s->image[(size_t)i * DIM + a]++;
+            } else if (X(p)[a] < s->cfg.lo[a]) {
+                X(p)[a] += s->L[a];
+                s->image[(size_t)i * DIM + a]--;
+            }
+        }
+    }
+    const int32_t old = FN(cell_of)(s, e->c);
+    FN(set_centre)(s, i);
+    const int32_t cell = FN(cell_of)(s, e->c);
+    if (cell != old) {
+        cell_remove(s, i, old);
+        cell_insert(s, i, cell);
+    }
+    int status = FN(link_near)(s, i, 0);
+    if (status != GR_OK) return status;
+    s->crossings++;
+    FN(predict)(s, i);
     return GR_OK;
 }
 
@@ -511,6 +655,13 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
             }
         }
     }
+    if (s->nl) {
+        for (int32_t i = 0; i < n; i++) FN(set_centre)(s, i); /* the cells as above */
+        for (int32_t i = 0; i < n; i++) {
+            int status = FN(link_near)(s, i, 1);
+            if (status != GR_OK) return status;
+        }
+    }
     int status = reorder(s);
     if (status != GR_OK) return status;
     for (int32_t i = 0; i < n; i++) FN(predict)(s, i);
@@ -584,7 +735,7 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
         }
         int status = GR_OK;
         if (e->t_cross < e->t_coll) {
-            status = FN(do_cross)(s, i, te);
+            status = s->nl ? FN(do_rebuild)(s, i, te) : FN(do_cross)(s, i, te);
         } else if (e->partner >= 0) {
             if (s->ev[e->partner].count != e->pcount) { /* partner collided since: stale */
                 s->invalid++;

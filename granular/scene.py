@@ -215,13 +215,13 @@ class Scene:
                 f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
                 f"temperature={self.temperature:.4g})")
 
-    def _engine(self, cell_factor=1.0, big_ratio=BIG_RATIO):
+    def _engine(self, cell_factor=1.0, big_ratio=BIG_RATIO, shell=0.0):
         from . import _core
 
         return _core.EDMD(self.positions, self.velocities, self.radii, self.masses,
                           self.lower, self.upper, self.boundary == "periodic",
                           self.wall_restitution, self.restitution, self.contact_duration,
-                          float(cell_factor), float(big_ratio))
+                          float(cell_factor), float(big_ratio), float(shell))
 
     # -- constructors ---------------------------------------------------------------
     @classmethod

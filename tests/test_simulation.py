@@ -185,6 +185,16 @@ def test_centre_of_mass_moves_with_total_momentum(n):
 
 # -- against the slow reference ------------------------------------------------------------
 
+def reference_scene(dim, boundary, xi, mixture, n=12):
+    """A small scene for comparisons with the O(N^2) reference."""
+    radius = 0.08 if dim == 2 else 0.1
+    if mixture:
+        radius = radius * np.linspace(0.6, 1.2, n)
+    return Scene.random(n, radius, dim=dim, boundary=boundary, restitution=xi,
+                        mass=(np.asarray(radius) / 0.1) ** dim if mixture else 1.0,
+                        wall_restitution=0.9 if boundary == "walls" and xi < 1 else 1.0, seed=7)
+
+
 @pytest.mark.parametrize("dim,boundary,xi,mixture", [(2, "walls", 1.0, False), (2, "periodic", 0.7, False),
                                                      (3, "periodic", 1.0, False), (3, "walls", 0.8, False),
                                                      (2, "periodic", 0.9, True), (3, "walls", 1.0, True)])
@@ -193,13 +203,8 @@ def test_agrees_with_slow_reference(dim, boundary, xi, mixture):
     (chaos amplifies rounding differences by ~e per collision, so the comparison stays
     short: ~10 collisions per particle, agreement to 1e-8).  Mixtures: radii spread by a
     factor 2, masses proportional to volume (large particles among small ones)."""
-    n = 12
-    radius = 0.08 if dim == 2 else 0.1
-    if mixture:
-        radius = radius * np.linspace(0.6, 1.2, n)
-    s = Scene.random(n, radius, dim=dim, boundary=boundary, restitution=xi,
-                     mass=(np.asarray(radius) / 0.1) ** dim if mixture else 1.0,
-                     wall_restitution=0.9 if boundary == "walls" and xi < 1 else 1.0, seed=7)
+    s = reference_scene(dim, boundary, xi, mixture)
+    n = s.n
     t_stop = 1.0
     times = np.linspace(0.0, t_stop, 11)
     sim = Simulation(s)

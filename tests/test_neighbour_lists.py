@@ -1,0 +1,171 @@
+"""The engine's neighbour-list mode (Simulation(shell=...)): the same dynamics as the
+cell-crossing mode and as the slow reference, conservation and no overlaps where lists
+matter (dense 3D), lists that grow, periodic wrapping at rebuilds, and the automatic
+choice."""
+import math
+
+import numpy as np
+import pytest
+
+from granular import Scene, Simulation
+
+import reference_edmd
+from test_simulation import _tracer_scene, min_distance_ratio, reference_scene
+
+
+def _dense(n, eta, dim=3, boundary="periodic", seed=1, **kw):
+    r = (eta / (n * 4 / 3 * math.pi)) ** (1 / 3) if dim == 3 else math.sqrt(eta / (n * math.pi))
+    return Scene.random(n, r, dim=dim, boundary=boundary, seed=seed, **kw)
+
+
+def _lists(scene, shell=0.25, **kw):
+    sim = Simulation(scene, shell=shell, **kw)
+    assert sim.stats["shell"] == shell  # lists are on, not declined for a small box
+    return sim
+
+
+@pytest.mark.parametrize("dim,boundary,xi,mixture", [(2, "walls", 1.0, False), (2, "periodic", 0.7, False),
+                                                     (3, "periodic", 1.0, False), (3, "walls", 0.8, False),
+                                                     (2, "periodic", 0.9, True), (3, "periodic", 1.0, True)])
+@pytest.mark.parametrize("shell", [0.02, 0.25])
+def test_agrees_with_slow_reference(dim, boundary, xi, mixture, shell):
+    """As test_simulation's reference test (same tolerance, same reasoning: ~10
+    collisions per particle, chaos keeps rounding differences below 1e-8), with lists:
+    a thin shell rebuilds often (every 0.02 diameters travelled), a thick one rarely."""
+    s = reference_scene(dim, boundary, xi, mixture)
+    n = s.n
+    times = np.linspace(0.0, 1.0, 11)
+    sim = _lists(s, shell)
+    tr = sim.run(t_stop=1.0, sample_times=times)
+    assert sim.stats["pair_collisions"] >= n
+    assert sim.stats["cell_crossings"] >= n  # list rebuilds did happen
+    rx, rv = reference_edmd.run(np.array(s.positions), np.array(s.velocities), s.radii,
+                                s.masses, s.lower, s.upper, boundary == "periodic", xi,
+                                1.0, times, wall_e=s.wall_restitution)
+    np.testing.assert_allclose(tr.positions, rx, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(tr.velocities, rv, rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("n,boundary,eta", [(1500, "periodic", 0.45), (1500, "walls", 0.4)])
+def test_lists_and_cells_give_the_same_trajectory(n, boundary, eta):
+    """Dense 3D, where lists are used: the two modes find the same collisions, so
+    positions agree until chaos has amplified the rounding differences of their
+    arithmetic (they differ in how a periodic image is added).  About 2 collisions per
+    particle: differences stay below 1e-8."""
+    s = _dense(n, eta, boundary=boundary, restitution=0.95, seed=2)
+    t_stop = Simulation(s).run(stop_when={"collisions_per_particle": 2}).times[-1]
+    times = np.linspace(0.0, t_stop, 5)
+    cells = Simulation(s, shell=0.0)
+    lists = _lists(s)
+    a = cells.run(t_stop=t_stop, sample_times=times)
+    b = lists.run(t_stop=t_stop, sample_times=times)
+    assert lists.stats["pair_collisions"] == cells.stats["pair_collisions"]
+    np.testing.assert_allclose(b.positions, a.positions, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(b.velocities, a.velocities, rtol=0, atol=1e-8)
+
+
+def test_energy_and_momentum_conserved_over_a_million_collisions():
+    """As in test_simulation (same bounds, same reasoning), with lists at packing 0.45."""
+    s = _dense(2000, 0.45, seed=11)
+    sim = _lists(s)
+    tr = sim.run(stop_when={"collisions_per_particle": 1000.0}, store=())
+    assert sim.stats["pair_collisions"] >= 1_000_000
+    assert tr.kinetic_energy[-1] / tr.kinetic_energy[0] - 1 == pytest.approx(0, abs=1e-13)
+    scale = np.sum(s.masses * np.linalg.norm(s.velocities, axis=1))
+    assert np.max(np.abs(tr.momentum[-1] - tr.momentum[0])) <= 1e-13 * scale
+    final = sim.scene  # constructing it checks overlaps and that everyone is in the box
+    assert min_distance_ratio(final, final.positions) >= 1 - 1e-10
+
+
+@pytest.mark.parametrize("boundary", ["periodic", "walls"])
+def test_no_overlaps_at_any_sample_dense_granular(boundary):
+    """Packing 0.5 (walls: 0.4), xi = 0.9 with the TC model: no pair closer than contact beyond
+    rounding (1e-10 relative) at any of 26 samples."""
+    eta = 0.5 if boundary == "periodic" else 0.4  # walls take room: 0.5 does not fit
+    s = _dense(1000, eta, boundary=boundary, restitution=0.9, contact_duration=1e-6, seed=5)
+    tr = _lists(s).run(t_stop=0.2, sample_times=np.linspace(0, 0.2, 26), store=("positions",))
+    for x in tr.positions:
+        assert min_distance_ratio(s, x) >= 1 - 1e-10
+
+
+def test_unwrapped_positions_through_rebuilds():
+    """Between rebuilds a particle may stray up to a shell beyond a periodic box; it is
+    wrapped back when its list is rebuilt.  Unwrapped positions must still be the
+    integral of the velocities (centre of mass moves at P / M to 1e-11), and the current
+    scene lies in the box.  N = 5000 also renumbers the particles (N >= 4096, every 16 N
+    events), which remaps every list entry and must stay invisible."""
+    s = _dense(5000, 0.45, seed=3, remove_drift=False)
+    masses = np.linspace(1.0, 3.0, s.n)
+    s = s.replace(masses=masses)
+    times = np.linspace(0.0, 0.3, 7)
+    sim = _lists(s)
+    tr = sim.run(t_stop=0.3, sample_times=times)
+    assert sim.stats["events"] > 2 * 16 * s.n
+    np.testing.assert_array_equal(tr.positions[0], s.positions)
+    M = masses.sum()
+    P = (masses[:, None] * s.velocities).sum(0)
+    com = np.einsum("i,tia->ta", masses, tr.positions) / M
+    np.testing.assert_allclose(com, com[0] + np.outer(times, P / M), rtol=0, atol=1e-11)
+    np.testing.assert_allclose(sim.unwrapped_positions, tr.positions[-1], rtol=0, atol=1e-12)
+    now = sim.scene
+    assert np.all((now.positions >= s.lower) & (now.positions < s.upper))
+    crossed = np.any(np.abs(sim.unwrapped_positions - now.positions) > 0.5, axis=1)
+    assert crossed.sum() >= 10  # some particles did cross the periodic boundary
+
+
+def test_lists_grow_around_a_large_particle():
+    """A particle 8 times wider than the rest with lists: its list must hold every
+    particle whose centre is within R + r + 2 delta (delta = 0.25 * 2R) of its own --
+    over a hundred here (counted below), far beyond the starting 32 per row, so rows are
+    doubled during setup and as the gas moves.  The trajectory must still be the cell
+    mode's (which keeps the big particle out of the grid: independent code; short run,
+    1e-8 as above) and the big particle must collide."""
+    r, big = 0.012, 0.096
+    s = _tracer_scene(4000, r, big, 3, "periodic", 1.0, seed=6)
+    d = s.positions[1:] - s.positions[0]
+    d -= np.round(d / s.lengths) * s.lengths
+    reach = big + r + 2 * 0.25 * 2 * big
+    assert np.sum(np.linalg.norm(d, axis=1) < reach) > 2 * 32  # 128: rows doubled twice
+    times = np.linspace(0.0, 0.05, 5)
+    lists = _lists(s, shell=0.25, big_ratio=math.inf)
+    b = lists.run(t_stop=0.05, sample_times=times)
+    a = Simulation(s, shell=0.0).run(t_stop=0.05, sample_times=times)
+    np.testing.assert_allclose(b.positions, a.positions, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(b.velocities, a.velocities, rtol=0, atol=1e-8)
+    assert np.any(b.velocities[-1, 0] != b.velocities[0, 0])
+
+
+def test_same_result_bit_for_bit_and_continued_runs():
+    s = _dense(800, 0.45, restitution=0.9, seed=8)
+    one = _lists(s).run(t_stop=0.2, sample_times=[0.1, 0.2])
+    sim = _lists(s)
+    a = sim.run(t_stop=0.1, sample_times=[0.1])
+    b = sim.run(t_stop=0.2, sample_times=[0.2])
+    np.testing.assert_array_equal(np.concatenate([a.positions, b.positions]), one.positions)
+    np.testing.assert_array_equal(np.concatenate([a.velocities, b.velocities]), one.velocities)
+
+
+def test_automatic_choice():
+    """Lists for dense 3D scenes without a big particle; cells otherwise."""
+    assert Simulation(_dense(500, 0.45)).stats["shell"] == 0.25
+    assert Simulation(_dense(500, 0.3)).stats["shell"] == 0.0
+    assert Simulation(_dense(500, 0.6, dim=2)).stats["shell"] == 0.0
+    # radii spread by 5 %: one is "big" when big_ratio is below that spread
+    s = _dense(500, 0.5)
+    s = s.replace(radii=s.radii * np.random.default_rng(1).uniform(0.95, 1.0, s.n))
+    assert s.packing_fraction > 0.42
+    assert Simulation(s).stats["shell"] == 0.25
+    assert Simulation(s, big_ratio=1.01).stats["shell"] == 0.0
+    # a box too small for the shell asked for: cells, and stats say so
+    tiny = Scene.random(4, 0.1, seed=1)
+    assert Simulation(tiny, shell=1.0).stats["shell"] == 0.0
+
+
+def test_bad_shell():
+    s = _dense(100, 0.2)
+    for bad in (-0.1, math.nan, math.inf):
+        with pytest.raises(ValueError, match="shell"):
+            Simulation(s, shell=bad)
+    for bad in ("big", True, None):
+        with pytest.raises(TypeError, match="shell"):
+            Simulation(s, shell=bad)
