@@ -212,8 +212,9 @@ static inline void cell_remove(gr_edmd *s, int32_t i, int32_t c)
 
 static int reorder(gr_edmd *s);
 
-/* Neighbour lists: rows of nl_cap entries, doubled when one overflows (rarely: the
- * starting capacity holds a crystal's neighbours at the densest packing).  An entry
+/* Neighbour lists: rows of nl_cap entries, doubled when one overflows (rarely with the
+ * automatic shell of 0.25 diameters: a close-packed crystal has 18 neighbours within
+ * 1.5 diameters in 3D, 6 in 2D; a wide particle among small ones has more).  An entry
  * keeps the image code in its low GR_NL_BITS bits, so list mode needs n < 2^26. */
 #define GR_NL_CAP_MAX 16384
 #define GR_NL_BITS 5
@@ -661,8 +662,10 @@ static int reorder(gr_edmd *s)
         for (int32_t i = 0; i < n; i++) {
             const int32_t *from = s->nl + (size_t)i * s->nl_cap;
             int32_t *to = nl + (size_t)newpos[i] * s->nl_cap;
-            for (int k = 0; k < s->ev[i].nn; k++)
-                to[k] = newpos[from[k] >> GR_NL_BITS] << GR_NL_BITS | (from[k] & ((1 << GR_NL_BITS) - 1));
+            for (int k = 0; k < s->ev[i].nn; k++) {
+                const int32_t code = from[k] & ((1 << GR_NL_BITS) - 1);
+                to[k] = (newpos[from[k] >> GR_NL_BITS] << GR_NL_BITS) | code;
+            }
         }
         free(s->nl);
         s->nl = nl;

@@ -228,14 +228,16 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
     }
 }
 
-/* List mode: pair collisions of i (clock at t) with its listed neighbours. */
+/* List mode: pair collisions of i (clock at t) with its listed neighbours, before its
+ * predicted wall collision and its shell exit (which rebuilds and predicts afresh, so
+ * later collisions need not be found now: most candidates then fail the cheap test). */
 static void FN(scan_list)(gr_edmd *s, int32_t i)
 {
     const double *p = rec(s, i);
     gr_event *e = &s->ev[i];
     const int32_t *row = s->nl + (size_t)i * s->nl_cap;
     const double t = T(p), ri = R(p);
-    double best = e->t_coll - t;
+    double best = (e->t_coll < e->t_cross ? e->t_coll : e->t_cross) - t;
     int32_t partner = -1;
     for (int k = 0; k < e->nn; k++) {
         const int32_t j = row[k] >> GR_NL_BITS;
@@ -390,8 +392,8 @@ static void FN(predict)(gr_edmd *s, int32_t i)
         }
     }
     if (s->nl) {
-        FN(scan_list)(s, i);
         FN(predict_exit)(s, i);
+        FN(scan_list)(s, i);
     } else {
         FN(scan)(s, i, -1, 0);
         FN(predict_cross)(s, i);

@@ -55,7 +55,7 @@ def edmd_workload(name, dim, n, eta, collisions, *, boundary="periodic", restitu
                 boundary=boundary, restitution=restitution, pair_collisions=pairs, events=events,
                 seconds=seconds, pair_collisions_per_second=pairs / seconds,
                 ns_per_event=1e9 * seconds / events, windows=windows,
-                cells=list(after["cells"][:dim]))
+                cells=list(after["cells"][:dim]), shell=after["shell"])
 
 
 def run(quick=False, large=False, langevin=True, out=print):
@@ -68,7 +68,8 @@ def run(quick=False, large=False, langevin=True, out=print):
         r = edmd_workload(name, dim, n, eta, coll)
         results.append(r)
         out(f"{r['name']:<28} N={r['n']:>8}  {r['pair_collisions_per_second'] / 1e6:6.3f} M pair collisions/s"
-            f"  ({r['ns_per_event']:.0f} ns/event, {r['events'] / r['pair_collisions']:.2f} events/collision)")
+            f"  ({r['ns_per_event']:.0f} ns/event, {r['events'] / r['pair_collisions']:.2f} events/collision"
+            f"{', neighbour lists' if r['shell'] > 0 else ''})")
     if langevin:
         try:
             from . import bench_langevin

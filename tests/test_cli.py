@@ -89,9 +89,10 @@ def test_bench_quick_json(tmp_path):
     assert len(edmd) == 5 and {r["dim"] for r in edmd} == {2, 3}
     for r in edmd:
         for key in ("name", "dim", "n", "packing_fraction", "boundary", "restitution",
-                    "pair_collisions", "seconds", "pair_collisions_per_second"):
+                    "pair_collisions", "seconds", "pair_collisions_per_second", "shell"):
             assert key in r
         assert r["pair_collisions"] > 0 and r["pair_collisions_per_second"] > 0
+        assert (r["shell"] > 0) == (r["packing_fraction"] > 0.4)  # lists for the dense one
     lang = [r for r in rows if r["engine"] == "langevin"]
     assert lang and all(r["particle_steps_per_second"] > 0 for r in lang)
 
