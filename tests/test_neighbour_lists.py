@@ -9,7 +9,9 @@ import pytest
 
 from granular import Scene, Simulation
 
+import granular
 import reference_edmd
+from test_scene import three_in_line
 from test_simulation import _tracer_scene, min_distance_ratio, reference_scene
 
 
@@ -143,6 +145,17 @@ def test_same_result_bit_for_bit_and_continued_runs():
     b = sim.run(t_stop=0.2, sample_times=[0.2])
     np.testing.assert_array_equal(np.concatenate([a.positions, b.positions]), one.positions)
     np.testing.assert_array_equal(np.concatenate([a.velocities, b.velocities]), one.velocities)
+
+
+def test_collapse_is_detected_and_the_tc_model_finishes():
+    """As in test_scene: three disks in a line with xi = 0.05 < 7 - 4 sqrt 3 collapse at
+    t = 0.1, raised after a bounded number of collisions; with t_c the run finishes."""
+    sim = _lists(three_in_line(0.05))
+    with pytest.raises(granular.InelasticCollapseError) as info:
+        sim.run(t_stop=10.0)
+    assert info.value.time == pytest.approx(0.1, abs=1e-6)
+    assert sim.stats["pair_collisions"] < 100
+    assert _lists(three_in_line(0.05, tc=1e-3)).run(t_stop=10.0).stop_reason == "time"
 
 
 def test_automatic_choice():
