@@ -451,6 +451,11 @@ static int FN(do_rebuild)(gr_edmd *s, int32_t i, double t)
     gr_event *e = &s->ev[i];
     FN(move)(p, t);
     const int32_t *row = s->nl + (size_t)i * s->nl_cap;
+    /* the neighbours' list lengths and rows are misses: ask for all of them first */
+    for (int k = 0; k < e->nn; k++) {
+        GR_PREFETCH(&s->ev[row[k] >> GR_NL_BITS]);
+        GR_PREFETCH(s->nl + (size_t)(row[k] >> GR_NL_BITS) * s->nl_cap);
+    }
     for (int k = 0; k < e->nn; k++) nl_unlink(s, row[k] >> GR_NL_BITS, i);
     e->nn = 0;
     if (s->cfg.periodic) {
