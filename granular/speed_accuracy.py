@@ -31,6 +31,7 @@ model; the cost of EDMD per unit time as the packing approaches the dense limit.
 from __future__ import annotations
 
 import functools
+import itertools
 import json
 import math
 import os
@@ -196,17 +197,20 @@ def collapse_map(quick=False, contact_durations=(0.0, 1e-4), events_per_particle
 
 
 def dense_cost(quick=False):
-    """EDMD cost per unit of simulated time (and per collision) as the packing grows."""
+    """EDMD cost per unit of simulated time (and per collision) as the packing grows; in
+    3D with cells and with neighbour lists (shell 0.25), the evidence for where
+    Simulation's shell="auto" switches."""
     rows = []
-    cases = [(3, (0.1, 0.2, 0.3, 0.4, 0.5, 0.55, 0.6)), (2, (0.1, 0.3, 0.5, 0.6, 0.7, 0.8))]
-    for dim, etas in cases:
+    cases = [(3, (0.1, 0.2, 0.3, 0.4, 0.45, 0.5, 0.55, 0.6), (0.0, 0.25)),
+             (2, (0.1, 0.3, 0.5, 0.6, 0.7, 0.8), (0.0,))]
+    for dim, etas, shells in cases:
         # a full face-centred cubic lattice (4 k^3 sites) reaches the densest 3D cases
         n = (2048 if dim == 3 else 2000) if not quick else (256 if dim == 3 else 300)
         if quick:
             etas = (etas[0], etas[-1])  # the dilute and the densest case
-        for eta in etas:
+        for eta, shell in itertools.product(etas, shells):
             r = ((eta / (n * 4 / 3 * math.pi)) ** (1 / 3) if dim == 3 else math.sqrt(eta / (n * math.pi)))
-            sim = Simulation(Scene.random(n, r, dim=dim, temperature=1.0, seed=2))
+            sim = Simulation(Scene.random(n, r, dim=dim, temperature=1.0, seed=2), shell=shell)
             sim.run(stop_when={"collisions_per_particle": 5}, store=())
             b = sim.stats
             t0 = clock()
@@ -214,7 +218,8 @@ def dense_cost(quick=False):
             sec = clock() - t0
             a = sim.stats
             pairs = a["pair_collisions"] - b["pair_collisions"]
-            rows.append(dict(dim=dim, eta=eta, n=n, seconds_per_time=sec / (a["time"] - b["time"]),
+            rows.append(dict(dim=dim, eta=eta, n=n, shell=shell,
+                             seconds_per_time=sec / (a["time"] - b["time"]),
                              ns_per_collision=1e9 * sec / pairs,
                              collisions_per_particle_per_time=2 * pairs / n / (a["time"] - b["time"])))
     return rows
@@ -329,13 +334,18 @@ def _charts(out, points, refs, stab, cells, dense):
     fig.savefig(os.path.join(out, "collapse_map.png"), dpi=110)
     plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
-    for dim in (2, 3):
-        rows = [r for r in dense if r["dim"] == dim]
-        ax.semilogy([r["eta"] for r in rows], [r["seconds_per_time"] for r in rows], "o-", label=f"{dim}D, N = {rows[0]['n']}")
-    ax.set_xlabel("packing (area) fraction")
-    ax.set_ylabel("seconds per unit of simulated time (T = 1)")
-    ax.legend()
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), layout="constrained")
+    for dim, shell in sorted({(r["dim"], r["shell"]) for r in dense}):
+        rows = [r for r in dense if r["dim"] == dim and r["shell"] == shell]
+        label = f"{dim}D, N = {rows[0]['n']}, " + (f"lists (shell {shell:g})" if shell else "cells")
+        eta = [r["eta"] for r in rows]
+        axes[0].semilogy(eta, [r["seconds_per_time"] for r in rows], "o-", label=label)
+        axes[1].plot(eta, [r["ns_per_collision"] / 1e3 for r in rows], "o-", label=label)
+    for ax in axes:
+        ax.set_xlabel("packing (area) fraction")
+        ax.legend()
+    axes[0].set_ylabel("seconds per unit of simulated time (T = 1)")
+    axes[1].set_ylabel("µs per pair collision")
     fig.savefig(os.path.join(out, "dense_cost.png"), dpi=110)
     plt.close(fig)
 

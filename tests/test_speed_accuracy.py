@@ -56,3 +56,6 @@ def test_speed_accuracy_cli_quick(tmp_path):
     dense = data["dense_cost"]
     assert max(r["eta"] for r in dense if r["dim"] == 3) >= 0.55
     assert max(r["eta"] for r in dense if r["dim"] == 2) >= 0.7
+    # 3D with both cells and lists, at every packing
+    assert {r["shell"] for r in dense if r["dim"] == 3} == {0.0, 0.25}
+    assert {r["shell"] for r in dense if r["dim"] == 2} == {0.0}
