@@ -16,11 +16,14 @@ _STOP_KEYS = ("collisions_per_particle", "kinetic_energy", "events")
 _CHUNK = 200_000
 _STORE = ("positions", "velocities")
 # shell="auto": neighbour lists with this shell (in largest diameters) for dense 3D
-# scenes.  Measured (pair collisions/s, N = 1e4, cells vs lists with shell 0.15 / 0.25 /
-# 0.35): packing 0.35 0.64 vs 0.40/0.48/0.50 M; 0.45 0.53 vs 0.58/0.65/0.64 M; 0.50 0.48
-# vs 0.66/0.84/0.80 M (2D at 0.60 and 0.68: within 5 % either way, so cells).
+# scenes.  Measured (pair collisions/s, N = 1e4, melted Scene.random, cells vs lists
+# with shell 0.25, two runs each): packing 0.30 0.67-0.69 vs 0.47-0.50 M; 0.35 0.46-0.67
+# vs 0.53-0.54 M; 0.40 0.54-0.60 vs 0.60-0.64 M; 0.45 0.44-0.50 vs 0.68-0.73 M; shells
+# 0.15 / 0.35 were slower than 0.25 at 0.45 and 0.5.  At N = 2048 lists win from 0.3 on
+# (speed_accuracy.dense_cost).  2D at area fractions 0.6 and 0.68: within 5 % either way,
+# so cells.
 _LIST_SHELL = 0.25
-_LIST_MIN_PACKING = 0.42
+_LIST_MIN_PACKING = 0.4
 # Lists add per particle: a row of 32 entries, its copy while reordering, the centre.
 _LIST_BYTES_PER_PARTICLE = 300
 
@@ -45,7 +48,7 @@ class Simulation:
     shell : "auto" or float >= 0
         Neighbour lists with a shell this many largest diameters thick instead of cell
         crossings (0), another speed knob: lists pay in dense 3D gases (packing fraction
-        above ~0.42, up to 1.75x at 0.5) and cost elsewhere.  "auto" uses shell 0.25
+        0.4 and up, 1.5-2x at 0.5) and cost elsewhere.  "auto" uses shell 0.25
         there, when no particle is big (see ``big_ratio``; lists keep none out), and
         cells otherwise.  ``stats["shell"]`` says which was used.
     """

@@ -166,7 +166,7 @@ def test_automatic_choice():
     # radii spread by 5 %: one is "big" when big_ratio is below that spread
     s = _dense(500, 0.5)
     s = s.replace(radii=s.radii * np.random.default_rng(1).uniform(0.95, 1.0, s.n))
-    assert s.packing_fraction > 0.42
+    assert s.packing_fraction > 0.4
     assert Simulation(s).stats["shell"] == 0.25
     assert Simulation(s, big_ratio=1.01).stats["shell"] == 0.0
     # a box too small for the shell asked for: cells, and stats say so
