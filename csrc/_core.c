@@ -33,7 +33,9 @@ static PyObject *raise_status(int status, const gr_error *e)
 
     switch (status) {
     case GR_ERR_NOMEM:
-        return PyErr_NoMemory();
+        if (!what[0]) return PyErr_NoMemory();
+        PyErr_SetString(PyExc_MemoryError, what);
+        return NULL;
     case GR_ERR_VALUE:
         PyErr_SetString(PyExc_ValueError, what[0] ? what : "invalid argument");
         return NULL;

@@ -238,11 +238,16 @@ static int nl_grow(gr_edmd *s)
 }
 
 /* List i and j as neighbours of each other, j seen from i through image `code`. */
-static int nl_link(gr_edmd *s, int32_t i, int32_t j, int32_t code)
+static int nl_link(gr_edmd *s, int32_t i, int32_t j, int32_t code, gr_error *err)
 {
     if (s->ev[i].nn == s->nl_cap || s->ev[j].nn == s->nl_cap) {
         int status = nl_grow(s);
-        if (status != GR_OK) return status;
+        if (status != GR_OK) {
+            gr_error_set(err, status, uid(s, i), -1, s->t, (double)s->nl_cap,
+                         "a neighbour list could not grow (out of memory, or past "
+                         GR_XSTR(GR_NL_CAP_MAX) " entries); the system cannot go on");
+            return status;
+        }
     }
     const int32_t opposite = (s->dim == 3 ? 26 : 8) - code;
     s->nl[(size_t)i * s->nl_cap + s->ev[i].nn++] = (j << GR_NL_BITS) | code;
@@ -471,8 +476,11 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
                      "cell_factor must be >= 1");
         return GR_ERR_VALUE;
     }
-    if (!(cfg->shell >= 0.0 && isfinite(cfg->shell))) {
-        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shell, "shell must be finite and >= 0");
+    /* a shell thinner than this rebuilds lists every few hundredths of a diameter
+     * travelled, and its rounding margin (1e-9 of it) nears that of the coordinates */
+    if (!(cfg->shell == 0.0 || (cfg->shell >= 0.01 && isfinite(cfg->shell)))) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shell,
+                     "shell must be 0 (cells) or finite and at least 0.01 (largest diameters)");
         return GR_ERR_VALUE;
     }
     const int32_t n = (int32_t)cfg->n;
@@ -695,7 +703,11 @@ static int reorder(gr_edmd *s)
 
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
-    if (s->nl_broken) return GR_ERR_NOMEM;
+    if (s->nl_broken) {
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, s->t, (double)s->nl_cap,
+                     "a neighbour list could not grow earlier; the system cannot go on");
+        return GR_ERR_NOMEM;
+    }
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
 }
 

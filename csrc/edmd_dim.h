@@ -286,7 +286,7 @@ static inline void FN(predict_exit)(gr_edmd *s, int32_t i)
 
 /* List mode: list i and every particle whose centre is within r_i + r_j + 2 delta of
  * i's (only those numbered above i if `above`: building all lists at once). */
-static int FN(link_near)(gr_edmd *s, int32_t i, int above)
+static int FN(link_near)(gr_edmd *s, int32_t i, int above, gr_error *err)
 {
     const double *ci = s->centre + (size_t)i * (DIM + 1);
     const double reach = ci[DIM] + 2.0 * s->shell;
@@ -312,7 +312,7 @@ static int FN(link_near)(gr_edmd *s, int32_t i, int above)
         }
     }
     for (int32_t k = 0; k < m; k++) {
-        int status = nl_link(s, i, near[k] >> GR_NL_BITS, near[k] & ((1 << GR_NL_BITS) - 1));
+        int status = nl_link(s, i, near[k] >> GR_NL_BITS, near[k] & ((1 << GR_NL_BITS) - 1), err);
         if (status != GR_OK) return status;
     }
     return GR_OK;
@@ -445,7 +445,7 @@ static int FN(do_cross)(gr_edmd *s, int32_t i, double t)
 /* List mode: i (clock at t) has left its shell.  Its list is rebuilt about its present
  * position, which is first brought back into a periodic box (between rebuilds a
  * particle may stray up to delta beyond the box: pair tests take the nearest image). */
-static int FN(do_rebuild)(gr_edmd *s, int32_t i, double t)
+static int FN(do_rebuild)(gr_edmd *s, int32_t i, double t, gr_error *err)
 {
     double *p = rec(s, i);
     gr_event *e = &s->ev[i];
@@ -476,7 +476,7 @@ static int FN(do_rebuild)(gr_edmd *s, int32_t i, double t)
         cell_remove(s, i, old);
         cell_insert(s, i, cell);
     }
-    int status = FN(link_near)(s, i, 0);
+    int status = FN(link_near)(s, i, 0, err);
     if (status != GR_OK) return status;
     s->crossings++;
     FN(predict)(s, i);
@@ -665,7 +665,7 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
     if (s->nl) {
         for (int32_t i = 0; i < n; i++) FN(set_centre)(s, i); /* the cells as above */
         for (int32_t i = 0; i < n; i++) {
-            int status = FN(link_near)(s, i, 1);
+            int status = FN(link_near)(s, i, 1, err);
             if (status != GR_OK) return status;
         }
     }
@@ -742,7 +742,7 @@ static int FN(advance)(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
         }
         int status = GR_OK;
         if (e->t_cross < e->t_coll) {
-            status = s->nl ? FN(do_rebuild)(s, i, te) : FN(do_cross)(s, i, te);
+            status = s->nl ? FN(do_rebuild)(s, i, te, err) : FN(do_cross)(s, i, te);
         } else if (e->partner >= 0) {
             if (s->ev[e->partner].count != e->pcount) { /* partner collided since: stale */
                 s->invalid++;

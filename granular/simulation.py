@@ -50,19 +50,28 @@ class Simulation:
         crossings (0), another speed knob: lists pay in dense 3D gases (packing fraction
         0.4 and up, 1.5-2x at 0.5) and cost elsewhere.  "auto" uses shell 0.25
         there, when no particle is big (see ``big_ratio``; lists keep none out), and
-        cells otherwise.  ``stats["shell"]`` says which was used.
+        cells otherwise; lists with a big particle are refused unless
+        ``big_ratio=math.inf``.  0 or at least 0.01.  ``stats["shell"]`` says which was
+        used.
     """
 
     def __init__(self, scene, *, cell_factor=1.0, big_ratio=BIG_RATIO, shell="auto"):
         if not isinstance(scene, Scene):
             raise TypeError(f"Simulation needs a granular.Scene, got {type(scene).__name__}")
         self._initial = scene
+        big = np.max(scene.radii) > big_ratio * np.median(scene.radii)
         if isinstance(shell, str) and shell == "auto":
             dense = scene.dim == 3 and scene.packing_fraction >= _LIST_MIN_PACKING
-            big = np.max(scene.radii) > big_ratio * np.median(scene.radii)
             shell = _LIST_SHELL if dense and not big else 0.0
         elif isinstance(shell, (bool, str)) or not isinstance(shell, (int, float, np.number)):
             raise TypeError(f"shell must be 'auto' or a number >= 0, got {shell!r}")
+        elif shell > 0 and big:
+            # the shell is a fraction of the largest diameter: every small particle's
+            # list would reach as far as the big one's (thousands of entries each)
+            raise ValueError(
+                f"neighbour lists (shell = {shell}) with particles wider than big_ratio = "
+                f"{big_ratio} times the median: every list would reach as far as the widest; "
+                "use shell=0 (cells keep the big ones out) or big_ratio=math.inf to insist")
         if shell > 0:
             _check_memory((_ENGINE_BYTES_PER_PARTICLE + _LIST_BYTES_PER_PARTICLE) * scene.n,
                           "the event-driven engine's state with neighbour lists")

@@ -176,9 +176,14 @@ def test_automatic_choice():
 
 def test_bad_shell():
     s = _dense(100, 0.2)
-    for bad in (-0.1, math.nan, math.inf):
+    for bad in (-0.1, 1e-5, math.nan, math.inf):
         with pytest.raises(ValueError, match="shell"):
             Simulation(s, shell=bad)
+    # lists with a particle far wider than the rest: refused unless insisted on
+    tracer = _tracer_scene(500, 0.01, 0.08, 3, "periodic", 1.0, seed=1)
+    with pytest.raises(ValueError, match="big_ratio"):
+        Simulation(tracer, shell=0.25)
+    assert Simulation(tracer, shell=0.25, big_ratio=math.inf).stats["shell"] == 0.25
     for bad in ("big", True, None):
         with pytest.raises(TypeError, match="shell"):
             Simulation(s, shell=bad)
