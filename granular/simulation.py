@@ -50,9 +50,9 @@ class Simulation:
         crossings (0), another speed knob: lists pay in dense 3D gases (packing fraction
         0.4 and up, 1.5-2x at 0.5) and cost elsewhere.  "auto" uses shell 0.25
         there, when no particle is big (see ``big_ratio``; lists keep none out), and
-        cells otherwise; lists with a big particle are refused unless
-        ``big_ratio=math.inf``.  0 or at least 0.01.  ``stats["shell"]`` says which was
-        used.
+        cells otherwise.  A number must be 0 or at least 0.01; lists with a big particle
+        are refused unless ``big_ratio=math.inf``.  ``stats["shell"]`` says which mode
+        ran.
     """
 
     def __init__(self, scene, *, cell_factor=1.0, big_ratio=BIG_RATIO, shell="auto"):
