@@ -118,6 +118,7 @@ static inline void FN(scan_cell)(const gr_edmd *s, int32_t i, const double *p, i
         if (FN(rebound_now)(s, i, j, t, dt)) continue;
         *best = dt;
         *partner = j;
+        GR_PREFETCH(&s->ev[j]); /* its collision count is read when the scan ends */
     }
 }
 
@@ -252,6 +253,7 @@ static void FN(scan_list)(gr_edmd *s, int32_t i)
         if (FN(rebound_now)(s, i, j, t, dt)) continue;
         best = dt;
         partner = j;
+        GR_PREFETCH(&s->ev[j]); /* its collision count is read at the end */
     }
     if (partner >= 0) {
         e->t_coll = T(p) + best;
