@@ -68,6 +68,17 @@ static inline int32_t FN(cell_of)(const gr_edmd *s, const int32_t *c)
 #endif
 }
 
+/* Set i's cell coordinates from its position (clamped: rounding may leave a particle a
+ * hair outside the box). */
+static inline void FN(file_in_cell)(gr_edmd *s, int32_t i)
+{
+    const double *p = rec(s, i);
+    for (int a = 0; a < DIM; a++) {
+        double f = floor((X(p)[a] - s->cfg.lo[a]) / s->w[a]);
+        s->ev[i].c[a] = f < 0.0 ? 0 : f >= s->nc[a] ? s->nc[a] - 1 : (int32_t)f;
+    }
+}
+
 /* Everything an event of particle i is about to read or write, requested at once.  A
  * macro, not a function: GCC takes a function that only prefetches for one without
  * effects and deletes the calls (seen with GCC 12 at -O3: none of these was emitted). */
@@ -97,42 +108,21 @@ static inline int FN(rebound_now)(const gr_edmd *s, int32_t i, int32_t j, double
            s->ev[j].t_last == t;
 }
 
-/* Pair collisions of i (record p, clock at t) with the particles of one cell, seen
- * through an image shift (NULL: none); keeps the earliest in *best / *partner.  `best` is
- * relative to t and is also the horizon for the early exit in gr_pair_beats. */
-static inline void FN(scan_cell)(const gr_edmd *s, int32_t i, const double *p, int32_t cell,
-                                 const double *shift, double *best, int32_t *partner)
+/* One candidate j (not i) for i's next pair collision (record p, clock at t): j seen
+ * through an image shift (NULL: none) or, with `nearest`, through the nearest periodic
+ * image.  Keeps the earliest in *best / *partner; `best` is relative to t and is also the
+ * horizon for the early exit in gr_pair_beats.  Every scan calls this with constant
+ * shift and nearest arguments, so each gets its own inlined copy. */
+static inline void FN(try_pair)(const gr_edmd *s, int32_t i, const double *p, int32_t j,
+                                const double *shift, int nearest, double *best,
+                                int32_t *partner)
 {
-    const double t = T(p), ri = R(p);
-    for (int32_t j = s->head[cell]; j >= 0; j = s->next[j]) {
-        if (j == i) continue;
-        const double *q = rec(s, j);
-        double dtj = t - T(q), dr[DIM], dv[DIM];
-        for (int a = 0; a < DIM; a++) {
-            dr[a] = X(q)[a] + V(q)[a] * dtj - X(p)[a];
-            if (shift) dr[a] += shift[a];
-            dv[a] = V(q)[a] - V(p)[a];
-        }
-        double dt;
-        if (!gr_pair_beats(DIM, dr, dv, ri + R(q), *best, &dt)) continue;
-        if (FN(rebound_now)(s, i, j, t, dt)) continue;
-        *best = dt;
-        *partner = j;
-        GR_PREFETCH(&s->ev[j]); /* its collision count is read when the scan ends */
-    }
-}
-
-/* The pair (i, j), j seen through the nearest periodic image (the one that touches:
- * contact distances are below half the box), for scans that involve a big particle. */
-static inline void FN(scan_one)(const gr_edmd *s, int32_t i, const double *p, int32_t j,
-                                double *best, int32_t *partner)
-{
-    if (j == i) return;
     const double *q = rec(s, j);
     double dtj = T(p) - T(q), dr[DIM], dv[DIM];
     for (int a = 0; a < DIM; a++) {
         dr[a] = X(q)[a] + V(q)[a] * dtj - X(p)[a];
-        if (s->cfg.periodic) dr[a] = nearest_image(dr[a], s->L[a]);
+        if (shift) dr[a] += shift[a];
+        if (nearest) dr[a] = nearest_image(dr[a], s->L[a]);
         dv[a] = V(q)[a] - V(p)[a];
     }
     double dt;
@@ -140,6 +130,33 @@ static inline void FN(scan_one)(const gr_edmd *s, int32_t i, const double *p, in
     if (FN(rebound_now)(s, i, j, T(p), dt)) return;
     *best = dt;
     *partner = j;
+    GR_PREFETCH(&s->ev[j]); /* its collision count is read when the scan ends */
+}
+
+/* The earliest pair collision of i found by a scan, if it beats i's prediction. */
+static inline void FN(keep_pair)(gr_edmd *s, int32_t i, double best, int32_t partner)
+{
+    if (partner < 0) return;
+    gr_event *e = &s->ev[i];
+    e->t_coll = T(rec(s, i)) + best;
+    e->partner = partner;
+    e->pcount = s->ev[partner].count;
+}
+
+/* Pair collisions of i with the particles of one cell, seen through an image shift. */
+static inline void FN(scan_cell)(const gr_edmd *s, int32_t i, const double *p, int32_t cell,
+                                 const double *shift, double *best, int32_t *partner)
+{
+    for (int32_t j = s->head[cell]; j >= 0; j = s->next[j])
+        if (j != i) FN(try_pair)(s, i, p, j, shift, 0, best, partner);
+}
+
+/* The pair (i, j), j seen through the nearest periodic image (the one that touches:
+ * contact distances are below half the box), for scans that involve a big particle. */
+static inline void FN(scan_one)(const gr_edmd *s, int32_t i, const double *p, int32_t j,
+                                double *best, int32_t *partner)
+{
+    if (j != i) FN(try_pair)(s, i, p, j, NULL, s->cfg.periodic, best, partner);
 }
 
 /* The cells within reach of big particle i (clock at t): the block of R cells each way
@@ -222,11 +239,7 @@ static void FN(scan)(gr_edmd *s, int32_t i, int axis, int dir)
             FN(scan_cell)(s, i, p, nb[k].cell, nb[k].shift, &best, &partner);
     }
     for (int32_t b = 0; b < s->n_big; b++) FN(scan_one)(s, i, p, s->big[b], &best, &partner);
-    if (partner >= 0) {
-        e->t_coll = T(p) + best;
-        e->partner = partner;
-        e->pcount = s->ev[partner].count;
-    }
+    FN(keep_pair)(s, i, best, partner);
 }
 
 /* List mode: pair collisions of i (clock at t) with its listed neighbours, before its
@@ -237,29 +250,12 @@ static void FN(scan_list)(gr_edmd *s, int32_t i)
     const double *p = rec(s, i);
     gr_event *e = &s->ev[i];
     const int32_t *row = s->nl + (size_t)i * s->nl_cap;
-    const double t = T(p), ri = R(p);
-    double best = (e->t_coll < e->t_cross ? e->t_coll : e->t_cross) - t;
+    double best = (e->t_coll < e->t_cross ? e->t_coll : e->t_cross) - T(p);
     int32_t partner = -1;
-    for (int k = 0; k < e->nn; k++) {
-        const int32_t j = row[k] >> GR_NL_BITS;
-        const double *q = rec(s, j), *shift = s->img[row[k] & ((1 << GR_NL_BITS) - 1)];
-        double dtj = t - T(q), dr[DIM], dv[DIM];
-        for (int a = 0; a < DIM; a++) {
-            dr[a] = X(q)[a] + V(q)[a] * dtj - X(p)[a] + shift[a];
-            dv[a] = V(q)[a] - V(p)[a];
-        }
-        double dt;
-        if (!gr_pair_beats(DIM, dr, dv, ri + R(q), best, &dt)) continue;
-        if (FN(rebound_now)(s, i, j, t, dt)) continue;
-        best = dt;
-        partner = j;
-        GR_PREFETCH(&s->ev[j]); /* its collision count is read at the end */
-    }
-    if (partner >= 0) {
-        e->t_coll = T(p) + best;
-        e->partner = partner;
-        e->pcount = s->ev[partner].count;
-    }
+    for (int k = 0; k < e->nn; k++)
+        FN(try_pair)(s, i, p, row[k] >> GR_NL_BITS, s->img[row[k] & ((1 << GR_NL_BITS) - 1)],
+                     0, &best, &partner);
+    FN(keep_pair)(s, i, best, partner);
 }
 
 /* List mode: when i leaves the sphere of radius delta about its list centre. */
@@ -325,13 +321,9 @@ static inline void FN(set_centre)(gr_edmd *s, int32_t i)
 {
     const double *p = rec(s, i);
     double *centre = s->centre + (size_t)i * (DIM + 1);
-    int32_t *c = s->ev[i].c;
     centre[DIM] = R(p);
-    for (int a = 0; a < DIM; a++) {
-        centre[a] = X(p)[a];
-        double f = floor((X(p)[a] - s->cfg.lo[a]) / s->w[a]);
-        c[a] = f < 0.0 ? 0 : f >= s->nc[a] ? s->nc[a] - 1 : (int32_t)f;
-    }
+    for (int a = 0; a < DIM; a++) centre[a] = X(p)[a];
+    FN(file_in_cell)(s, i);
 }
 
 /* Next cell crossing of i from its current position, cell and velocity. */
@@ -608,14 +600,8 @@ static int FN(setup)(gr_edmd *s, gr_error *err)
 {
     const int32_t n = s->n;
     for (int32_t i = 0; i < n; i++) {
-        const double *p = rec(s, i);
-        int32_t *c = s->ev[i].c;
-        for (int a = 0; a < DIM; a++) {
-            double f = floor((X(p)[a] - s->cfg.lo[a]) / s->w[a]);
-            int32_t q = f < 0.0 ? 0 : f >= s->nc[a] ? s->nc[a] - 1 : (int32_t)f;
-            c[a] = q;
-        }
-        if (!s->is_big[i]) cell_insert(s, i, FN(cell_of)(s, c));
+        FN(file_in_cell)(s, i);
+        if (!s->is_big[i]) cell_insert(s, i, FN(cell_of)(s, s->ev[i].c));
     }
     /* Overlaps of the big particles with everyone, O(N) each. */
     for (int32_t b = 0; b < s->n_big; b++) {
