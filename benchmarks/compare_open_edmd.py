@@ -1,0 +1,108 @@
+"""granular against Smallenburg's EDMD, side by side on one machine.
+
+The fastest open event-driven code we know is F. Smallenburg's (github.com/FSmallenburg/EDMD,
+"Efficient event-driven simulations of hard spheres", Eur. Phys. J. E 45, 22 (2022)):
+`Cell/` keeps cell lists, `Single/` neighbour lists.  Its numbers depend on the machine as
+much as ours, so the only fair comparison is both codes on the same machine at the same
+time.  This script does that: for each workload it runs a prepared copy of the other code,
+then granular on the same number of pair collisions, and repeats, interleaved.
+
+The other code is not shipped here; prepare one directory per workload:
+  1. clone the repository; copy `Cell/` (dilute workloads) or `Single/` (packing 0.45),
+     with `Grow/mt19937ar.c` beside the source, into a directory per workload;
+  2. in the source set `maxtime` so the run makes ~2 M pair collisions (the third number in WORKLOADS below),
+     and in `Single/` `usethermostat = 0` (it is on as published; we compare NVE runs);
+  3. build with its Makefile (as published: -Ofast -march=native; granular is built with
+     portable -O3);
+  4. give it an `init.sph`: from its `Grow/` program with `N` and `targetpackfrac` set, or,
+     where that fails (it crashed at N = 1e6 here), a simple cubic lattice written by
+     `--write-init` (a dilute lattice melts within the first collisions).
+Then, for example:
+
+    python benchmarks/compare_open_edmd.py --other 3d-1e5-0.065=/tmp/sm/cell_1e5 \\
+        --other 3d-1e4-0.45=/tmp/sm/single_1e4 --repeats 2
+
+Its throughput is the collision count it prints last ("Collisions: ...") over the wall time
+of the whole run, setup included (0.3 s of 9 s at N = 1e5).  granular's is timed the same
+way over one window after its usual equilibration (bench.edmd_workload with one window).
+"""
+import argparse
+import math
+import re
+import subprocess
+import time
+
+from granular.bench import edmd_workload
+
+# name -> (N, packing fraction, maxtime for ~2 M pair collisions in the other code)
+WORKLOADS = {
+    "3d-1e3-0.065": (1_000, 0.065, 4000),
+    "3d-1e4-0.065": (10_000, 0.065, 400),
+    "3d-1e5-0.065": (100_000, 0.065, 40),
+    "3d-1e6-0.065": (1_000_000, 0.065, 6),
+    "3d-1e4-0.45": (10_000, 0.45, 20),
+}
+
+
+def write_init(path, m, eta):
+    """A simple cubic lattice of m**3 spheres of diameter 1 at packing fraction eta, in the
+    other code's init.sph format (N; box lengths; one 'a x y z radius' line each)."""
+    n = m ** 3
+    box = (n * math.pi / 6.0 / eta) ** (1.0 / 3.0)
+    a = box / m
+    with open(path, "w") as f:
+        f.write(f"{n}\n{box:.12f} {box:.12f} {box:.12f}\n")
+        for i in range(m):
+            for j in range(m):
+                f.writelines(f"a {(i + 0.5) * a:.12f} {(j + 0.5) * a:.12f} {(k + 0.5) * a:.12f} 0.5\n"
+                             for k in range(m))
+
+
+def run_other(directory):
+    """Run ./md in directory; (pair collisions, seconds)."""
+    t0 = time.perf_counter()
+    out = subprocess.run(["./md"], cwd=directory, capture_output=True, text=True, check=True).stdout
+    seconds = time.perf_counter() - t0
+    counts = re.findall(r"Collisions:\s*(\d+)", out)
+    if not counts:
+        raise RuntimeError(f"{directory}: no 'Collisions:' line in its output")
+    return int(counts[-1]), seconds
+
+
+def run_granular(name, pairs):
+    n, eta, _ = WORKLOADS[name]
+    r = edmd_workload(name, 3, n, eta, 2.0 * pairs / n, windows=1)
+    return r["pair_collisions"], r["seconds"]
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--other", action="append", default=[], metavar="WORKLOAD=DIR",
+                   help=f"a prepared run directory of the other code; workloads: {', '.join(WORKLOADS)}")
+    p.add_argument("--repeats", type=int, default=2)
+    p.add_argument("--write-init", nargs=3, metavar=("M", "ETA", "FILE"),
+                   help="write an M**3 simple cubic lattice at packing fraction ETA and exit")
+    args = p.parse_args()
+    if args.write_init:
+        m, eta, path = args.write_init
+        write_init(path, int(m), float(eta))
+        return
+    others = dict(item.split("=", 1) for item in args.other)
+    unknown = set(others) - set(WORKLOADS)
+    if unknown:
+        p.error(f"unknown workloads {sorted(unknown)}; known: {', '.join(WORKLOADS)}")
+    names = [name for name in WORKLOADS if name in others] or list(WORKLOADS)
+    print(f"{'workload':14s} {'code':12s} {'pair collisions':>16s} {'seconds':>8s} {'M/s':>7s}")
+    for _ in range(args.repeats):
+        for name in names:
+            pairs = 2.08e6
+            if name in others:
+                pairs, seconds = run_other(others[name])
+                print(f"{name:14s} {'Smallenburg':12s} {pairs:16d} {seconds:8.2f} {pairs / seconds / 1e6:7.3f}",
+                      flush=True)
+            done, seconds = run_granular(name, pairs)
+            print(f"{name:14s} {'granular':12s} {done:16d} {seconds:8.2f} {done / seconds / 1e6:7.3f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
