@@ -10,8 +10,9 @@ then granular on the same number of pair collisions, and repeats, interleaved.
 The other code is not shipped here; prepare one directory per workload:
   1. clone the repository; copy `Cell/` (dilute workloads) or `Single/` (packing 0.45),
      with `Grow/mt19937ar.c` beside the source, into a directory per workload;
-  2. in the source set `maxtime` so the run makes ~2 M pair collisions (the third number in WORKLOADS below),
-     and in `Single/` `usethermostat = 0` (it is on as published; we compare NVE runs);
+  2. in the source set `maxtime` so the run makes ~2 M pair collisions (the third number
+     of each workload in WORKLOADS below; ~3 M at N = 1e6), and in `Single/`
+     `usethermostat = 0` (it is on as published; we compare NVE runs);
   3. build with its Makefile (as published: -Ofast -march=native; granular is built with
      portable -O3);
   4. give it an `init.sph`: from its `Grow/` program with `N` and `targetpackfrac` set, or,
@@ -23,8 +24,10 @@ Then, for example:
         --other 3d-1e4-0.45=/tmp/sm/single_1e4 --repeats 2
 
 Its throughput is the collision count it prints last ("Collisions: ...") over the wall time
-of the whole run, setup included (0.3 s of 9 s at N = 1e5).  granular's is timed the same
-way over one window after its usual equilibration (bench.edmd_workload with one window).
+of the whole run, its setup included (0.3 s of 9 s at N = 1e5; at 1e6 also reading the
+lattice and melting it).  granular's is the same count over the wall time of one window
+after building and equilibrating the gas, which is not timed (bench.edmd_workload with one
+window); so the comparison leans a few per cent granular's way.
 """
 import argparse
 import math
@@ -87,6 +90,8 @@ def main():
         m, eta, path = args.write_init
         write_init(path, int(m), float(eta))
         return
+    if any("=" not in item for item in args.other):
+        p.error("--other wants WORKLOAD=DIR")
     others = dict(item.split("=", 1) for item in args.other)
     unknown = set(others) - set(WORKLOADS)
     if unknown:
