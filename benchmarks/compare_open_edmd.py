@@ -35,6 +35,8 @@ import re
 import subprocess
 import time
 
+import numpy as np
+
 from granular.bench import edmd_workload
 
 # name -> (N, packing fraction, maxtime for ~2 M pair collisions in the other code)
@@ -83,6 +85,7 @@ def main():
     p.add_argument("--other", action="append", default=[], metavar="WORKLOAD=DIR",
                    help=f"a prepared run directory of the other code; workloads: {', '.join(WORKLOADS)}")
     p.add_argument("--repeats", type=int, default=2)
+    p.add_argument("--plot", metavar="FILE", help="also chart the figures into FILE (PNG)")
     p.add_argument("--write-init", nargs=3, metavar=("M", "ETA", "FILE"),
                    help="write an M**3 simple cubic lattice at packing fraction ETA and exit")
     args = p.parse_args()
@@ -97,17 +100,58 @@ def main():
     if unknown:
         p.error(f"unknown workloads {sorted(unknown)}; known: {', '.join(WORKLOADS)}")
     names = [name for name in WORKLOADS if name in others] or list(WORKLOADS)
+    rows = []  # (workload, code, pair collisions per second)
+
+    def report(name, code, pairs, seconds):
+        rows.append((name, code, pairs / seconds))
+        print(f"{name:14s} {code:12s} {pairs:16d} {seconds:8.2f} {pairs / seconds / 1e6:7.3f}", flush=True)
+
     print(f"{'workload':14s} {'code':12s} {'pair collisions':>16s} {'seconds':>8s} {'M/s':>7s}")
     for _ in range(args.repeats):
         for name in names:
             pairs = 2.08e6
             if name in others:
                 pairs, seconds = run_other(others[name])
-                print(f"{name:14s} {'Smallenburg':12s} {pairs:16d} {seconds:8.2f} {pairs / seconds / 1e6:7.3f}",
-                      flush=True)
-            done, seconds = run_granular(name, pairs)
-            print(f"{name:14s} {'granular':12s} {done:16d} {seconds:8.2f} {done / seconds / 1e6:7.3f}", flush=True)
+                report(name, "Smallenburg", pairs, seconds)
+            report(name, "granular", *run_granular(name, pairs))
+    if args.plot:
+        plot(rows, args.plot)
 
+
+def plot(rows, path):
+    """Pair collisions per second against N, every round a point, a line through the means
+    of the dilute workloads; the dense one (packing 0.45) as open markers."""
+    import matplotlib
+    import matplotlib.ticker
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.5, 4.0), layout="constrained")
+    for code, colour in (("granular", "C0"), ("Smallenburg", "C1")):
+        label = "granular" if code == "granular" else "Smallenburg's EDMD"
+        for dense in (False, True):
+            mine = [(WORKLOADS[name][0], rate) for name, c, rate in rows
+                    if c == code and (WORKLOADS[name][1] > 0.1) == dense]
+            if not mine:
+                continue
+            n, rate = np.array(mine).T
+            ax.plot(n, rate / 1e6, "s" if dense else "o", mfc="none" if dense else colour, color=colour,
+                    label=f"{label}, packing 0.45" if dense else f"{label}, packing 0.065")
+            if not dense:
+                ns = np.unique(n)
+                ax.plot(ns, [rate[n == v].mean() / 1e6 for v in ns], "-", color=colour)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.FuncFormatter(
+        lambda v, _: f"{v:g}" if round(v / 10 ** math.floor(math.log10(v))) in (2, 3, 5) else ""))
+    ax.set_xlabel("particles N (3D, periodic, monodisperse)")
+    ax.set_ylabel("pair collisions per second (millions)")
+    ax.set_title("one thread, same machine, interleaved runs")
+    ax.legend(fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
 
 if __name__ == "__main__":
     main()
