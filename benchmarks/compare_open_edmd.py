@@ -10,24 +10,26 @@ then granular on the same number of pair collisions, and repeats, interleaved.
 The other code is not shipped here; prepare one directory per workload:
   1. clone the repository; copy `Cell/` (dilute workloads) or `Single/` (packing 0.45),
      with `Grow/mt19937ar.c` beside the source, into a directory per workload;
-  2. in the source set `maxtime` so the run makes ~2 M pair collisions (the third number
-     of each workload in WORKLOADS below; ~3 M at N = 1e6), and in `Single/`
-     `usethermostat = 0` (it is on as published; we compare NVE runs);
+  2. in the source set `maxtime` (the third number of each workload in WORKLOADS below:
+     2-3 M pair collisions), in `Single/` `usethermostat = 0` (it is on as published; we
+     compare NVE runs), and in `Cell/` `MAXCEL` to at least the cells per side it asks for
+     (published as 75, which at N = 1e5 and 1e6 makes cells wider than it wants and says
+     "Consider increasing MAXCEL"; 250 does for 1e6);
   3. build with its Makefile (as published: -Ofast -march=native; granular is built with
      portable -O3);
   4. give it an `init.sph`: from its `Grow/` program with `N` and `targetpackfrac` set, or,
-     where that fails (it crashed at N = 1e6 here), a simple cubic lattice written by
-     `--write-init` (a dilute lattice melts within the first collisions).
+     where that fails (it crashed at N = 1e6 here), a simple cubic lattice of M**3 spheres
+     written by `--write-init` (a dilute lattice melts within the first collisions).
 Then, for example:
 
     python benchmarks/compare_open_edmd.py --other 3d-1e5-0.065=/tmp/sm/cell_1e5 \\
         --other 3d-1e4-0.45=/tmp/sm/single_1e4 --repeats 2
 
-Its throughput is the collision count it prints last ("Collisions: ...") over the wall time
-of the whole run, its setup included (0.3 s of 9 s at N = 1e5; at 1e6 also reading the
-lattice and melting it).  granular's is the same count over the wall time of one window
-after building and equilibrating the gas, which is not timed (bench.edmd_workload with one
-window); so the comparison leans a few per cent granular's way.
+The other code's throughput is the pair collisions between its first and last reports
+("Simtime: t, Collisions: c"; its output is made line-buffered) over the wall time between
+them: its setup (8 s at N = 1e6) and final snapshot are not timed.  granular then runs the
+same number of pair collisions in one window after building and equilibrating the gas,
+which is not timed either (bench.edmd_workload with one window).
 """
 import argparse
 import math
@@ -39,7 +41,7 @@ import numpy as np
 
 from granular.bench import edmd_workload
 
-# name -> (N, packing fraction, maxtime for ~2 M pair collisions in the other code)
+# name -> (N, packing fraction, the other code's maxtime: 2-3 M pair collisions)
 WORKLOADS = {
     "3d-1e3-0.065": (1_000, 0.065, 4000),
     "3d-1e4-0.065": (10_000, 0.065, 400),
@@ -52,6 +54,8 @@ WORKLOADS = {
 def write_init(path, m, eta):
     """A simple cubic lattice of m**3 spheres of diameter 1 at packing fraction eta, in the
     other code's init.sph format (N; box lengths; one 'a x y z radius' line each)."""
+    if not 0.0 < eta < math.pi / 6.0:
+        raise ValueError(f"a simple cubic lattice holds packing fractions below pi/6, not {eta}")
     n = m ** 3
     box = (n * math.pi / 6.0 / eta) ** (1.0 / 3.0)
     a = box / m
@@ -59,19 +63,31 @@ def write_init(path, m, eta):
         f.write(f"{n}\n{box:.12f} {box:.12f} {box:.12f}\n")
         for i in range(m):
             for j in range(m):
-                f.writelines(f"a {(i + 0.5) * a:.12f} {(j + 0.5) * a:.12f} {(k + 0.5) * a:.12f} 0.5\n"
-                             for k in range(m))
+                x, y = (i + 0.5) * a, (j + 0.5) * a
+                f.writelines(f"a {x:.12f} {y:.12f} {(k + 0.5) * a:.12f} 0.5\n" for k in range(m))
 
 
-def run_other(directory):
-    """Run ./md in directory; (pair collisions, seconds)."""
-    t0 = time.perf_counter()
-    out = subprocess.run(["./md"], cwd=directory, capture_output=True, text=True, check=True).stdout
-    seconds = time.perf_counter() - t0
-    counts = re.findall(r"Collisions:\s*(\d+)", out)
-    if not counts:
-        raise RuntimeError(f"{directory}: no 'Collisions:' line in its output")
-    return int(counts[-1]), seconds
+def run_other(directory, eta):
+    """Run ./md in directory, line-buffered; (pair collisions, seconds) between its first
+    and its last report ("Simtime: t, Collisions: c, ..."), so that neither its setup (8 s
+    at N = 1e6) nor its final snapshot is timed, as granular's setup is not."""
+    proc = subprocess.Popen(["stdbuf", "-oL", "./md"], cwd=directory, stdout=subprocess.PIPE,
+                            text=True)
+    reports, packing = [], None
+    for line in proc.stdout:
+        now = time.perf_counter()
+        if m := re.match(r"Packing fraction\s*:\s*([0-9.]+)", line):
+            packing = float(m.group(1))
+        elif m := re.match(r"Simtime:\s*[0-9.e+-]+,\s*Collisions:\s*(\d+)", line):
+            reports.append((now, int(m.group(1))))
+    if proc.wait() != 0:
+        raise RuntimeError(f"{directory}: ./md exited with status {proc.returncode}")
+    if packing is None or abs(packing - eta) > 1e-3:
+        raise RuntimeError(f"{directory}: packing fraction {packing}, not the workload's {eta}")
+    if len(reports) < 2:
+        raise RuntimeError(f"{directory}: fewer than two 'Simtime: ..., Collisions: ...' lines")
+    (t0, c0), (t1, c1) = reports[0], reports[-1]
+    return c1 - c0, t1 - t0
 
 
 def run_granular(name, pairs):
@@ -81,9 +97,11 @@ def run_granular(name, pairs):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--other", action="append", default=[], metavar="WORKLOAD=DIR",
-                   help=f"a prepared run directory of the other code; workloads: {', '.join(WORKLOADS)}")
+                   help="a prepared run directory of the other code; workloads: "
+                        + ", ".join(WORKLOADS))
     p.add_argument("--repeats", type=int, default=2)
     p.add_argument("--plot", metavar="FILE", help="also chart the figures into FILE (PNG)")
     p.add_argument("--write-init", nargs=3, metavar=("M", "ETA", "FILE"),
@@ -91,28 +109,34 @@ def main():
     args = p.parse_args()
     if args.write_init:
         m, eta, path = args.write_init
-        write_init(path, int(m), float(eta))
+        try:
+            write_init(path, int(m), float(eta))
+        except ValueError as e:
+            p.error(str(e))
         return
     if any("=" not in item for item in args.other):
         p.error("--other wants WORKLOAD=DIR")
     others = dict(item.split("=", 1) for item in args.other)
+    if not others:
+        p.error("give at least one --other (granular alone: python -m granular bench)")
+    if len(others) < len(args.other):
+        p.error("a workload given twice in --other")
     unknown = set(others) - set(WORKLOADS)
     if unknown:
         p.error(f"unknown workloads {sorted(unknown)}; known: {', '.join(WORKLOADS)}")
-    names = [name for name in WORKLOADS if name in others] or list(WORKLOADS)
+    names = [name for name in WORKLOADS if name in others]
     rows = []  # (workload, code, pair collisions per second)
 
     def report(name, code, pairs, seconds):
         rows.append((name, code, pairs / seconds))
-        print(f"{name:14s} {code:12s} {pairs:16d} {seconds:8.2f} {pairs / seconds / 1e6:7.3f}", flush=True)
+        print(f"{name:14s} {code:12s} {pairs:16d} {seconds:8.2f} {pairs / seconds / 1e6:7.3f}",
+              flush=True)
 
     print(f"{'workload':14s} {'code':12s} {'pair collisions':>16s} {'seconds':>8s} {'M/s':>7s}")
     for _ in range(args.repeats):
         for name in names:
-            pairs = 2.08e6
-            if name in others:
-                pairs, seconds = run_other(others[name])
-                report(name, "Smallenburg", pairs, seconds)
+            pairs, seconds = run_other(others[name], WORKLOADS[name][1])
+            report(name, "Smallenburg", pairs, seconds)
             report(name, "granular", *run_granular(name, pairs))
     if args.plot:
         plot(rows, args.plot)
@@ -136,7 +160,8 @@ def plot(rows, path):
             if not mine:
                 continue
             n, rate = np.array(mine).T
-            ax.plot(n, rate / 1e6, "s" if dense else "o", mfc="none" if dense else colour, color=colour,
+            ax.plot(n, rate / 1e6, "s" if dense else "o", color=colour,
+                    mfc="none" if dense else colour,
                     label=f"{label}, packing 0.45" if dense else f"{label}, packing 0.065")
             if not dense:
                 ns = np.unique(n)
@@ -152,6 +177,7 @@ def plot(rows, path):
     ax.legend(fontsize=8)
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
 
 if __name__ == "__main__":
     main()
