@@ -44,7 +44,7 @@ from .bench_langevin import log_lags
 from .ensemble import ensemble
 from .errors import InelasticCollapseError, UnstableStepError
 from .scene import Scene
-from .simulation import Simulation
+from .simulation import _LIST_SHELL, Simulation
 
 T0 = 2.0 / 3.0
 R = 0.025
@@ -198,10 +198,10 @@ def collapse_map(quick=False, contact_durations=(0.0, 1e-4), events_per_particle
 
 def dense_cost(quick=False):
     """EDMD cost per unit of simulated time (and per collision) as the packing grows; in
-    3D with cells and with neighbour lists (shell 0.25), the evidence for where
-    Simulation's shell="auto" switches."""
+    3D with cells and with neighbour lists (the shell Simulation's shell="auto" uses),
+    the evidence for where "auto" switches."""
     rows = []
-    cases = [(3, (0.1, 0.2, 0.3, 0.4, 0.45, 0.5, 0.55, 0.6), (0.0, 0.25)),
+    cases = [(3, (0.1, 0.2, 0.3, 0.4, 0.45, 0.5, 0.55, 0.6), (0.0, _LIST_SHELL)),
              (2, (0.1, 0.3, 0.5, 0.6, 0.7, 0.8), (0.0,))]
     for dim, etas, shells in cases:
         # a full face-centred cubic lattice (4 k^3 sites) reaches the densest 3D cases

@@ -6,6 +6,7 @@ import math
 import numpy as np
 
 from granular import speed_accuracy
+from granular.simulation import _LIST_SHELL
 
 
 def test_failure_maps_pin_each_failure_mode():
@@ -57,5 +58,5 @@ def test_speed_accuracy_cli_quick(tmp_path):
     assert max(r["eta"] for r in dense if r["dim"] == 3) >= 0.55
     assert max(r["eta"] for r in dense if r["dim"] == 2) >= 0.7
     # 3D with both cells and lists, at every packing
-    assert {r["shell"] for r in dense if r["dim"] == 3} == {0.0, 0.25}
+    assert {r["shell"] for r in dense if r["dim"] == 3} == {0.0, _LIST_SHELL}
     assert {r["shell"] for r in dense if r["dim"] == 2} == {0.0}
