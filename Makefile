@@ -1,11 +1,12 @@
 # Two commands from a fresh machine (Python >= 3.10, pip, a C compiler):
 #   make demo   -- set up .venv and run the main job
 #   make test   -- set up .venv and run the whole test suite
+# and for the C core: make test-asan (the suite against an ASan + UBSan build, in its own venv)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: setup demo test bench clean
+.PHONY: setup demo test test-asan test-asan-ci bench clean
 
 $(VENV)/.installed: pyproject.toml setup.py $(wildcard csrc/*.c csrc/*.h)
 	$(PYTHON) -m venv $(VENV)
@@ -23,6 +24,44 @@ test: setup
 
 bench: setup
 	$(PY) -m granular bench --json bench.json
+
+# --- sanitizers -----------------------------------------------------------------------------
+# The extension built with AddressSanitizer (setup.py's GRANULAR_ASAN=1) and UBSan (CFLAGS,
+# which setuptools passes to both compiling and linking; -fno-sanitize-recover makes undefined
+# behaviour abort, so a test sees it), installed non-editable into its own venv: the in-place
+# granular/_core*.so of .venv stays as it is. Built from a copy of the sources, so no object
+# file of an ordinary build is reused. The tests run from a copy of tests/ so that
+# `import granular` finds the sanitized install, not the source tree. Under build/: git ignores it.
+ASAN_VENV  := build/venv-asan
+ASAN_PY    := $(ASAN_VENV)/bin/python
+ASAN_CFLAGS := -fsanitize=undefined -fno-sanitize-recover=undefined
+# notebooks run kernels (not the C core); packaging builds an sdist
+ASAN_TESTS ?= $(filter-out test_notebooks.py test_packaging.py,$(notdir $(wildcard tests/test_*.py)))
+# CI's share (.ci/run): the tests that drive the C core hardest
+ASAN_CI_TESTS := test_scene.py test_simulation.py test_neighbour_lists.py test_physics_edmd.py \
+                 test_langevin.py test_fuzz.py
+ASAN_ENV   := LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
+              ASAN_OPTIONS=detect_leaks=0:allocator_may_return_null=1 \
+              UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 GRANULAR_FUZZ_TIMEOUT=30
+
+$(ASAN_VENV)/.installed: pyproject.toml setup.py MANIFEST.in $(wildcard csrc/*.c csrc/*.h granular/*.py)
+	$(PYTHON) -m venv $(ASAN_VENV)
+	$(ASAN_PY) -m pip install --quiet --upgrade pip
+	rm -rf $(ASAN_VENV)/src && mkdir -p $(ASAN_VENV)/src/granular
+	cp setup.py pyproject.toml README.md MANIFEST.in $(ASAN_VENV)/src/
+	cp -r csrc $(ASAN_VENV)/src/ && cp granular/*.py $(ASAN_VENV)/src/granular/
+	GRANULAR_ASAN=1 CFLAGS="$(ASAN_CFLAGS)" $(ASAN_PY) -m pip install --quiet --force-reinstall \
+	    "$(ASAN_VENV)/src[test]"
+	touch $@
+
+test-asan: $(ASAN_VENV)/.installed
+	rm -rf $(ASAN_VENV)/tests && cp -r tests $(ASAN_VENV)/tests
+	cd $(ASAN_VENV)/tests && $(ASAN_ENV) ../bin/python -c "import granular._core, sys; \
+	    f = granular.__file__; sys.exit(0 if 'site-packages' in f else 'not the install: ' + f)"
+	cd $(ASAN_VENV)/tests && $(ASAN_ENV) ../bin/python -m pytest -q -p no:cacheprovider $(ASAN_TESTS)
+
+test-asan-ci:
+	$(MAKE) test-asan ASAN_TESTS="$(ASAN_CI_TESTS)"
 
 clean:
 	rm -rf build $(VENV) granular/*.so *.egg-info

@@ -1,0 +1,521 @@
+"""Random bad and edge inputs for tests/test_fuzz.py, and the worker process that runs them.
+
+A case is one call -- ``Scene(...)``, ``Scene.random(...)``, ``Simulation(scene).run(...)`` or
+``langevin.run(...)`` -- drawn by a seeded generator: a valid baseline with none, one or two of
+its arguments replaced by something wrong or extreme (wrong shapes and types, NaN/inf, zero and
+negative values, scales at the ends of float64, overlapping particles, far-away boxes, odd
+sample times and stop criteria). ``make_cases(seed, count)`` gives the same list in every
+process, so the worker and the test only exchange case numbers.
+
+A case passes when the call raises GranularError, ValueError or TypeError with a message
+(MemoryError too where the input asks for more memory than a machine has), or returns a result
+that passes the invariants: every number finite, no two particles overlapping at any sample,
+the kinetic energy conserved when pair collisions and walls are elastic, every requested
+sample returned when the run reaches its t_stop, Scene.random's radii where they were asked
+for. An unmutated baseline must not raise at all (but for an inelastic collapse, which is
+physics).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import traceback
+import warnings
+
+import numpy as np
+
+NAN, INF = math.nan, math.inf
+# Floats at the edges of float64: subnormal, near the square root of the extremes, near the max
+EXTREME = [NAN, INF, -INF, 0.0, -0.0, -1.0, 5e-324, 1e-310, 1e-300, 1e-154, 1e154, 1e300,
+           1.7976931348623157e308]
+# An elastic run may drift by rounding only: ~1e-16 relative per collision (the issue measured
+# <= 2e-15 over 1e7 collisions); these runs have < 1e5 events, so 1e-10 is far above rounding
+# and far below any real loss (a lost or doubled impulse changes E by O(1/N)).
+ENERGY_RTOL = 1e-10
+EVENTS = 20_000  # the event budget that keeps a case's run short
+
+
+class Opaque:
+    """A value of a type no parameter accepts, with a stable repr for the report."""
+
+    def __repr__(self):
+        return "Opaque()"
+
+
+WRONG_TYPES = ["abc", None, {"a": 1}, 1 + 1j, Opaque(), b"x"]
+
+
+# -- valid baselines ------------------------------------------------------------------------
+
+def _grid(rng, n, dim, length):
+    """n centres on a cubic grid in [0, length]^dim and the grid spacing."""
+    k = math.ceil(n ** (1 / dim) - 1e-9)
+    idx = np.array(np.unravel_index(rng.permutation(k**dim)[:n], (k,) * dim)).T
+    spacing = length / k
+    return (idx + 0.5) * spacing, spacing
+
+
+def _scene_params(rng):
+    n = int(rng.integers(1, 21))
+    dim = int(rng.choice([2, 3]))
+    length = float(rng.choice([1.0, 2.5, 0.5]))
+    pos, spacing = _grid(rng, n, dim, length)
+    boundary = str(rng.choice(["periodic", "walls"]))
+    radius = spacing * rng.uniform(0.1, 0.4)
+    if boundary == "periodic":
+        radius = min(radius, length / 4.5)  # the box must be > 2 diameters wide
+    return dict(positions=pos, velocities=rng.normal(size=(n, dim)),
+                radii=np.full(n, radius), masses=rng.uniform(0.5, 2.0, n), box=length,
+                boundary=boundary, wall_restitution=float(rng.choice([1.0, 1.0, 0.9])),
+                restitution=float(rng.choice([1.0, 1.0, 0.9, 0.5])),
+                contact_duration=float(rng.choice([0.0, 0.0, 1e-3])))
+
+
+def _random_params(rng, max_n=50):
+    n = int(rng.integers(1, max_n + 1))
+    dim = int(rng.choice([2, 3]))
+    length = float(rng.choice([1.0, 2.0]))
+    # the lattice start, melted by EDMD; in 2D only: a 3D box holds few fcc cells at n <= 50,
+    # and Scene.random refuses packings from 0.3 that such a small lattice cannot reach
+    dense = dim == 2 and n >= 20 and rng.random() < 0.2
+    packing = rng.uniform(0.3, 0.45) if dense else rng.uniform(0.01, 0.15)
+    if not dense and rng.random() < 0.4:  # a mixture of 2-3 species, size ratios up to 3
+        sizes = rng.uniform(1.0, 3.0, int(rng.integers(2, 4)))
+        rel = sizes[rng.integers(0, len(sizes), n)]
+    else:
+        rel = np.ones(n)
+    unit = math.pi if dim == 2 else 4 * math.pi / 3  # volume of a unit disk / sphere
+    scale = (packing * length**dim / (unit * np.sum(rel**dim))) ** (1 / dim)
+    radius = rel * scale if len(set(rel)) > 1 else float(scale)
+    boundary = str(rng.choice(["periodic", "walls"]))
+    if boundary == "periodic" and np.max(radius) > length / 4.5:
+        boundary = "walls"
+    p = dict(n=n, radius=radius, dim=dim, box=length, boundary=boundary,
+             restitution=float(rng.choice([1.0, 0.9])), seed=int(rng.integers(0, 2**31)))
+    if rng.random() < 0.3:
+        p["temperature"] = float(rng.uniform(0.1, 3))
+    if boundary == "walls" and rng.random() < 0.3:
+        p["wall_restitution"] = float(rng.choice([0.9, 1.0]))
+    return p
+
+
+def _run_params(rng):
+    scene = _random_params(rng, max_n=30)
+    t_stop = float(rng.choice([0.5, 1.0, 2.0]))
+    run = dict(t_stop=t_stop, sample_times=np.linspace(0.0, t_stop, int(rng.integers(2, 8))),
+               stop_when={"events": EVENTS})
+    return dict(scene=scene, run=run)
+
+
+def _langevin_params(rng):
+    p = dict(n=int(rng.integers(1, 51)), gamma0=float(rng.uniform(0.1, 10)),
+             D0=float(rng.uniform(0.1, 2)), dt=0.01, t_stop=float(rng.choice([0.5, 1.0, 2.0])),
+             scheme=str(rng.choice(["em", "exact"])), dim=int(rng.integers(1, 4)),
+             initial=str(rng.choice(["thermal", "fixed"])), seed=int(rng.integers(0, 2**31)))
+    if rng.random() < 0.4:
+        p["tau0"] = float(rng.uniform(1, 100))
+        p["initial"] = str(rng.choice(["thermal", "udsbm", "fixed"]))
+    if rng.random() < 0.3:
+        p["tamsd_lags"] = [0.1, 0.2]
+    if rng.random() < 0.3:
+        p["store_positions"] = True
+    return p
+
+
+# -- mutations: (label, function(rng, params)); labels starting "big:" may raise MemoryError --
+
+def _set(key, values):
+    def mutate(rng, p):
+        v = values[int(rng.integers(len(values)))]
+        p[key] = v
+        return f"{key}={v!r}"
+    return mutate
+
+
+def _entry(key, values):
+    """One entry of an array parameter set to a special value."""
+    def mutate(rng, p):
+        a = np.array(p[key], dtype=float)
+        v = values[int(rng.integers(len(values)))]
+        a.flat[int(rng.integers(a.size))] = v
+        p[key] = a
+        return f"{key}[one entry]={v!r}"
+    return mutate
+
+
+def _shape(key):
+    def mutate(rng, p):
+        a = np.asarray(p[key])
+        choice = int(rng.integers(6))
+        p[key] = [a.reshape(-1), a[:-1], np.concatenate([a, a[:1]]), a[None],
+                  a.reshape(len(a), -1)[:, :1], np.zeros((0,) + a.shape[1:])][choice]
+        return f"{key} reshaped to {np.shape(p[key])}"
+    return mutate
+
+
+def _scale(factor):
+    """Every length (positions, radii, box) times factor: the same scene at another scale."""
+    def mutate(rng, p):
+        p["positions"] = p["positions"] * factor
+        p["radii"] = p["radii"] * factor
+        p["box"] = p["box"] * factor
+        return f"all lengths x {factor:g}"
+    return mutate
+
+
+def _far_box(offset):
+    def mutate(rng, p):
+        p["positions"] = p["positions"] + offset
+        p["box"] = (offset, offset + p["box"])
+        return f"box shifted to {offset:g}"
+    return mutate
+
+
+def _overlap(kind):
+    def mutate(rng, p):
+        pos = np.array(p["positions"], dtype=float)
+        if len(pos) < 2:
+            pos = np.vstack([pos, pos])
+            p["velocities"] = np.vstack([p["velocities"], p["velocities"]])
+            p["radii"] = np.concatenate([p["radii"], p["radii"]])
+            p["masses"] = np.concatenate([p["masses"], p["masses"]])
+        gap = {"same place": 0.0, "overlap 1e-9": 1 - 1e-9, "touching": 1.0}[kind]
+        pos[1] = pos[0]
+        pos[1, 0] += gap * (p["radii"][0] + p["radii"][1])
+        p["positions"] = pos
+        return f"particles 0 and 1: {kind}"
+    return mutate
+
+
+def _outside(rng, p):
+    pos = np.array(p["positions"], dtype=float)
+    pos[0, 0] = float(rng.choice([-0.5, 1.5])) * p["box"]
+    p["positions"] = pos
+    return "particle 0 outside the box"
+
+
+def _velocity_scale(rng, p):
+    f = float(rng.choice([1e154, 1e200, 1e-300, 0.0]))
+    p["velocities"] = np.asarray(p["velocities"]) * f
+    return f"velocities x {f:g}"
+
+
+def _mass_spread(rng, p):
+    m = np.ones(len(p["masses"]))
+    m[::2] = 1e-300
+    m[1::2] = 1e300
+    p["masses"] = m
+    return "masses alternating 1e-300 and 1e300"
+
+
+SCENE_MUTATIONS = [
+    _entry("positions", [NAN, INF, -INF]), _shape("positions"),
+    _set("positions", WRONG_TYPES + [[[0.1, 0.1], [0.5]], np.array([["a", "b"]])]),
+    _entry("velocities", [NAN, INF, 1e154, 1e300]), _shape("velocities"),
+    _set("velocities", WRONG_TYPES), _velocity_scale,
+    _entry("radii", EXTREME), _shape("radii"), _set("radii", EXTREME + WRONG_TYPES),
+    _entry("masses", EXTREME), _shape("masses"), _set("masses", EXTREME + WRONG_TYPES),
+    _mass_spread,
+    _set("box", EXTREME + WRONG_TYPES + [(1.0, 0.0), ([0, 0], [1, 1, 1]), (0.0, NAN)]),
+    _far_box(1e8), _far_box(1e13), _far_box(1e15), _scale(1e-300), _scale(1e300),
+    _scale(1e-150), _scale(1e150),
+    _set("boundary", ["wall", "", None, 3, "PERIODIC"]),
+    _set("wall_restitution", EXTREME + [2.0, 1e3] + WRONG_TYPES),
+    _set("restitution", EXTREME + [-0.1, 1.1, 1 - 1e-16, "0.5", 1j, None]),
+    _set("contact_duration", EXTREME + ["x", None]),
+    _overlap("same place"), _overlap("overlap 1e-9"), _overlap("touching"), _outside,
+]
+
+RANDOM_MUTATIONS = [
+    _set("n", [0, -1, 1.5, "3", True, NAN, INF, None, 2**62, 10**30, np.int64(3), 1.0]),
+    _set("radius", EXTREME + WRONG_TYPES + [0.6, [0.01, 0.02], np.array([[0.01]])]),
+    _set("dim", [0, 1, 4, "3", 2.5, True, None, NAN]),
+    _set("box", EXTREME + WRONG_TYPES + [(1e15, 1e15 + 1), (1e13, 1e13 + 1), (1.0, 0.0),
+                                         ([0, 0], [1, 1]), 1e-300]),
+    _set("boundary", ["wall", None, 0]),
+    _set("restitution", EXTREME + [-0.1, 1.1, "1"]),
+    _set("speed", EXTREME + WRONG_TYPES + [1e200]),
+    _set("temperature", EXTREME + WRONG_TYPES),
+    _set("mass", EXTREME + WRONG_TYPES + [1e308, 5e-324, [1.0, 2.0]]),
+    _set("wall_restitution", EXTREME + [2.0, 1e3]),
+    _set("contact_duration", EXTREME + ["x"]),
+    _set("seed", [-1, "abc", 1.5, NAN, [1, 2], 2**200]),
+    _set("remove_drift", ["no", None, 2]),
+]
+
+
+def _scene_key(key, values):
+    def mutate(rng, p):
+        v = values[int(rng.integers(len(values)))]
+        p["scene"][key] = v
+        return f"scene {key}={v!r}"
+    return mutate
+
+
+def _run_key(key, values, unbounded=False):
+    """A run argument; ``unbounded`` drops the event budget and t_stop (criteria that must end
+    on their own or be refused)."""
+    def mutate(rng, p):
+        v = values[int(rng.integers(len(values)))]
+        p["run"][key] = v
+        if unbounded:
+            p["run"].pop("t_stop", None)
+            p["run"].pop("sample_times", None)
+        return f"run {key}={v!r}" + (" (no t_stop, no event budget)" if unbounded else "")
+    return mutate
+
+
+def _unbounded_t_stop(rng, p):
+    """t_stop infinite, absent or astronomic, with the event budget kept: the run must end."""
+    v = [INF, None, 1e300][int(rng.integers(3))]
+    p["run"]["t_stop"] = v
+    p["run"]["stop_when"] = {"events": EVENTS}
+    return f"run t_stop={v!r} (event budget kept)"
+
+
+def _huge_event_budget(rng, p):
+    """An event budget past int64, with a short t_stop that ends the run."""
+    p["run"]["t_stop"] = 0.5
+    p["run"]["sample_times"] = None
+    p["run"]["stop_when"] = {"events": 2**70}
+    return "run stop_when={'events': 2**70} with t_stop=0.5"
+
+
+def _run_twice(rng, p):
+    p["again"] = dict(t_stop=float(rng.choice([0.1, NAN, 1e300])))
+    return f"a second run to t_stop={p['again']['t_stop']!r}"
+
+
+def _round_sample(rng, p):
+    t = p["run"]["t_stop"]
+    p["run"]["sample_times"] = [t + 5e-13 * t, t + 9e-13 * t]
+    return "sample_times within rounding past t_stop"
+
+
+def _big_n(rng, p):
+    p["n"] = int(rng.choice([2**62, 2**40]))
+    return f"big: n={p['n']}"
+
+
+RUN_MUTATIONS = [
+    _scene_key("restitution", [0.0, 0.5, 0.99]),
+    _scene_key("wall_restitution", [0.5, 1.2, 2.0, 1e3]),
+    _scene_key("contact_duration", [1e-4, 1e-2, 1e3]),
+    _scene_key("speed", [1e154, 1e-154, 0.0]),
+    _scene_key("mass", [1e-300, 1e300, 1e-310, 1e308]),
+    _run_key("t_stop", [0.0, -1.0, NAN, "1", 5e-324, [1.0]]), _unbounded_t_stop,
+    _huge_event_budget,
+    _run_key("sample_times", [[], [NAN], [0.5, 0.2], [[0.0, 1.0]], [0.0, 3.0], [-1.0, 0.0],
+                              ["a"], [0.0, 0.0], np.linspace(0, 0.5, 10**4), 5.0, None,
+                              [0.0, 5e-324, 1e-323]]),
+    _round_sample,
+    _run_key("stop_when", [{"kinetic_energy": 0.1}, {"kinetic_energy": 0.0},
+                           {"kinetic_energy": 1e-300}, {"collisions_per_particle": 5}],
+             unbounded=True),
+    _run_key("stop_when", [{"kinetic_energy": NAN}, {"kinetic_energy": INF},
+                           {"collisions_per_particle": 0}, {"collisions_per_particle": -1},
+                           {"collisions_per_particle": NAN}, {"events": -1}, {"events": 1.5},
+                           {"events": True}, {"events": 0}, {"bogus": 1},
+                           "kinetic_energy", 5, {"events": "10"}]),
+    _run_key("store", [(), ("positions",), ("foo",), "positions", None, 3]),
+    _run_twice,
+]
+
+LANGEVIN_MUTATIONS = [
+    _set("n", [0, -1, 1.5, "5", True, NAN, None]), _big_n,
+    _set("gamma0", EXTREME + WRONG_TYPES + [250.0]),
+    _set("D0", EXTREME + WRONG_TYPES),
+    _set("dt", EXTREME + WRONG_TYPES + [10.0]),
+    _set("t_stop", EXTREME + WRONG_TYPES),
+    _set("tau0", EXTREME + WRONG_TYPES),
+    _set("model", ["langevin", "udsbm", "foo", None, 3]),
+    _set("scheme", ["rk4", None, "EM", 1]),
+    _set("dim", [0, 4, "2", 2.5, None]),
+    _set("sample_times", [[], [NAN], [0.5, 0.2], [[0.0, 1.0]], [0.0, 1e300], [-1.0], ["a"],
+                          5.0, [0.0, 1e-300]]),
+    _set("tamsd_lags", [[], [0.0], [-0.1], [NAN], [1e300], [0.2, 0.1], [[0.1]], ["a"],
+                        [1e-300]]),
+    _set("initial", ["foo", None, 3]),
+    _set("speed", EXTREME + WRONG_TYPES),
+    _set("seed", [-1, "abc", 1.5, NAN]),
+    _set("store_positions", ["yes", None]),
+]
+
+KINDS = {"scene": (_scene_params, SCENE_MUTATIONS), "random": (_random_params, RANDOM_MUTATIONS),
+         "run": (_run_params, RUN_MUTATIONS), "langevin": (_langevin_params, LANGEVIN_MUTATIONS)}
+
+
+def make_cases(seed, count):
+    """``count`` cases as dicts {kind, params, labels}, the same for the same seed."""
+    rng = np.random.default_rng(seed)
+    cases = []
+    for i in range(count):
+        kind = list(KINDS)[i % len(KINDS)]
+        baseline, mutations = KINDS[kind]
+        params = baseline(rng)
+        n_mut = int(rng.choice([0, 1, 1, 1, 1, 1, 2, 2, 2, 2]))
+        labels = []
+        for _ in range(n_mut):
+            mutate = mutations[int(rng.integers(len(mutations)))]
+            try:
+                labels.append(mutate(rng, params))
+            except Exception:  # noqa: BLE001 -- does not apply after an earlier mutation
+                pass
+        cases.append(dict(kind=kind, params=params, labels=labels))
+    return cases
+
+
+def describe(case):
+    """A short, reproducible description: kind, what was changed, the main arguments."""
+    def short(v):
+        if isinstance(v, np.ndarray):
+            return f"array{v.shape}" if v.size > 4 else repr(v.tolist())
+        if isinstance(v, dict):
+            return "{" + ", ".join(f"{k}: {short(x)}" for k, x in v.items()) + "}"
+        return repr(v)
+    params = ", ".join(f"{k}={short(v)}" for k, v in case["params"].items())
+    return f"{case['kind']}[{'; '.join(case['labels']) or 'baseline'}]({params})"
+
+
+# -- running one case -----------------------------------------------------------------------
+
+class InvariantError(AssertionError):
+    pass
+
+
+def _check(ok, what):
+    if not ok:
+        raise InvariantError(what)
+
+
+def _verified(check):
+    """``check`` with any exception it raises turned into a failed invariant: once a call has
+    returned, its result must be usable (a final state that raises OverlapError is a bug)."""
+    def wrapped(*args):
+        try:
+            check(*args)
+        except InvariantError:
+            raise
+        except Exception as exc:  # noqa: BLE001
+            raise InvariantError(f"checking the result raised {type(exc).__name__}: {exc}") \
+                from None
+    return wrapped
+
+
+@_verified
+def _check_trajectory(scene, traj, sim, sample_times=None):
+    from granular import Scene
+
+    if sample_times is not None and traj.stop_reason == "time":  # every sample or an error
+        want = len(np.asarray(sample_times, dtype=float))
+        _check(len(traj.times) == want, f"{want} sample times asked, {len(traj.times)} returned")
+
+    for name in ("times", "positions", "velocities", "kinetic_energy", "momentum"):
+        a = getattr(traj, name)
+        _check(a is None or np.all(np.isfinite(a)), f"non-finite {name} in the trajectory")
+    stats = {k: v for k, v in sim.stats.items()  # pressure: NaN is a documented answer
+             if k != "pressure" and isinstance(v, (int, float, np.number))}
+    _check(all(math.isfinite(v) for v in stats.values()), f"non-finite stats: {stats}")
+    if traj.positions is not None and traj.velocities is not None:
+        length = scene.upper - scene.lower
+        every = max(1, len(traj.times) // 20)  # at most ~20 samples checked for overlaps
+        for x, v in zip(traj.positions[::every], traj.velocities[::every]):
+            if scene.boundary == "periodic":
+                x = scene.lower + np.mod(x - scene.lower, length)
+                x = np.where(x >= scene.upper, scene.lower, x)  # mod can round up to L
+            # the scene's own checks (inside the box, no overlap) raise on a bad sample
+            Scene(x, v, scene.radii, scene.masses, box=(scene.lower, scene.upper),
+                  boundary=scene.boundary)
+    sim.scene  # the final state, checked the same way
+    elastic = scene.restitution == 1 and (scene.boundary == "periodic"
+                                          or scene.wall_restitution == 1)
+    if elastic and len(traj.kinetic_energy):
+        e = np.asarray(traj.kinetic_energy, dtype=float)
+        drift = np.max(np.abs(e - e[0])) / e[0] if e[0] > 0 else np.max(np.abs(e))
+        _check(drift <= ENERGY_RTOL, f"elastic run: kinetic energy drifted by {drift:.3g}")
+
+
+@_verified
+def _check_langevin(r):
+    for name in ("times", "msd", "v2", "tamsd", "positions"):
+        a = getattr(r, name, None)
+        _check(a is None or np.all(np.isfinite(a)), f"non-finite {name}")
+    _check(np.all(r.msd >= 0), "negative MSD")
+    _check(np.all(np.diff(r.times) > 0), "sample times not increasing")
+
+
+def _run_scene(scene):
+    """A short run of a scene that was accepted: it must keep the invariants."""
+    from granular import Simulation
+
+    speed = math.sqrt(2 * scene.kinetic_energy / np.sum(scene.masses)) if scene.n else 0.0
+    length = float(np.min(scene.upper - scene.lower))
+    t_stop = length / speed if speed > 0 and math.isfinite(length / speed) else 1.0
+    sim = Simulation(scene)
+    traj = sim.run(t_stop, sample_times=np.linspace(0, t_stop, 5), stop_when={"events": EVENTS})
+    _check_trajectory(scene, traj, sim)
+
+
+def run_case(case):
+    """Run one case: ("ok" | "error" | "FAIL", detail)."""
+    import granular
+    from granular import Scene, Simulation, langevin
+
+    kind, p = case["kind"], case["params"]
+    mutated = bool(case["labels"])
+    big = any("big:" in label for label in case["labels"])
+    try:
+        if kind == "scene":
+            _run_scene(Scene(**p))
+        elif kind == "random":
+            s = Scene.random(**p)
+            want = np.asarray(p["radius"], dtype=float)
+            _check(s.n == p["n"] and s.dim == p["dim"], f"got n={s.n}, dim={s.dim}")
+            _check(want.shape in ((), (s.n,)) and np.array_equal(s.radii, want * np.ones(s.n)),
+                   "the radii are not the requested ones, particle by particle")
+            _run_scene(s)
+        elif kind == "run":
+            scene = Scene.random(**p["scene"])
+            sim = Simulation(scene)
+            traj = sim.run(**p["run"])
+            _check_trajectory(scene, traj, sim, p["run"].get("sample_times"))
+            if "again" in p:
+                traj = sim.run(**p["again"], stop_when={"events": EVENTS})
+                _check_trajectory(scene, traj, sim)
+        else:
+            _check_langevin(langevin.run(**p))
+        return "ok", ""
+    except InvariantError as exc:
+        return "FAIL", f"invariant: {exc}"
+    except Exception as exc:  # noqa: BLE001 -- classifying every exception is the point
+        name = type(exc).__name__
+        msg = str(exc).strip()
+        allowed = (granular.GranularError, ValueError, TypeError) + ((MemoryError,) if big else ())
+        if not mutated and not isinstance(exc, granular.InelasticCollapseError):
+            return "FAIL", f"a valid baseline raised {name}: {msg}"
+        if not isinstance(exc, allowed):
+            tb = traceback.extract_tb(exc.__traceback__)[-1]
+            return "FAIL", f"{name}: {msg} (at {os.path.basename(tb.filename)}:{tb.lineno})"
+        if not msg:
+            return "FAIL", f"{name} without a message"
+        return "error", f"{name}: {msg}"
+
+
+def worker(seed, count):
+    """Read case numbers from stdin, write one JSON line [status, detail] per case."""
+    out = os.fdopen(os.dup(1), "w")
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)  # what the library prints must not mix with the answers
+    warnings.simplefilter("ignore")
+    np.seterr(all="ignore")
+    cases = make_cases(seed, count)
+    import granular  # noqa: F401 -- imported before the first case's timer starts
+
+    out.write("ready\n")
+    out.flush()
+    for line in sys.stdin:
+        status, detail = run_case(cases[int(line)])
+        out.write(json.dumps([status, detail[:500]]) + "\n")
+        out.flush()
