@@ -3,11 +3,11 @@ Langevin engine's workloads when it is present).  Figures are printed and writte
 JSON, never asserted: speed is measured here, not in the tests."""
 from __future__ import annotations
 
-import json
 import math
 import platform
 import time
 
+from .demo import write_json
 from .scene import Scene
 from .simulation import Simulation
 
@@ -90,6 +90,5 @@ def main(json_path=None, quick=False, large=False):
                     processor=platform.processor())
         for r in results:
             r.setdefault("host", meta)
-        with open(json_path, "w") as f:
-            json.dump(results, f, indent=1)
+        write_json(json_path, results)
     return results

@@ -75,7 +75,8 @@ def speed_distribution(velocities, temperature=None, mass=1.0, bins=40, ax=None,
     v = np.asarray(velocities, dtype=np.float64)
     dim = v.shape[-1]
     T = float(np.mean(analysis.temperature(v, mass))) if temperature is None else temperature
-    top = 4.0 * np.sqrt(dim * T / mass)
+    # up to the fastest particle, so that the panel is not empty beyond the data
+    top = float(np.max(np.linalg.norm(v, axis=-1))) * 1.02
     centres, dens, err = analysis.speed_histogram(v, bins=bins, range=(0.0, top))
     width = centres[1] - centres[0]
     ax.bar(centres, dens, width=width, alpha=0.5, label=label, yerr=err, ecolor="0.4")
@@ -112,8 +113,9 @@ def haff(times, temperature, tau0, temperature0=None, ax=None, label="simulation
 
 
 def msd(times, values, error=None, theory_values=None, ax=None, label="simulation",
-        theory_label="theory", loglog=True):
-    """MSD against time with error bars and a theory curve (Figs 4.11-4.13, 4.17-4.20)."""
+        theory_label="theory", loglog=True, theory_style="k--"):
+    """MSD against time with error bars and a theory curve (Figs 4.11-4.13, 4.17-4.20);
+    ``theory_style`` is its matplotlib format string, to tell several theories apart."""
     ax = _axes(ax)
     t = np.asarray(times, dtype=np.float64)
     keep = t > 0 if loglog else np.ones(len(t), dtype=bool)
@@ -123,7 +125,7 @@ def msd(times, values, error=None, theory_values=None, ax=None, label="simulatio
     else:
         ax.plot(t[keep], y, "o", ms=3, label=label)
     if theory_values is not None:
-        ax.plot(t[keep], np.asarray(theory_values)[keep], "k--", label=theory_label)
+        ax.plot(t[keep], np.asarray(theory_values)[keep], theory_style, label=theory_label)
     if loglog:
         ax.set_xscale("log")
         ax.set_yscale("log")

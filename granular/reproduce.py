@@ -19,7 +19,7 @@ smaller systems over shorter times with ``QUICK_RUNS`` runs each.  A row is
 central-limit standard error over ``runs`` independent runs (both None where the value is
 not a mean over runs), the thesis' value where it printed one for the same system (the App. F
 slopes are None in quick mode, whose system is smaller; the quantity text quotes them), and
-theory's.
+theory's; non-finite numbers are written as null (strict JSON has no Infinity).
 ``report.md`` shows the table beside the figures; its sentences are generated from the
 rows: each comparison with its relative deviation and whether it lies within ``SIGMA``
 standard errors.
@@ -32,7 +32,6 @@ whose velocity vectors are shuffled among the particles for each run (section 3.
 from __future__ import annotations
 
 import functools
-import json
 import math
 import os
 import time
@@ -40,6 +39,7 @@ import time
 import numpy as np
 
 from . import analysis, langevin, plot, theory
+from .demo import write_json
 from .ensemble import ensemble
 from .scene import Scene
 from .simulation import Simulation
@@ -134,8 +134,8 @@ def _fig_4_1(cfg, out):
     for k in range(2):
         ax.plot(t, tr.positions[:, k, 0], label=f"particle {k}")
     ax.axvline(0.4, color="0.7", ls=":", label="contact, t = 0.4")
-    ax.set_xlabel("time t")
-    ax.set_ylabel("x position")
+    ax.set_xlabel(plot.TIME)
+    ax.set_ylabel(plot.POSITION.format("x"))
     ax.legend()
     ax.set_title("Fig. 4.1: head-on collision, reflecting walls")
     return [_save(fig, out, "fig4_1_head_on.png")], []
@@ -158,8 +158,8 @@ def _fig_4_2_to_4_4(cfg, out):
         rel = np.array([run["kinetic_energy"] / run["kinetic_energy"][0] - 1 for run in r.runs])
         drifts.append(np.max(np.abs(rel)))
         ax.plot(t, rel.mean(0), label=name)
-    ax.set_xlabel("time t")
-    ax.set_ylabel(r"$\langle E \rangle(t) / \langle E \rangle(0) - 1$")
+    ax.set_xlabel(plot.TIME)
+    ax.set_ylabel(r"$\langle E \rangle(t) / \langle E \rangle(0) - 1$ (dimensionless)")
     ax.set_title("Fig. 4.2: energy of a molecular gas")
     ax.legend()
     names = [_save(fig, out, "fig4_2_energy.png")]
@@ -169,8 +169,8 @@ def _fig_4_2_to_4_4(cfg, out):
             r = res[boundary, xi]
             ax.errorbar(t, r.mean["collisions_per_particle"], yerr=r.error["collisions_per_particle"],
                         label=name, errorevery=10)
-        ax.set_xlabel("time t")
-        ax.set_ylabel("collisions per particle")
+        ax.set_xlabel(plot.TIME)
+        ax.set_ylabel(plot.COLLISIONS)
         ax.set_title(f"Fig. {fig_no.replace('_', '.')}: " + ("molecular gas" if xi == 1 else r"granular gas, $\xi$ = 0.8"))
         ax.legend()
         names.append(_save(fig, out, f"fig{fig_no}_collisions.png"))
@@ -231,8 +231,8 @@ def _fig_4_8_and_4_10(cfg, out):
     ax.plot(t[1:], theory.haff_temperature(t[1:], T0, c.tau0), "k--", label="Haff (2.40)")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time t")
-    ax.set_ylabel("granular temperature T")
+    ax.set_xlabel(plot.TIME)
+    ax.set_ylabel(plot.TEMPERATURE)
     ax.set_title(r"Fig. 4.8: boundary conditions, $\xi$ = 0.8")
     ax.legend()
     names.append(_save(fig, out, "fig4_8_haff_boundaries.png"))
@@ -247,7 +247,7 @@ def _fig_4_8_and_4_10(cfg, out):
                         [analysis.fit_haff_tau0(t, run["temperature"])[0] for run in r.runs], None, c.tau0)
         rows.append(row)
         plot.haff(t, r.mean["temperature"], c.tau0, temperature0=eq.temperature, ax=ax,
-                  error=r.error["temperature"], label=f"EDMD, fit tau0 = {row['ours']:.3g}")
+                  error=r.error["temperature"], label=rf"EDMD, fit $\tau_0$ = {row['ours']:.3g}")
         ax.set_title(rf"Fig. 4.10: $\xi$ = {xi}")
     names.append(_save(fig, out, "fig4_10_haff_xi.png"))
     return names, rows
@@ -354,7 +354,8 @@ def _fig_4_17_to_4_23(cfg, out):
         model = "Langevin" if xi == 1 else f"UDSBM, xi = {xi}"
         fig, ax = _fig()
         plot.msd(r.times, r.mean["msd"], error=r.error["msd"], theory_values=th, ax=ax,
-                 label="Euler-Maruyama, dt = 0.01", theory_label="(2.68)" if xi == 1 else "(2.113) + start")
+                 label=r"Euler-Maruyama, $\Delta t$ = 0.01",
+                 theory_label="(2.68)" if xi == 1 else "(2.113) + start")
         ax.set_title(f"Fig. {fig_no.replace('_', '.')}: " + ("Langevin" if xi == 1 else rf"UDSBM, $\xi$ = {xi}"))
         names.append(_save(fig, out, f"fig{fig_no}_sde_msd_xi{xi}.png"))
         rows.append(_mean_row(f"sde.msd.xi{xi:g}", f"{model}: MSD at t = {r.times[-1]:g}, Euler-Maruyama "
@@ -367,13 +368,13 @@ def _fig_4_17_to_4_23(cfg, out):
         stable = c.gamma0 * dt < 2  # Euler-Maruyama's stability limit
         r = run(0.8, dt, cfg.t_long, scheme="em" if stable else "exact")
         ax.plot(r.times[1:], r.mean["msd"][1:], "o-", ms=3,
-                label=f"dt = {dt} (" + ("Euler-Maruyama" if stable else
-                                        f"exact: Euler-Maruyama diverges, gamma0 dt = {c.gamma0 * dt:.1f}") + ")")
+                label=rf"$\Delta t$ = {dt} (" + ("Euler-Maruyama" if stable else "exact: Euler-Maruyama "
+                                                 rf"diverges, $\gamma_0 \Delta t$ = {c.gamma0 * dt:.1f}") + ")")
     ax.plot(t_samples[1:], msd_theory(0.8, t_samples[1:]), "k--", label="theory")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time t")
-    ax.set_ylabel("MSD")
+    ax.set_xlabel(plot.TIME)
+    ax.set_ylabel(plot.MSD)
     ax.set_title(r"Fig. 4.20: UDSBM $\xi$ = 0.8, time steps")
     ax.legend(fontsize=7)
     names.append(_save(fig, out, "fig4_20_dt_sweep.png"))
@@ -407,7 +408,7 @@ def _fig_4_17_to_4_23(cfg, out):
         ax.plot(lags, tamsd_th, "k--", lw=1, label="time-averaged MSD, theory")
         ax.legend()
         ax.set_title(f"Fig. {fig_no.replace('_', '.')}: " + ("Langevin" if xi == 1 else rf"UDSBM, $\xi$ = {xi}")
-                     + f", t_stop = {cfg.t_long:g}")
+                     + rf", $t_{{stop}}$ = {cfg.t_long:g}")
         names.append(_save(fig, out, f"fig{fig_no}_ergodicity_{label}_t{cfg.t_long:g}.png"))
         rows.append(ratio_row(label, xi, r, lags, tamsd_th))
 
@@ -416,15 +417,16 @@ def _fig_4_17_to_4_23(cfg, out):
     keep = longest.times > 0
     ax.plot(longest.times[keep], longest.mean["msd"][keep], "k-", label="ensemble MSD")
     for i, (t_stop, (r, lags, tamsd_th)) in enumerate(sorted(udsbm.items())):
-        ax.plot(lags, r.mean["tamsd"], "o", ms=3, color=f"C{i}", label=f"time-averaged MSD, t_stop = {t_stop:g}")
+        ax.plot(lags, r.mean["tamsd"], "o", ms=3, color=f"C{i}",
+                label=rf"time-averaged MSD, $t_{{stop}}$ = {t_stop:g}")
         ax.plot(lags, tamsd_th, "--", lw=1, color=f"C{i}")
     ax.plot([], [], "--", lw=1, color="0.4", label="time-averaged MSD, theory")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("time t / lag")
-    ax.set_ylabel("MSD")
+    ax.set_xlabel(plot.LAG_OR_TIME)
+    ax.set_ylabel(plot.MSD_AND_TAMSD)
     ax.legend(fontsize=7)
-    ax.set_title(r"Fig. 4.23: UDSBM, $\xi$ = 0.8, against t_stop")
+    ax.set_title(r"Fig. 4.23: UDSBM, $\xi$ = 0.8, against $t_{stop}$")
     names.append(_save(fig, out, "fig4_23_ergodicity_udsbm_tstop.png"))
     return names, rows
 
@@ -467,8 +469,7 @@ def main(out="granular-reproduce", quick=False, runs=None, backend="processes"):
         names += n
         rows += r
         print(f"  Fig. {name:<12} {time.perf_counter() - t0:6.1f} s  {', '.join(n)}", flush=True)
-    with open(os.path.join(out, "summary.json"), "w") as f:
-        json.dump(rows, f, indent=1)
+    write_json(os.path.join(out, "summary.json"), rows)
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write(_report(rows, cfg, names, time.perf_counter() - started))
     print(f"reproduced {len(names)} figures, {len(rows)} summary rows in {out}/ "

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import functools
 import itertools
-import json
 import math
 import os
 import time
@@ -41,6 +40,7 @@ import numpy as np
 
 from . import analysis, langevin, theory
 from .bench_langevin import log_lags
+from .demo import write_json
 from .ensemble import ensemble
 from .errors import InelasticCollapseError, UnstableStepError
 from .scene import Scene
@@ -271,10 +271,45 @@ def scene_costs(quick=False):
     for lags in (0, 30):
         t0 = clock()
         r = langevin.run(1000, gamma0=9.26, D0=0.072, dt=0.01, t_stop=100.0 if not quick else 10.0,
-                         tamsd_lags=log_lags(lags, 10.0, 0.01) if lags else None, seed=1)
+                         tamsd_lags=log_lags(lags, 10.0, 0.01) if lags else None, scheme="em", seed=1)
         rows.append(dict(case=f"Langevin EM, N = 1000, {len(r.tamsd_lags)} TAMSD lags accumulated",
                          seconds=clock() - t0))
     return rows
+
+
+# the collapse map's outcomes, in legend order, with their colours and meanings
+COLLAPSE_STATUS = {"ok": ("tab:green", "ok: reached 100 collisions per particle"),
+                   "tc": ("tab:blue", "tc: reached it, TC model acting"),
+                   "budget": ("tab:orange", "budget: event budget ran out first"),
+                   "collapse": ("tab:red", "collapse: inelastic collapse")}
+
+
+def _collapse_map(plt, cells):
+    """One panel per contact duration: a grid of cells (area fraction x restitution), each
+    coloured and labelled by its outcome; the legend lists only the outcomes that occur."""
+    from matplotlib.patches import Patch, Rectangle
+
+    tcs = sorted({c["contact_duration"] for c in cells})
+    etas = sorted({c["eta"] for c in cells})
+    xis = sorted({c["xi"] for c in cells})
+    fig, axes = plt.subplots(1, len(tcs), figsize=(4.5 * len(tcs) + 1.5, 4.2), layout="constrained",
+                             squeeze=False)
+    for ax, tc in zip(axes[0], tcs):
+        for c in (c for c in cells if c["contact_duration"] == tc):
+            x, y = etas.index(c["eta"]), xis.index(c["xi"])
+            ax.add_patch(Rectangle((x - 0.45, y - 0.45), 0.9, 0.9, color=COLLAPSE_STATUS[c["status"]][0]))
+            ax.text(x, y, c["status"], ha="center", va="center", fontsize=8, color="w")
+        ax.set_xlim(-0.5, len(etas) - 0.5)
+        ax.set_ylim(-0.5, len(xis) - 0.5)
+        ax.set_xticks(range(len(etas)), [f"{e:g}" for e in etas])
+        ax.set_yticks(range(len(xis)), [f"{x:g}" for x in xis])
+        ax.set_xlabel("area fraction")
+        ax.set_ylabel(r"restitution $\xi$")
+        ax.set_title("2D disks, walls, " + ("no TC model" if tc == 0 else rf"TC model $t_c$ = {tc:g}"))
+    seen = {c["status"] for c in cells}
+    fig.legend(handles=[Patch(color=color, label=text) for status, (color, text) in COLLAPSE_STATUS.items()
+                        if status in seen], loc="outside lower center", ncols=len(seen), fontsize=8)
+    return fig
 
 
 def _charts(out, points, refs, stab, cells, dense):
@@ -291,11 +326,16 @@ def _charts(out, points, refs, stab, cells, dense):
                 pts = [p for p in points if p["gas"] == gas and p["method"] == method]
                 if not pts:
                     continue
+                if method != "edmd":
+                    # one line per scheme in order of the step, labelled at its two ends only:
+                    # a label at every step would pile up where the steps cost alike
+                    pts = sorted(pts, key=lambda p: p["dt"])
+                    marker += "-"
                 ax.loglog([p["seconds"] for p in pts], [max(p[key], 1e-5) for p in pts], marker,
-                          label={"edmd": "EDMD (N, runs)", "em": "Langevin/UDSBM, Euler-Maruyama",
-                                 "exact": "Langevin/UDSBM, exact scheme"}[method])
-                for p in pts:
-                    ax.annotate(p["label"] if method == "edmd" else p["label"].split(", ", 1)[-1],
+                          label={"edmd": "EDMD (N, runs)", "em": r"Langevin/UDSBM, Euler-Maruyama ($\Delta t$)",
+                                 "exact": r"Langevin/UDSBM, exact scheme ($\Delta t$)"}[method])
+                for p in (pts if method == "edmd" else (pts[0], pts[-1])):
+                    ax.annotate(p["label"] if method == "edmd" else rf"$\Delta t$ = {p['dt']:.3g}",
                                 (p["seconds"], max(p[key], 1e-5)),
                                 fontsize=6, xytext=(3, 3), textcoords="offset points")
             ax.set_xlabel("CPU seconds, one core (EDMD: equilibration included)")
@@ -311,26 +351,14 @@ def _charts(out, points, refs, stab, cells, dense):
     for scheme, marker in (("em", "s-"), ("exact", "^-")):
         ax.loglog(g, [r[scheme] if r[scheme] is not None else np.nan for r in stab], marker,
                   label={"em": "Euler-Maruyama", "exact": "exact scheme"}[scheme])
-    ax.axvline(2.0, color="r", ls=":", label="EM refused (gamma0 dt >= 2)")
+    ax.axvline(2.0, color="r", ls=":", label=r"EM refused ($\gamma_0 \Delta t \geq 2$)")
     ax.set_xlabel(r"$\gamma_0 \Delta t$")
     ax.set_ylabel("max relative MSD error vs (2.68)")
     ax.legend()
     fig.savefig(os.path.join(out, "em_stability.png"), dpi=110)
     plt.close(fig)
 
-    tcs = sorted({c["contact_duration"] for c in cells})
-    fig, axes = plt.subplots(1, len(tcs), figsize=(5.5 * len(tcs), 4.2), layout="constrained", squeeze=False)
-    colors = {"ok": "tab:green", "tc": "tab:blue", "budget": "tab:orange", "collapse": "tab:red"}
-    for ax, tc in zip(axes[0], tcs):
-        for c in (c for c in cells if c["contact_duration"] == tc):
-            ax.scatter(c["eta"], c["xi"], s=700, marker="s", color=colors[c["status"]])
-            ax.annotate(c["status"], (c["eta"], c["xi"]), ha="center", va="center", fontsize=6, color="w")
-        for status, color in colors.items():
-            ax.scatter([], [], s=60, marker="s", color=color, label=status)
-        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1, 1))
-        ax.set_xlabel("area fraction")
-        ax.set_ylabel(r"restitution $\xi$")
-        ax.set_title("2D disks, walls, " + ("no TC model" if tc == 0 else f"TC model t_c = {tc:g}"))
+    fig = _collapse_map(plt, cells)
     fig.savefig(os.path.join(out, "collapse_map.png"), dpi=110)
     plt.close(fig)
 
@@ -360,10 +388,10 @@ def main(out="speed-accuracy", quick=False):
     dense = dense_cost(quick)
     costs = scene_costs(quick)
     _charts(out, points, refs, stab, cells, dense)
-    with open(os.path.join(out, "speed_accuracy.json"), "w") as f:
-        json.dump(dict(seconds="CPU-seconds of one process, every method serial on one thread",
-                       points=points, references=refs, em_stability=stab, collapse_map=cells,
-                       dense_cost=dense, scene_costs=costs), f, indent=1)
+    write_json(os.path.join(out, "speed_accuracy.json"),
+               dict(seconds="CPU-seconds of one process, every method serial on one thread",
+                    points=points, references=refs, em_stability=stab, collapse_map=cells,
+                    dense_cost=dense, scene_costs=costs))
     print(f"{'method':<34} {'CPU s':>8} {'MSD err':>8} {'slope err':>9}")
     for p in points:
         print(f"{p['gas'][:4] + ' ' + p['label']:<34} {p['seconds']:>8.2f} {p['msd_error']:>8.3f} {p['slope_error']:>9.3f}")

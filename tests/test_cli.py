@@ -24,6 +24,26 @@ def run(*args, cwd):
                           text=True, timeout=600, check=True)
 
 
+def strict_json(path):
+    """The file parsed by a strict JSON parser: Infinity and NaN, which Python's json writes
+    by default but other parsers reject, raise."""
+    def refuse(constant):
+        raise ValueError(f"{path.name} holds {constant}, which is not JSON")
+
+    return json.loads(path.read_text(), parse_constant=refuse)
+
+
+def test_json_files_are_strict(tmp_path):
+    """Non-finite numbers (a molecular gas' tau0 is infinite) are written as null, so the
+    summaries parse with strict parsers; demo, reproduce and the benchmarks all write this way."""
+    import numpy as np
+
+    from granular.demo import write_json
+
+    write_json(tmp_path / "s.json", [dict(tau0=float("inf"), x=np.float64("nan"), ok=1.5, row=(2, -math.inf))])
+    assert strict_json(tmp_path / "s.json") == [dict(tau0=None, x=None, ok=1.5, row=[2, None])]
+
+
 def assert_agrees(what, ours, error, runs, theory, margin):
     t = stats.t.ppf(1 - FALSE_ALARM / 2, runs - 1)
     tolerance = t * error + margin * abs(theory)
@@ -71,8 +91,15 @@ def test_demo_quick(tmp_path):
     assert "granular demo" in out.stdout
     for name in ("demo.png", "msd.png", "temperature.png", "speeds.png"):
         assert (tmp_path / "demo" / name).stat().st_size > 10_000
-    rows = {r["gas"]: r for r in json.loads((tmp_path / "demo" / "summary.json").read_text())}
+    rows = {r["gas"]: r for r in strict_json(tmp_path / "demo" / "summary.json")}
     mol, gran = rows["molecular"], rows["granular"]
+    assert mol["tau0_theory"] is None and gran["tau0_theory"] > 0  # a molecular gas never cools
+    # the deviations from theory are printed with their standard errors, and explained
+    line = re.search(r"molecular MSD ([-+][\d.]+)% \+- ([\d.]+)%", out.stdout)
+    assert line, out.stdout
+    assert float(line[1]) == pytest.approx(100 * (mol["msd_end"] / mol["msd_end_theory"] - 1), abs=0.05)
+    assert float(line[2]) == pytest.approx(100 * mol["msd_end_error"] / mol["msd_end_theory"], abs=0.05)
+    assert "Enskog's D0" in out.stdout and "Maxwellian cooling rate" in out.stdout
     assert mol["runs"] >= 10 and gran["runs"] >= 10
     assert mol["T_end"] == pytest.approx(mol["T_end_theory"], rel=1e-12)
     assert_agrees("granular T(t_end)", gran["T_end"], gran["T_end_error"], gran["runs"], gran["T_end_theory"],
@@ -105,7 +132,7 @@ def test_reproduce_quick(tmp_path):
     from granular import reproduce
 
     run("reproduce", "--quick", "--out", "rep", cwd=tmp_path)
-    rows = {r["id"]: r for r in json.loads((tmp_path / "rep" / "summary.json").read_text())}
+    rows = {r["id"]: r for r in strict_json(tmp_path / "rep" / "summary.json")}
     required = ["energy.drift.xi1", "msd.slope.xi1", "msd.slope.xi0.8", "ergodicity.langevin",
                 "ergodicity.udsbm"] + [f"table4.1.{d}.{k}" for d in ("2d", "3d") for k in ("mean", "mean_sq", "std")] \
         + [f"haff.tau0.xi{x}" for x in ("0.99", "0.5", "0.3")]

@@ -32,3 +32,49 @@ def test_all_plots_render(tmp_path):
     fig, ax = plt.subplots()
     assert plot.energy(t, np.ones(20), ax=ax) is ax
     plt.close("all")
+
+
+def _texts(ax):
+    """Every piece of text a reader sees on the axes: labels, title, legend entries."""
+    legend = ax.get_legend()
+    return [ax.get_xlabel(), ax.get_ylabel(), ax.get_title(),
+            *([t.get_text() for t in legend.get_texts()] if legend else [])]
+
+
+def test_demo_panels_read_well():
+    """The demo's panels, drawn from synthetic results: the two MSD theories are told apart by
+    line style, every axis has a unit, Greek symbols are mathtext (never 'tau0' or 'xi'),
+    and the speed histograms end at the fastest particle rather than far beyond it."""
+    from types import SimpleNamespace
+
+    from granular import demo
+
+    rng = np.random.default_rng(1)
+    t = np.concatenate([[0.0], np.logspace(-2, 1, 20)])
+    results = {}
+    for label, xi in (("molecular", 1.0), ("granular", 0.8)):
+        c = theory.langevin_coefficients(300, 0.037, 1.0, xi, 0.66)
+        T = theory.haff_temperature(t, 0.66, c.tau0) if xi < 1 else np.full_like(t, 0.66)
+        msd = theory.msd_granular(t, c.D0, c.gamma0, c.tau0)
+        res = SimpleNamespace(mean=dict(msd=msd, temperature=T), error=dict(msd=0.01 * msd, temperature=0.01 * T),
+                              times=t, runs=[dict(velocities=[rng.normal(size=(300, 3)) * np.sqrt(T[-1])])])
+        results[label] = (res, msd, T, c)
+    fig, axes = plt.subplots(1, 4)
+    demo._msd(axes[0], t, results)
+    demo._temperature(axes[1], t, results)
+    demo._speeds(axes[2], "molecular", results)
+    demo._speeds(axes[3], "granular", results)
+    theories = [line for line in axes[0].get_lines() if "theory" in line.get_label()]
+    assert len(theories) == 2
+    assert len({(line.get_linestyle(), line.get_color()) for line in theories}) == 2, "theories look alike"
+    for ax in axes:
+        for label in (ax.get_xlabel(), ax.get_ylabel()):
+            assert "[" in label or "dimensionless" in label, f"no unit in {label!r}"
+        for text in _texts(ax):
+            assert "tau0" not in text and "xi " not in text and "xi=" not in text, text
+    for ax, label in ((axes[2], "molecular"), (axes[3], "granular")):
+        v = results[label][0].runs[0]["velocities"][-1]
+        fastest = np.max(np.linalg.norm(v, axis=1))
+        # the histogram's last bin ends 2% past the fastest particle; matplotlib's 5% margin
+        assert ax.get_xlim()[1] < 1.1 * fastest
+    plt.close("all")

@@ -40,7 +40,10 @@ def test_speed_accuracy_cli_quick(tmp_path):
 
     subprocess.run([sys.executable, "-m", "granular", "bench", "--speed-accuracy", "--quick",
                     "--out", str(tmp_path)], check=True, capture_output=True, timeout=600)
-    data = json.loads((tmp_path / "speed_accuracy.json").read_text())
+    def refuse(constant):  # strict JSON: no Infinity or NaN, which other parsers reject
+        raise ValueError(f"speed_accuracy.json holds {constant}, which is not JSON")
+
+    data = json.loads((tmp_path / "speed_accuracy.json").read_text(), parse_constant=refuse)
     methods = {p["method"] for p in data["points"]}
     assert methods == {"edmd", "em", "exact"}
     assert {p["gas"] for p in data["points"]} == {"granular", "molecular"}
@@ -60,3 +63,28 @@ def test_speed_accuracy_cli_quick(tmp_path):
     # 3D with both cells and lists, at every packing
     assert {r["shell"] for r in dense if r["dim"] == 3} == {0.0, _LIST_SHELL}
     assert {r["shell"] for r in dense if r["dim"] == 2} == {0.0}
+
+
+def test_collapse_map_chart_reads_well():
+    """The collapse map's legend lists only the outcomes that occur, and each cell's label
+    lies inside its square (synthetic cells: all four outcomes possible, two occur)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
+    cells = [dict(contact_duration=tc, eta=eta, xi=xi, status="collapse" if xi < 0.5 and tc == 0 else "ok")
+             for tc in (0.0, 1e-4) for eta in (0.05, 0.2, 0.4, 0.6, 0.7) for xi in (0.9, 0.7, 0.5, 0.3, 0.1)]
+    fig = speed_accuracy._collapse_map(plt, cells)
+    legend = [t.get_text().split(":")[0] for t in fig.legends[0].get_texts()]
+    assert sorted(legend) == ["collapse", "ok"]
+    renderer = fig.canvas.get_renderer()
+    for ax in fig.axes:
+        squares = [p.get_window_extent(renderer) for p in ax.patches if isinstance(p, Rectangle)]
+        assert len(squares) == 25 and len(ax.texts) == 25
+        for text, square in zip(ax.texts, squares):
+            box = text.get_window_extent(renderer)
+            assert square.x0 <= box.x0 and box.x1 <= square.x1 and square.y0 <= box.y0 and box.y1 <= square.y1, \
+                text.get_text()
+    plt.close(fig)
