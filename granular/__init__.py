@@ -8,8 +8,9 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 from . import errors
-from .errors import (GranularError, InelasticCollapseError, NoProgressError, NonFiniteError,
-                     OutsideBoxError, OverlapError, UnstableStepError)
+from .errors import (FrozenGasError, GranularError, HeatedWallsError, InelasticCollapseError,
+                     NoProgressError, NonFiniteError, OutsideBoxError, OverlapError,
+                     UnstableStepError)
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
@@ -17,7 +18,24 @@ from .ensemble import EnsembleResult, ensemble
 from . import analysis, langevin, theory
 
 __version__ = "0.1.0"
+
+# imported on first use (PEP 562): they pull in matplotlib and MDAnalysis, which
+# `import granular` must not
+_LAZY = ("plot", "interop")
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_LAZY))
+
 __all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "analysis",
            "langevin", "theory", "errors", "GranularError", "OverlapError",
-           "OutsideBoxError", "InelasticCollapseError", "NoProgressError", "NonFiniteError",
-           "UnstableStepError"]
+           "OutsideBoxError", "InelasticCollapseError", "HeatedWallsError", "NoProgressError",
+           "FrozenGasError", "NonFiniteError", "UnstableStepError"]

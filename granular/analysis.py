@@ -31,12 +31,35 @@ def _times(times, count=None):
 
 # -- mean squared displacements -------------------------------------------------------------
 
-def msd(positions, per_dimension=False):
+def _select(x, particles):
+    """Positions (T, N, d) of the chosen particles: indices, or a boolean mask over all N."""
+    if particles is None:
+        return x
+    p = np.asarray(particles)
+    n = x.shape[1]
+    if p.dtype == bool:
+        if p.shape != (n,):
+            raise ValueError(f"a boolean particles mask must have one entry per particle "
+                             f"({n}), got shape {p.shape}")
+        p = np.nonzero(p)[0]
+    elif p.size and not np.issubdtype(p.dtype, np.integer):
+        raise TypeError(f"particles must be indices (integers) or a boolean mask, got {p.dtype}")
+    p = p.reshape(-1).astype(np.int64)
+    if p.size == 0:
+        raise ValueError("particles selects no particle")
+    if np.any((p < -n) | (p >= n)):
+        raise IndexError(f"particles holds indices outside 0..{n - 1}")
+    return x[:, p, :]
+
+
+def msd(positions, per_dimension=False, particles=None):
     """Ensemble MSD ``<|x(t) - x(0)|^2>`` over particles at every sample (any spacing).
 
     Returns (T,) summed over dimensions, or (T, d) with ``per_dimension=True``.
+    ``particles`` (indices, or a boolean mask over all N) averages over those only,
+    e.g. a tracer.
     """
-    x = _positions(positions)
+    x = _select(_positions(positions), particles)
     d = x - x[0]
     out = np.einsum("tna,tna->ta", d, d) / x.shape[1]
     return out if per_dimension else out.sum(axis=1)
@@ -47,7 +70,8 @@ def _uniform(times):
     return len(dt) > 0 and np.allclose(dt, dt[0], rtol=1e-9, atol=0)
 
 
-def tamsd(positions, lags, times=None, method="auto", per_particle=False):
+def tamsd(positions, lags=None, times=None, *, lag_samples=None, method="auto",
+          per_particle=False, particles=None):
     """Time-averaged MSD (thesis 2.114-2.115) at the given lags, averaged over particles.
 
     For each particle, ``delta^2(lag) = mean_k |x(t_k + lag) - x(t_k)|^2`` over all sample
@@ -56,35 +80,62 @@ def tamsd(positions, lags, times=None, method="auto", per_particle=False):
 
     Parameters
     ----------
-    lags : array_like
+    lags : array_like, optional
         Without ``times``: lags in samples (integers).  With ``times``: lags in time
-        units, each of which must match a difference of sample times (to 1e-9 relative).
+        units, each of which must match a difference of sample times (to 1e-9 relative;
+        with uniform sampling, a multiple of the spacing).
     times : (T,) array, optional
+    lag_samples : array_like of int, optional
+        Lags as whole numbers of samples, instead of ``lags`` (uniform sampling).
     method : "auto", "fft" or "direct"
         "fft" (uniform sampling only): all lags at once in O(T log T) per particle, from
         the autocorrelation of positions taken relative to each particle's start (which
         keeps the rounding of the squared sums small).  "direct": pairs of samples
         ``lag`` apart, for any sampling.  "auto" picks FFT when sampling is uniform.
+    particles : array_like of int or bool, optional
+        Only these particles (indices, or a boolean mask over all N), e.g. a tracer.
     """
-    x = _positions(positions)
+    x = _select(_positions(positions), particles)
     T = x.shape[0]
-    lags = np.atleast_1d(np.asarray(lags, dtype=np.float64))
     if times is not None:
         t = _times(times, T)
     else:
         t = np.arange(T, dtype=np.float64)
-    if np.any(lags <= 0) or np.any(lags > t[-1] - t[0]):
-        raise ValueError("lags must be positive and no longer than the trajectory")
     uniform = _uniform(t)
+    if (lags is None) == (lag_samples is None):
+        raise TypeError("give exactly one of lags (in time) and lag_samples (in samples)")
+    if lag_samples is not None:
+        k = np.atleast_1d(np.asarray(lag_samples))
+        if k.size and not np.issubdtype(k.dtype, np.integer):
+            if not np.all(np.isfinite(k)) or np.any(k != np.rint(k)):
+                raise ValueError(f"lag_samples must be whole numbers of samples, got {k}")
+        k = k.astype(np.int64)
+        if np.any(k < 1) or np.any(k > T - 1):
+            raise ValueError(f"lag_samples must be between 1 and {T - 1} (the trajectory "
+                             f"has {T} samples), got {k}")
+        if times is not None and not uniform:
+            raise ValueError("lag_samples needs uniformly spaced samples; give lags in time")
+        lags = k * (t[1] - t[0])
+    lags = np.atleast_1d(np.asarray(lags, dtype=np.float64))
+    if not np.all(np.isfinite(lags)) or np.any(lags <= 0) or np.any(lags > t[-1] - t[0]):
+        raise ValueError(f"lags must be positive and no longer than the trajectory "
+                         f"({t[-1] - t[0]:g}), got {lags}")
     if method == "auto":
         method = "fft" if uniform else "direct"
     if method == "fft":
         if not uniform:
             raise ValueError("the FFT method needs uniformly spaced samples; use method='direct'")
-        steps = lags / (t[1] - t[0])
+        spacing = t[1] - t[0]
+        steps = lags / spacing
         k = np.rint(steps).astype(np.int64)
-        if not np.allclose(steps, k, rtol=1e-9, atol=1e-9):
-            raise ValueError("with uniform sampling, lags must be multiples of the sample spacing")
+        bad = ~np.isclose(steps, k, rtol=1e-9, atol=1e-9)
+        if np.any(bad):
+            lag = lags[bad][0]
+            below = math.floor(lag / spacing) * spacing
+            raise ValueError(
+                f"lag {lag:g} is not a multiple of the sample spacing {spacing:g}; the "
+                f"nearest lags that are: {below:g} and {below + spacing:g} (or give "
+                "lag_samples= in samples)")
         out = _tamsd_fft(x, k)
     elif method == "direct":
         out = _tamsd_direct(x, t, lags)

@@ -32,6 +32,18 @@ class InelasticCollapseError(GranularError, RuntimeError):
     """
 
 
+class HeatedWallsError(GranularError, RuntimeError):
+    """Heated walls (``wall_restitution > 1``) pumped so much energy into the gas that the
+    event times can no longer be resolved in float64.  ``.time`` is when it was detected
+    and ``.value`` the kinetic energy over its initial value."""
+
+
+class FrozenGasError(GranularError, RuntimeError):
+    """The gas is so slow (it cooled, or started so) that its speeds times the smallest
+    diameter fall below 1e-140: float64 can no longer resolve when two particles touch.
+    ``.time`` is when it was detected and ``.value`` the kinetic energy then."""
+
+
 class NonFiniteError(GranularError, FloatingPointError):
     """A NaN or infinity appeared in the state."""
 

@@ -36,6 +36,69 @@ _BIG_MAX = 16
 _ENGINE_BYTES_PER_PARTICLE = 400
 
 
+# float64 holds magnitudes from 2.2e-308 to 1.8e308.  The collision arithmetic
+# (csrc/collide.h) squares lengths, speeds and length x speed (the contact-time quadratic)
+# and multiplies a squared length by a mass (the impulse); keeping each scale that gets
+# squared within 1e-140 .. 1e140 (and each product within 1e-280 .. 1e280) leaves room
+# for sums over particles and for a gas that cools or heats by many orders.
+_SCALE_LO, _SCALE_HI = 1e-140, 1e140
+# Coordinates must resolve a diameter far more finely than the engine's overlap
+# tolerance (a relative 1e-10 of the contact distance, csrc/edmd_dim.h): at most this
+# fraction of the smallest diameter per float64 step at the box's farthest corner.
+_RESOLUTION = 1e-11
+
+
+def _check_range(name, value, lo, hi):
+    if not lo <= value <= hi:
+        raise ValueError(
+            f"{name} = {value:.3g} is outside {lo:g} .. {hi:g}, the range in which the "
+            "collision arithmetic stays within float64: choose units in which diameters, "
+            "masses and speeds are nearer 1 (e.g. a diameter, a mass and the thermal speed)")
+
+
+@np.errstate(over="ignore", under="ignore")
+def _check_scales(radii, masses, velocities, lower, upper):
+    """Refuse a scene whose scales would under- or overflow the collision formulas, or
+    whose coordinates cannot resolve its smallest diameter (see _SCALE_LO, _RESOLUTION)."""
+    # NumPy scalars: a product past float64 becomes inf (refused below), not OverflowError
+    sigma_min, sigma_max = 2.0 * radii.min(), 2.0 * radii.max()
+    m_min, m_max = masses.min(), masses.max()
+    edge = np.max(upper - lower)
+    lo2, hi2 = _SCALE_LO**2, _SCALE_HI**2
+    _check_range("the smallest diameter", sigma_min, _SCALE_LO, _SCALE_HI)
+    _check_range("the largest diameter", sigma_max, _SCALE_LO, _SCALE_HI)
+    _check_range("the longest box edge", edge, _SCALE_LO, _SCALE_HI)
+    _check_range("the smallest mass", m_min, lo2, hi2)
+    _check_range("the largest mass", m_max, lo2, hi2)
+    _check_range("the smallest diameter squared times the smallest mass",
+                 sigma_min**2 * m_min, lo2, hi2)
+    _check_range("the largest diameter squared times the largest mass",
+                 sigma_max**2 * m_max, lo2, hi2)
+    v_max = np.max(np.abs(velocities))
+    # Speeds only from above: a gas too slow to resolve a contact in float64 (a diameter
+    # times its speeds below _SCALE_LO) is a valid state, e.g. one that inelastic walls
+    # cooled; Simulation.run refuses to advance it (FrozenGasError).
+    _check_range("the largest speed", v_max, 0.0, _SCALE_HI)
+    _check_range("the longest box edge times the largest speed", edge * v_max, 0.0, _SCALE_HI)
+    _check_range("the largest mass times speed squared", m_max * v_max**2, 0.0, hi2)
+    far = float(max(np.max(np.abs(lower)), np.max(np.abs(upper))))
+    step = float(np.spacing(far))
+    if step > _RESOLUTION * sigma_min:
+        raise ValueError(
+            f"float64 resolves coordinates near {far:.6g} only to steps of {step:.3g}, not "
+            f"far enough below the smallest diameter {sigma_min:.3g} (at most "
+            f"{_RESOLUTION:g} of it): particles would pass through each other; move the box "
+            "nearer the origin")
+
+
+def frozen_energy(radii, masses):
+    """Total kinetic energy below which the speeds times the smallest diameter fall below
+    _SCALE_LO, where the contact-time arithmetic underflows and pairs would pass through
+    each other (speeds estimated with the largest mass, to be safe)."""
+    speed = _SCALE_LO / (2.0 * float(np.min(radii)))
+    return 0.5 * len(radii) * float(np.max(masses)) * speed * speed
+
+
 def _check_memory(need, what):
     """Refuse, before allocating, anything that would take more than half of this
     machine's memory (on Linux an allocation that large may 'succeed' and end in the
@@ -61,6 +124,12 @@ def _box_corners(box, dim):
         hi = np.broadcast_to(np.asarray(box[1], dtype=np.float64), (dim,)).copy()
     if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
         raise ValueError(f"box needs finite lower < upper on every axis, got {lo} and {hi}")
+    with np.errstate(over="ignore", under="ignore"):
+        lengths = hi - lo
+        volume = float(np.prod(lengths))
+    if not (np.all(np.isfinite(lengths)) and _SCALE_LO**2 <= volume <= _SCALE_HI**2):
+        raise ValueError(f"the box's volume {volume:.3g} is outside {_SCALE_LO**2:g} .. "
+                         f"{_SCALE_HI**2:g}: choose units nearer the box's size")
     return lo, hi
 
 
@@ -128,11 +197,12 @@ class Scene:
             raise ValueError(f"radii must be positive (particle {int(np.argmin(self.radii))})")
         if np.any(self.masses <= 0):
             raise ValueError(f"masses must be positive (particle {int(np.argmin(self.masses))})")
+        self.lower, self.upper = _box_corners(box, d)
+        _check_scales(self.radii, self.masses, self.velocities, self.lower, self.upper)
         with np.errstate(over="ignore"):
             finite_energy = math.isfinite(self.kinetic_energy)
         if not finite_energy:
             raise ValueError("the kinetic energy overflows: velocities too large for float64")
-        self.lower, self.upper = _box_corners(box, d)
         self.lower.setflags(write=False)
         self.upper.setflags(write=False)
         if boundary not in BOUNDARIES:
@@ -252,7 +322,11 @@ class Scene:
         """
         if dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim}")
-        if isinstance(n, bool) or int(n) != n:
+        try:
+            whole = not isinstance(n, bool) and int(n) == n
+        except (OverflowError, ValueError, TypeError):  # inf, nan, "ten"
+            whole = False
+        if not whole:
             raise ValueError(f"n must be a whole number, got {n!r}")
         n = int(n)
         if n < 1:
@@ -334,9 +408,11 @@ def _draw_velocities(rng, n, dim, masses, speed, temperature, remove_drift):
     return v
 
 
-def _place_rsa(rng, radii, lo, hi, periodic, max_rounds=200):
+def _place_rsa(rng, radii, lo, hi, periodic, patience=100, max_rounds=5000):
     """Random sequential addition in batches, with k-d trees for the neighbour search.
-    Returns None if it does not finish (too dense).
+    Returns None if it does not finish (too dense): when ``patience`` rounds in a row
+    place nobody, or after ``max_rounds`` rounds.  (A fixed number of rounds gave up on
+    mixtures whose last few big particles need many tries in a small box.)
 
     A few particles much larger than the rest (a tracer) would make every neighbour
     query as wide as they are; they are checked against everyone directly instead, and
@@ -356,8 +432,9 @@ def _place_rsa(rng, radii, lo, hi, periodic, max_rounds=200):
     box = L if periodic else None
     shift = lambda x: np.mod(x - lo, L) if periodic else x  # noqa: E731
     todo = order
+    idle = 0
     for _ in range(max_rounds):
-        if len(todo) == 0:
+        if len(todo) == 0 or idle >= patience:
             break
         r = radii[todo]
         inset = np.zeros((len(todo), 1)) if periodic else r[:, None]
@@ -389,10 +466,15 @@ def _place_rsa(rng, radii, lo, hi, periodic, max_rounds=200):
         placed_r = np.concatenate([placed_r, r[ok]])
         placed_big = np.concatenate([placed_big, cand_big[ok]])
         todo = todo[~ok]
+        idle = 0 if ok.any() else idle + 1
     if len(todo):
         return None
     out = np.empty((n, dim))
-    out[order] = placed
+    # Rows were placed round by round, not in `order`: hand the rows of each radius to the
+    # particles of that radius, in `order` (stable sorts on -radius on both sides).  Which
+    # of the equal particles gets which row does not matter (velocities are drawn apart);
+    # for equal radii this is the order in which they were placed.
+    out[order] = placed[np.argsort(-placed_r, kind="stable")]
     return out
 
 
@@ -458,6 +540,8 @@ def _place_lattice(rng, radii, lo, hi, periodic):
     if nearest < sigma:
         raise ValueError(
             f"{n} particles of radius {radii.max():g} do not fit in this box even on a "
-            f"{'face-centred cubic' if dim == 3 else 'triangular'} lattice")
+            f"{'face-centred cubic' if dim == 3 else 'triangular'} lattice"
+            + (" spaced for the largest of them (random sequential addition jammed first)"
+               if radii.min() < radii.max() else ""))
     pick = rng.choice(len(sites), size=n, replace=False)
     return lo + (0.0 if periodic else sigma / 2) + sites[pick], G

@@ -2,13 +2,15 @@
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 
 from . import _core
-from .errors import GranularError, NoProgressError
-from .scene import _ENGINE_BYTES_PER_PARTICLE, BIG_RATIO, Scene, _check_memory
-from .trajectory import Trajectory
+from .errors import (FrozenGasError, GranularError, HeatedWallsError, InelasticCollapseError,
+                     NoProgressError)
+from .scene import _ENGINE_BYTES_PER_PARTICLE, BIG_RATIO, Scene, _check_memory, frozen_energy
+from .trajectory import Trajectory, _pressure_volume
 
 _STOP_KEYS = ("collisions_per_particle", "kinetic_energy", "events")
 # Events per call into C: about 0.1 s of work, so Ctrl-C and the progress bar respond
@@ -76,6 +78,18 @@ class Simulation:
             _check_memory((_ENGINE_BYTES_PER_PARTICLE + _LIST_BYTES_PER_PARTICLE) * scene.n,
                           "the event-driven engine's state with neighbour lists")
         self._engine = scene._engine(cell_factor, big_ratio, shell)
+        # held for a whole run: the engine's own busy flag covers one C call only, and two
+        # interleaved runs would write each other's samples
+        self._running = threading.Lock()
+
+    def _no_copy(self, *args):
+        raise TypeError(
+            "a Simulation cannot be copied or pickled: its state lives in the C engine, "
+            "which would be shared, not copied.  For an independent simulation from the "
+            "current state use Simulation(sim.scene) (it starts its counters, stats and "
+            "time from zero)")
+
+    __copy__ = __deepcopy__ = __reduce_ex__ = __reduce__ = _no_copy
 
     # -- state ----------------------------------------------------------------------
     @property
@@ -89,14 +103,18 @@ class Simulation:
         cell_crossings (neighbour-list rebuilds with lists), stale_events,
         tc_elastic_collisions, virial, wall_impulse, kinetic_energy,
         kinetic_time_integral, time, cells, shell (0: cells); and the pressure averaged over
-        the whole simulation from the collision virial, P = (2 <E_kin>_t + W / t) / (d V)
-        with the time average <E_kin>_t (exact for a cooling gas too).  Walls add no
-        virial here: for a walled box see ``Trajectory.wall_pressure``."""
+        the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
+        with the time average <E_kin>_t (exact for a cooling gas too) and W the pair
+        collisions' virial.  In a periodic box V is the box volume.  In a walled box the
+        walls' virial is -P d V_reach, so V is the volume the centres reach, the box shrunk
+        by one radius at each face (see ``Trajectory.pressure``: exact for equal radii,
+        approximate for mixtures)."""
         c = self._engine.counters()
         s = self._initial
         if c["time"] > 0:
+            volume = _pressure_volume(s.lower, s.upper, s.radii, s.boundary)
             c["pressure"] = ((2.0 * c["kinetic_time_integral"] + c["virial"]) / c["time"]
-                             / (s.dim * s.volume))
+                             / (s.dim * volume))
         else:
             c["pressure"] = float("nan")
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
@@ -141,7 +159,25 @@ class Simulation:
             nothing keeps memory O(T) for long runs.
         progress : bool
             Show a tqdm progress bar.
+
+        Raises
+        ------
+        RuntimeError
+            If another thread is running this Simulation at the same time.
+        HeatedWallsError
+            If heated walls (``wall_restitution > 1``) pumped the energy up beyond what
+            float64 event times can resolve.
         """
+        if not self._running.acquire(blocking=False):
+            raise RuntimeError(
+                "another thread is running this Simulation; a Simulation runs one run at a "
+                "time (wait for it, or give each thread its own Simulation(scene))")
+        try:
+            return self._run(t_stop, sample_times, stop_when, store, progress)
+        finally:
+            self._running.release()
+
+    def _run(self, t_stop, sample_times, stop_when, store, progress):
         crit = dict(stop_when or {})
         unknown = set(crit) - set(_STOP_KEYS)
         if unknown:
@@ -159,6 +195,12 @@ class Simulation:
         kin = float(crit.get("kinetic_energy", -1.0))
         if math.isnan(cpp) or math.isnan(kin):
             raise ValueError(f"stop_when criteria must be numbers, got {crit}")
+        frozen = frozen_energy(self._initial.radii, self._initial.masses)
+        if "kinetic_energy" in crit and not kin * self._initial.n > frozen:
+            raise ValueError(
+                f"stop_when kinetic_energy = {kin:g} is not above {frozen / self._initial.n:.3g},"
+                " the mean kinetic energy below which float64 cannot resolve this gas' "
+                "collisions (a cooling gas only approaches 0): give a larger target")
         budget = crit.get("events")
         if budget is not None and (isinstance(budget, bool) or int(budget) != budget or budget < 0):
             raise ValueError(f"stop_when['events'] must be a whole number >= 0, got {budget!r}")
@@ -185,7 +227,9 @@ class Simulation:
             if len(times) and times[-1] > t_end:
                 if times[-1] > t_end + 1e-12 * max(1.0, abs(t_end)):
                     raise ValueError(f"sample_times reach {times[-1]}, past t_stop = {t_end}")
-                times[-1] = t_end  # the same time up to rounding (e.g. from np.logspace)
+                # past t_stop by rounding only (e.g. np.logspace's end): run on to the last
+                # sample so that every sample is taken at the time asked for
+                t_end = float(times[-1])
         count = len(times) + final_sample
         _check_memory(8.0 * count * self._initial.n * self._initial.dim * len(store),
                       f"storing {count} samples of {' and '.join(store)} (sample less often, "
@@ -196,9 +240,13 @@ class Simulation:
         views = {k: (None if v is None else v[:len(times)]) for k, v in buf.items()}
         reason, nxt, done = "events", 0, 0
         bar = _progress_bar(progress, t_now, t_end, cpp)
-        stall = _StallGuard(self) if unbounded else None
-        events = self._engine.counters()["events"]  # counters() sums over particles: once a chunk
+        stall = _StallGuard(self, dissipative_only=cpp == math.inf) if unbounded else None
+        energy0 = self._initial.kinetic_energy
+        start = self._engine.counters()  # counters() sums over particles: once a chunk
+        events = start["events"]
+        moving = start["kinetic_energy"] > 0.0
         try:
+            self._check_not_frozen(start, frozen, moving)
             while budget - done > 0:
                 chunk = int(min(_CHUNK, budget - done))
                 code, nxt = self._engine.advance(t_end, cpp, kin, chunk, times, nxt, **views)
@@ -207,6 +255,7 @@ class Simulation:
                 events = after["events"]
                 if bar is not None:
                     bar.update(self)
+                self._check_not_frozen(after, frozen, moving)
                 if code != _core.STOP_BUDGET:
                     reason = _REASONS[code]
                     break
@@ -215,7 +264,12 @@ class Simulation:
         except (GranularError, KeyboardInterrupt) as exc:
             # keep what was sampled: every sample time up to the engine's clock is written
             k = int(np.searchsorted(times, self.time, side="right"))
-            exc.trajectory = self._trajectory(times[:k], buf, k, "error")
+            trajectory = self._trajectory(times[:k], buf, k, "error")
+            heated = self._heated_walls_error(exc, energy0)
+            if heated is not None:
+                heated.trajectory = trajectory
+                raise heated from exc
+            exc.trajectory = trajectory
             raise
         finally:
             if bar is not None:
@@ -226,17 +280,58 @@ class Simulation:
             nxt += 1
         return self._trajectory(times[:nxt], buf, nxt, reason)
 
-    def _check_energy_reachable(self, target):
-        """Refuse a kinetic-energy stop that can never come, before running forever: with
-        elastic collisions and walls that heat or conserve, the energy never falls."""
+    # a collapse cools the gas; an energy this far above the start can only come from
+    # heated walls, and it puts the event times beyond float64's resolution
+    _BLOWUP_RATIO = 1e6
+
+    def _heated_walls_error(self, exc, energy0):
+        """The error to raise instead of ``exc`` when heated walls blew the gas up, else
+        None (the engine reports the unresolvable event times as a collapse)."""
         s = self._initial
-        conserving = s.restitution == 1.0 and (s.boundary == "periodic" or s.wall_restitution >= 1.0)
+        if not (isinstance(exc, InelasticCollapseError) and s.boundary == "walls"
+                and s.wall_restitution > 1.0 and energy0 > 0):
+            return None
+        c = self._engine.counters()
+        ratio = c["kinetic_energy"] / energy0
+        if not ratio > self._BLOWUP_RATIO:
+            return None  # a real collapse of inelastic pairs
+        return HeatedWallsError(
+            f"the heated walls (wall_restitution = {s.wall_restitution} > 1) pumped the kinetic "
+            f"energy up by a factor {ratio:.3g} by t = {c['time']:.6g}: the particles are so fast "
+            "that the event times can no longer be resolved in float64.  Lower "
+            "wall_restitution, or stop earlier (t_stop, or stop_when with kinetic_energy or "
+            "collisions_per_particle)", time=c["time"], value=ratio)
+
+    @staticmethod
+    def _check_not_frozen(c, frozen, moving):
+        """Stop a gas too slow for float64 (at the start, or cooled there by inelastic
+        walls or collisions, possibly to 0 by underflow) before pairs pass through each
+        other unseen.  A gas at rest from the start of the run is left alone: nothing moves."""
+        energy = c["kinetic_energy"]
+        if moving and energy < frozen:
+            raise FrozenGasError(
+                f"at t = {c['time']:.6g} the kinetic energy is {energy:.3g}, below {frozen:.3g}: "
+                "the speeds times the smallest diameter are under 1e-140 and float64 can no "
+                "longer resolve when two particles touch.  Stop earlier (t_stop, or "
+                "stop_when kinetic_energy), or rescale the velocities (scene.replace)",
+                time=c["time"], value=energy)
+
+    def _check_energy_reachable(self, target):
+        """Refuse a kinetic-energy stop that can never come, before running forever: the
+        energy never falls without a dissipative channel (inelastic pairs, of which there
+        must be two, or absorbing walls)."""
+        s = self._initial
+        pairs_lose = s.restitution < 1.0 and s.n >= 2
+        walls_lose = s.boundary == "walls" and s.wall_restitution < 1.0
         mean = self._engine.counters()["kinetic_energy"] / s.n
-        if conserving and target < mean:
+        if not (pairs_lose or walls_lose) and target < mean:
+            why = ("a single particle has no partner to collide with" if s.n == 1
+                   else "restitution 1")
+            walls = "" if s.boundary == "periodic" else ", walls that do not absorb"
             raise ValueError(
                 f"stop_when kinetic_energy = {target} can never be reached: the mean kinetic "
-                f"energy is {mean:.6g} and this scene does not lose energy (restitution 1"
-                f"{'' if s.boundary == 'periodic' else ', walls that do not absorb'}); give t_stop")
+                f"energy is {mean:.6g} and this scene does not lose energy ({why}{walls}); "
+                "give t_stop")
 
     def _sample_now(self, buf, k):
         """Write the current state as sample k (reads the state, processes no event)."""
@@ -279,25 +374,45 @@ _REASONS = {_core.STOP_TIME: "time", _core.STOP_COLLISIONS: "collisions",
 
 class _StallGuard:
     """A run with no time limit and no event budget that stops on collisions or energy
-    must not spin forever where no collision can come (a lone particle in a periodic box,
-    particles on parallel lines): after this many events without a single collision it
-    raises.  A gas needs a handful of events (cell crossings) per collision; a very
+    must not spin forever where no progress can come (a lone particle in a periodic box,
+    particles on parallel lines, elastic walls under an energy target): after this many
+    events without progress it raises.  Progress is any collision for a
+    collisions_per_particle criterion, and only a dissipative one for an energy target
+    alone: an inelastic pair collision (not one the TC model made elastic), a hit on an
+    absorbing wall.  A gas needs a handful of events (cell crossings) per collision; a very
     dilute one many more, so the bound is generous."""
 
-    def __init__(self, sim):
-        self.limit = max(10**7, 1000 * sim._initial.n)
+    MIN_LIMIT = 10**7
+
+    def __init__(self, sim, dissipative_only):
+        s = sim._initial
+        self.limit = max(self.MIN_LIMIT, 1000 * s.n)
+        self.pairs = not dissipative_only or s.restitution < 1.0
+        self.walls = not dissipative_only or (s.boundary == "walls" and s.wall_restitution < 1.0)
+        self.dissipative_only = dissipative_only
         c = sim._engine.counters()
-        self.collisions = c["pair_collisions"] + c["wall_collisions"]
+        self.progress = self._progress(c)
         self.events = c["events"]
+
+    def _progress(self, c):
+        count = 0
+        if self.pairs:
+            count += c["pair_collisions"]
+            if self.dissipative_only:  # pairs the TC model made elastic dissipate nothing
+                count -= c["tc_elastic_collisions"]
+        if self.walls:
+            count += c["wall_collisions"]
+        return count
 
     def check(self, c, criteria):
         """c: the engine's counters now."""
-        collisions = c["pair_collisions"] + c["wall_collisions"]
-        if collisions != self.collisions:
-            self.collisions, self.events = collisions, c["events"]
+        progress = self._progress(c)
+        if progress != self.progress:
+            self.progress, self.events = progress, c["events"]
         elif c["events"] - self.events >= self.limit:
+            what = "dissipative collision" if self.dissipative_only else "collision"
             raise NoProgressError(
-                f"no collision in {c['events'] - self.events} events (t = {c['time']:.6g}): the "
+                f"no {what} in {c['events'] - self.events} events (t = {c['time']:.6g}): the "
                 f"stop criteria {criteria} may never be met; give t_stop or stop_when['events']",
                 time=c["time"])
 

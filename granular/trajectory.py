@@ -4,6 +4,15 @@ from __future__ import annotations
 import numpy as np
 
 
+def _pressure_volume(lower, upper, radii, boundary):
+    """The volume in the virial pressure: the box when periodic; in a walled box the volume
+    the centres reach, each side shrunk by the largest diameter (exact for equal radii)."""
+    lengths = np.asarray(upper) - np.asarray(lower)
+    if boundary == "walls":
+        lengths = lengths - 2.0 * float(np.max(radii))
+    return float(np.prod(lengths))
+
+
 class Trajectory:
     """Samples of one run.
 
@@ -71,19 +80,25 @@ class Trajectory:
         return value
 
     def pressure(self):
-        """Pressure over the run from the collision virial,
-        P = (2 <E_kin> + W / dt) / (d V), with W the virial of the pair collisions between
-        the first and last sample and <E_kin> the time average of the kinetic energy
-        (trapezoid over the samples: exact for a molecular gas, which keeps E_kin
-        constant; sample densely when it changes).  Walls add no virial here: for a
-        walled box see ``wall_pressure``."""
+        """Pressure over the run from the virial theorem, P = (2 <E_kin> + W / dt) / (d V),
+        with W the virial of the pair collisions between the first and last sample and
+        <E_kin> the time average of the kinetic energy (trapezoid over the samples: exact
+        for a molecular gas, which keeps E_kin constant; sample densely when it changes).
+
+        In a periodic box V is the box volume.  In a walled box the walls' own virial is
+        -P d V_reach, with V_reach the volume the centres reach (each side shrunk by one
+        diameter), so V = V_reach: the same pressure as ``wall_pressure``, estimated from
+        the pair collisions instead of the wall hits.  Exact for equal radii; for a mixture
+        V_reach uses the largest radius, which is approximate (smaller particles reach
+        closer to the walls), to a relative error of order (r_max - r_min) / L."""
         t = self.times
         if len(t) < 2 or t[-1] <= t[0]:
             raise ValueError("pressure needs at least two samples spanning some time")
         span = t[-1] - t[0]
         mean_k = np.trapezoid(self.kinetic_energy, t) / span
         w = self.virial[-1] - self.virial[0]
-        return float((2.0 * mean_k + w / span) / (self.dim * self.volume))
+        volume = _pressure_volume(self.lower, self.upper, self.radii, self.boundary)
+        return float((2.0 * mean_k + w / span) / (self.dim * volume))
 
     def wall_pressure(self):
         """Mechanical pressure on the walls between the first and last sample: the normal
@@ -100,19 +115,42 @@ class Trajectory:
         area = 2.0 * sum(np.prod(np.delete(reach, a)) for a in range(self.dim))
         return float((self.wall_impulse[-1] - self.wall_impulse[0]) / ((t[-1] - t[0]) * area))
 
-    def msd(self, per_dimension=False):
+    def msd(self, per_dimension=False, particles=None):
         """Ensemble mean squared displacement from the first sample, at every sample
-        (summed over dimensions, or (T, d) per dimension)."""
+        (summed over dimensions, or (T, d) per dimension); see ``granular.analysis.msd``.
+
+        particles : array_like of int or bool, optional
+            Average over these particles only (indices, or a boolean mask over all N),
+            e.g. a tracer; by default over all.
+        """
         positions = self._need("positions")
         from . import analysis
 
-        return analysis.msd(positions, per_dimension=per_dimension)
+        # particles only when given, so that analysis.msd's own default applies
+        extra = {} if particles is None else {"particles": particles}
+        return analysis.msd(positions, per_dimension=per_dimension, **extra)
 
-    def tamsd(self, lags, **kwargs):
-        """Time-averaged MSD at the given lags; see ``granular.analysis.tamsd``."""
+    def tamsd(self, lags=None, *, lag_samples=None, particles=None, **kwargs):
+        """Time-averaged MSD at the given lags; see ``granular.analysis.tamsd``.
+
+        lags : array_like of float, optional
+            Lags in time, multiples of the (uniform) sample spacing.
+        lag_samples : array_like of int, optional
+            Lags as whole numbers of samples instead (uniformly spaced samples).  Give
+            exactly one of ``lags`` and ``lag_samples``.
+        particles : array_like of int or bool, optional
+            Average over these particles only (indices or a boolean mask over all N).
+        **kwargs
+            Passed on (``method``, ``per_particle``).
+        """
         positions = self._need("positions")
         from . import analysis
 
+        # only what was given is passed on, so that analysis.tamsd's own defaults and
+        # checks (exactly one of lags / lag_samples) apply
+        for name, value in (("lag_samples", lag_samples), ("particles", particles)):
+            if value is not None:
+                kwargs[name] = value
         return analysis.tamsd(positions, lags, times=self.times, **kwargs)
 
     def to_universe(self):

@@ -158,9 +158,10 @@ def _shape(key):
 def _scale(factor):
     """Every length (positions, radii, box) times factor: the same scene at another scale."""
     def mutate(rng, p):
-        p["positions"] = p["positions"] * factor
-        p["radii"] = p["radii"] * factor
-        p["box"] = p["box"] * factor
+        with np.errstate(over="ignore", under="ignore"):  # to inf or 0 on purpose
+            p["positions"] = p["positions"] * factor
+            p["radii"] = p["radii"] * factor
+            p["box"] = p["box"] * factor
         return f"all lengths x {factor:g}"
     return mutate
 

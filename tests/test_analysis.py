@@ -136,3 +136,50 @@ def test_bad_input():
         analysis.tamsd(np.zeros((3, 2, 2)), [5])
     with pytest.raises(ValueError, match="at least two runs"):
         analysis.ensemble_mean(np.zeros((1, 3)))
+
+
+def test_msd_and_tamsd_of_chosen_particles():
+    """A tracer among a gas: each particle moves ballistically with its own velocity, so
+    the MSD and TAMSD of a selection are exactly the mean v^2 t^2 of the selection."""
+    rng = np.random.default_rng(3)
+    v = rng.normal(size=(30, 2))
+    v[4] *= 10.0  # the fast tracer
+    t = np.linspace(0.0, 5.0, 51)
+    x = rng.random((1, 30, 2)) + t[:, None, None] * v[None]
+    v2 = np.sum(v * v, axis=1)
+    np.testing.assert_allclose(analysis.msd(x, particles=[4]), v2[4] * t**2, rtol=1e-12)
+    mask = np.zeros(30, dtype=bool)
+    mask[[1, 4, 9]] = True
+    np.testing.assert_allclose(analysis.msd(x, particles=mask), v2[mask].mean() * t**2,
+                               rtol=1e-12)
+    np.testing.assert_allclose(analysis.msd(x, per_dimension=True, particles=[4]),
+                               v[4] ** 2 * t[:, None] ** 2, rtol=1e-12)
+    lags = np.array([0.1, 1.0, 4.0])
+    np.testing.assert_allclose(analysis.tamsd(x, lags, times=t, particles=[4]),
+                               v2[4] * lags**2, rtol=1e-9)
+    np.testing.assert_allclose(analysis.tamsd(x, lags, times=t, particles=mask),
+                               v2[mask].mean() * lags**2, rtol=1e-9)
+    with pytest.raises(ValueError, match="one entry per particle"):
+        analysis.msd(x, particles=mask[:10])
+    with pytest.raises(IndexError, match="outside 0..29"):
+        analysis.tamsd(x, lags, times=t, particles=[30])
+    with pytest.raises(ValueError, match="selects no particle"):
+        analysis.msd(x, particles=np.zeros(30, dtype=bool))
+
+
+def test_tamsd_lags_in_samples_and_a_lag_off_the_grid_named():
+    t, x = random_walk(T=101, N=20, dt=0.25)
+    in_time = analysis.tamsd(x, [0.25, 2.5, 25.0], times=t)
+    np.testing.assert_allclose(analysis.tamsd(x, times=t, lag_samples=[1, 10, 100]), in_time,
+                               rtol=1e-12)
+    with pytest.raises(ValueError, match=r"lag 0\.3 is not a multiple of the sample spacing "
+                                         r"0\.25; the nearest lags that are: 0\.25 and 0\.5"):
+        analysis.tamsd(x, [0.3], times=t)
+    with pytest.raises(TypeError, match="exactly one of lags"):
+        analysis.tamsd(x, [0.25], times=t, lag_samples=[1])
+    with pytest.raises(TypeError, match="exactly one of lags"):
+        analysis.tamsd(x, times=t)
+    with pytest.raises(ValueError, match="between 1 and 100"):
+        analysis.tamsd(x, times=t, lag_samples=[0, 101])
+    with pytest.raises(ValueError, match="whole numbers"):
+        analysis.tamsd(x, times=t, lag_samples=[1.5])

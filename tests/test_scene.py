@@ -94,6 +94,40 @@ def test_too_dense_random_scene_is_refused():
         Scene.random(n, (0.8 / (n * 4 / 3 * math.pi)) ** (1 / 3), seed=2)
 
 
+@pytest.mark.parametrize("dim,boundary", [(2, "periodic"), (2, "walls"), (3, "periodic"),
+                                          (3, "walls")])
+def test_random_mixtures_keep_each_particle_its_radius(dim, boundary):
+    """Two and three species, size ratios up to 3, packing up to the RSA limit, many seeds:
+    each particle gets the radius asked for at its index (the scene validates, so no
+    overlap, inside the box), and every species is spread over the box.  Random sequential
+    addition rejects some candidates in almost every round here, which used to hand a small
+    particle's slot to a big one (OverlapError, OutsideBoxError)."""
+    n = 150
+    for seed in range(12):
+        rng = np.random.default_rng(seed)
+        ratio = rng.uniform(1.5, 3.0)
+        sizes = [1.0, ratio] if seed % 2 else [1.0, rng.uniform(1.0, ratio), ratio]
+        rel = np.array(sizes)[np.arange(n) % len(sizes)]
+        rng.shuffle(rel)
+        eta = rng.uniform(0.05, 0.15 if dim == 3 else 0.3)
+        unit = math.pi if dim == 2 else 4 * math.pi / 3
+        radii = rel * (eta / (unit * np.sum(rel**dim))) ** (1 / dim)
+        s = Scene.random(n, radii, dim=dim, boundary=boundary, seed=seed)
+        np.testing.assert_array_equal(s.radii, radii)
+        # the biggest species (n / species particles): its centres' mean along each axis
+        # is uniform on the reachable interval, standard deviation sqrt(1/12 / count)
+        # <= 0.075 here; 5 of them is far wider than chance and far narrower than a
+        # species crowded into one place
+        big = s.positions[radii == radii.max()]
+        assert np.all(np.abs(big.mean(0) - 0.5) < 5 * math.sqrt(1 / 12 / len(big)))
+
+
+def test_random_mixture_from_the_report_validates():
+    radii = np.where(np.arange(40) % 2 == 0, 0.02, 0.045)
+    s = Scene.random(40, radii, dim=2, seed=0)
+    np.testing.assert_array_equal(s.radii, radii)
+
+
 def test_walls_scene_keeps_particles_inside():
     s = Scene.random(500, 0.02, dim=2, box=(-3, 3), boundary="walls", seed=4)
     assert np.all(s.positions - 0.02 >= -3) and np.all(s.positions + 0.02 <= 3)
@@ -224,3 +258,58 @@ def test_no_collapse_above_the_threshold():
     """xi = 0.2 > 0.0718: a finite number of collisions, no error."""
     sim = Simulation(three_in_line(0.2))
     assert sim.run(t_stop=10.0).stop_reason == "time"
+
+
+def test_si_units_work():
+    """Argon in SI units (diameter 3.4e-10 m, mass 6.6e-26 kg, thermal speeds ~ 250 m/s at
+    300 K, a box of 1e-8 m) is far inside the scales the collision arithmetic handles: it
+    validates and runs elastically, conserving energy to rounding (1e-12 relative)."""
+    kT, m = 1.380649e-23 * 300.0, 6.63e-26
+    s = Scene.random(200, 1.7e-10, box=1e-8, mass=m, temperature=kT, seed=1)
+    sim = Simulation(s)
+    sim.run(stop_when={"collisions_per_particle": 5})
+    assert sim.stats["pair_collisions"] >= 500
+    assert sim.scene.kinetic_energy == pytest.approx(s.kinetic_energy, rel=1e-12)
+    assert s.temperature == pytest.approx(kT, rel=0.3)  # 200 Maxwellian particles
+
+
+@pytest.mark.parametrize("change,match", [
+    (dict(masses=1e-310), "smallest mass"),
+    (dict(masses=1e308), "mass = 1e\\+308"),
+    (dict(masses=np.where(np.arange(8) % 2, 1e-279, 1.0)), "diameter squared times the smallest mass"),
+    (dict(velocities=np.full((8, 3), 1e154)), "largest speed"),
+])
+def test_scales_outside_float64s_reach_are_refused(change, match):
+    """Masses 1e-310 or 1e308, speeds 1e154 gave NaN positions, pairs passing through each
+    other or collisions without impulse; now the scene names the scale that is out of range."""
+    pos = np.stack([np.arange(8) * 0.12 + 0.05, np.full(8, 0.5), np.full(8, 0.5)], 1)
+    base = dict(positions=pos, velocities=np.ones((8, 3)), radii=0.05)
+    base.update(change)
+    with pytest.raises(ValueError, match=match):
+        Scene(base.pop("positions"), base.pop("velocities"), base.pop("radii"), **base)
+
+
+@pytest.mark.parametrize("offset,ok", [(1e15, False), (1e13, False), (1e3, True)])
+def test_a_box_far_from_the_origin_must_still_resolve_a_diameter(offset, ok):
+    """Diameter 0.1 in a box at 1e15 (coordinate steps 0.125) let particles pass through
+    each other, at 1e13 (steps 0.002) 3 % of them overlapped.  Refused unless a float64
+    step at the box is at most 1e-11 of the smallest diameter; at 1e3 (steps 1e-13) fine."""
+    pos = offset + np.stack([np.arange(8) * 0.12 + 0.05, np.full(8, 0.5)], 1)
+    make = lambda: Scene(pos, np.ones((8, 2)), 0.05, box=(offset, offset + 1.0))  # noqa: E731
+    if ok:
+        make()
+    else:
+        with pytest.raises(ValueError, match="resolves coordinates near .* move the box"):
+            make()
+
+
+def test_counts_and_boxes_beyond_float64_are_refused():
+    with pytest.raises(ValueError, match="n must be a whole number, got inf"):
+        Scene.random(math.inf, 0.05)
+    with pytest.raises(ValueError, match="n must be a whole number"):
+        Scene.random(math.nan, 0.05)
+    # all lengths x 1e-150: the volume underflows to 0 (it used to divide by zero later)
+    with pytest.raises(ValueError, match="volume"):
+        Scene.random(10, 0.05e-150, box=1e-150)
+    with pytest.raises(ValueError, match="volume"):
+        Scene.random(10, 0.05e120, box=1e120)

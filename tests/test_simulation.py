@@ -1,5 +1,10 @@
 """The event-driven engine: exact cases, conservation laws, a slow reference, determinism."""
+import copy
 import math
+import pickle
+import subprocess
+import sys
+import threading
 
 import numpy as np
 import pytest
@@ -473,3 +478,167 @@ def test_large_tracer_long_run_conserves_and_never_overlaps(dim):
     assert changed.sum() >= 15
     coarse = Simulation(s, big_ratio=math.inf)
     assert min(coarse.stats["cells"][:dim]) < min(sim.stats["cells"][:dim])
+
+
+# -- issue 13: unreachable energy targets, rounding past t_stop, heated walls, threads ------
+
+def test_energy_target_without_a_dissipative_channel_is_refused():
+    """A lone particle cannot collide with anyone, and elastic walls take no energy: the
+    energy never falls, so the target is refused at once (this used to run forever)."""
+    lone = Scene.random(1, 0.05, boundary="walls", restitution=0.9, seed=3)
+    with pytest.raises(ValueError, match="can never be reached.*single particle"):
+        Simulation(lone).run(stop_when={"kinetic_energy": 0.1})
+    # absorbing walls do take energy: the same target is reached
+    sim = Simulation(lone.replace(wall_restitution=0.5))
+    assert sim.run(stop_when={"kinetic_energy": 0.1}).stop_reason == "kinetic_energy"
+
+
+def test_stall_guard_counts_only_progress_towards_the_criterion(monkeypatch):
+    """Two inelastic disks on parallel lines between elastic walls never meet: wall hits go
+    on for ever but take no energy.  Under an energy target the guard counts only
+    dissipative collisions and raises after its limit (lowered here to 1e5 events to keep
+    the test fast); under a collision target the wall hits are progress and it ends."""
+    monkeypatch.setattr(granular.simulation._StallGuard, "MIN_LIMIT", 10**5)
+    s = Scene([[0.3, 0.25], [0.6, 0.75]], [[1.0, 0.0], [-1.0, 0.0]], 0.05, box=1.0,
+              boundary="walls", restitution=0.9)
+    sim = Simulation(s)
+    with pytest.raises(granular.NoProgressError, match="no dissipative collision"):
+        sim.run(stop_when={"kinetic_energy": 0.1})
+    # the wall hits the old guard took for progress did happen (1 in 4 events here)
+    assert sim.stats["pair_collisions"] == 0 and sim.stats["wall_collisions"] > 10**4
+    tr = sim.run(stop_when={"collisions_per_particle": sim.stats["collisions_per_particle"] + 10})
+    assert tr.stop_reason == "collisions"
+
+
+def test_samples_past_t_stop_by_rounding_are_all_returned():
+    """Sample times past t_stop by no more than rounding (1e-12 relative) are taken at the
+    times asked for, not dropped; beyond rounding they are refused."""
+    sim = Simulation(Scene.random(50, 0.02, seed=1))
+    asked = [1 + 5e-13, 1 + 9e-13]
+    tr = sim.run(1.0, sample_times=asked)
+    np.testing.assert_array_equal(tr.times, asked)
+    assert sim.time == asked[-1]
+    # a log-spaced grid ending at t_stop up to rounding keeps all its samples
+    times = np.logspace(-3, math.log10(3.0), 30)
+    tr = Simulation(Scene.random(50, 0.02, seed=1)).run(3.0, sample_times=times)
+    np.testing.assert_array_equal(tr.times, times)
+    with pytest.raises(ValueError, match="past t_stop"):
+        Simulation(Scene.random(50, 0.02, seed=1)).run(1.0, sample_times=[0.5, 1 + 1e-9])
+
+
+def test_heated_walls_blowing_up_are_not_called_a_collapse():
+    """Walls with restitution 1.5 multiply a particle's normal speed by 1.5 at each hit, so
+    the energy grows without bound until the event times cannot be resolved in float64:
+    a HeatedWallsError, with the energy ratio, not an inelastic collapse.  A real collapse
+    (three disks in a line, xi = 0.05 < 7 - 4 sqrt 3, at t = 0.1, long before any wall
+    hit) in a box with heated walls stays an InelasticCollapseError."""
+    s = Scene.random(4, 0.05, dim=3, boundary="walls", wall_restitution=1.5, seed=3)
+    with pytest.raises(granular.HeatedWallsError,
+                       match=r"wall_restitution = 1.5 > 1\) pumped .* float64") as info:
+        Simulation(s).run(10.0)
+    assert isinstance(info.value, granular.GranularError) and isinstance(info.value, RuntimeError)
+    assert not isinstance(info.value, granular.InelasticCollapseError)
+    assert info.value.value > 1e6 and 0 < info.value.time < 10.0
+    assert info.value.trajectory.stop_reason == "error"
+    line = Scene([[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]], [[1, 0], [0, 0], [-1, 0]], 0.05,
+                 boundary="walls", restitution=0.05, wall_restitution=1.01)
+    with pytest.raises(granular.InelasticCollapseError):
+        Simulation(line).run(10.0)
+
+
+class _BlockingEngine:
+    """The real engine, whose advance() signals that it is running and waits for a go."""
+
+    def __init__(self, engine):
+        self.engine, self.inside, self.go = engine, threading.Event(), threading.Event()
+
+    def advance(self, *args, **kwargs):
+        self.inside.set()
+        assert self.go.wait(10)
+        return self.engine.advance(*args, **kwargs)
+
+    def __getattr__(self, name):
+        return getattr(self.engine, name)
+
+
+def test_a_second_concurrent_run_raises_at_once():
+    """While one thread is inside run (held inside the engine until released), a second
+    run of the same Simulation from another thread raises at once; after the first run
+    ends, runs work again.  The first run's samples are untouched."""
+    sim = Simulation(Scene.random(50, 0.02, seed=1))
+    blocking = sim._engine = _BlockingEngine(sim._engine)
+    result = {}
+    first = threading.Thread(target=lambda: result.setdefault("tr", sim.run(1.0)))
+    first.start()
+    try:
+        assert blocking.inside.wait(10)
+        with pytest.raises(RuntimeError, match="another thread is running this Simulation"):
+            sim.run(2.0)
+    finally:
+        blocking.go.set()
+        first.join(10)
+    assert result["tr"].times[-1] == 1.0 and sim.time == 1.0
+    assert sim.run(2.0).times[-1] == 2.0
+
+
+def test_copying_or_pickling_a_simulation_is_refused():
+    """A copy would share the C engine; the message says how to get an independent one."""
+    sim = Simulation(Scene.random(50, 0.02, seed=1))
+    for copier in (copy.copy, copy.deepcopy, pickle.dumps):
+        with pytest.raises(TypeError, match=r"Simulation\(sim.scene\)"):
+            copier(sim)
+
+
+def test_plot_and_interop_are_attributes_imported_lazily():
+    """The README writes granular.plot.msd after `import granular`; importing granular
+    alone must not pull in matplotlib or MDAnalysis (fresh interpreter)."""
+    code = ("import sys, granular\n"
+            "assert 'matplotlib' not in sys.modules and 'MDAnalysis' not in sys.modules\n"
+            "assert callable(granular.plot.msd)\n"
+            "assert callable(granular.interop.to_universe)\n"
+            "assert 'plot' in dir(granular)\n")
+    subprocess.run([sys.executable, "-c", code], check=True)
+    with pytest.raises(AttributeError, match="no attribute 'nonesuch'"):
+        granular.nonesuch
+
+
+def test_trajectory_msd_and_tamsd_select_particles_and_take_lags_in_samples():
+    """A tracer's MSD is the full per-particle data restricted to it; lag_samples k is the
+    lag k * dt in time."""
+    s = Scene.random(60, 0.02, seed=5)
+    tr = Simulation(s).run(2.0, sample_times=np.linspace(0.0, 2.0, 21))
+    d = tr.positions - tr.positions[0]
+    np.testing.assert_allclose(tr.msd(particles=[7]), (d[:, 7] ** 2).sum(axis=1), rtol=1e-14)
+    mask = np.arange(60) < 10
+    np.testing.assert_allclose(tr.msd(particles=mask), (d[:, :10] ** 2).sum(axis=2).mean(axis=1),
+                               rtol=1e-14)
+    lags = np.array([0.1, 0.5, 1.0])
+    np.testing.assert_allclose(tr.tamsd(lag_samples=[1, 5, 10], particles=[7]),
+                               tr.tamsd(lags, particles=[7]), rtol=1e-12)
+    per = tr.tamsd(lags, per_particle=True)
+    np.testing.assert_allclose(tr.tamsd(lags, particles=[7]), per[7], rtol=1e-12)
+
+
+def test_a_gas_too_slow_for_float64_is_not_advanced():
+    """Below speeds x diameter ~ 1e-140 the contact-time quadratic underflows and pairs
+    would pass through each other: a scene that slow, or one that absorbing walls cool that
+    far (wall restitution 1e-30: each hit takes 30 decades off a speed), raises
+    FrozenGasError instead of returning overlapping particles.  A gas at rest runs."""
+    pos = np.array([[0.2, 0.5], [0.5, 0.5], [0.8, 0.5]])
+    slow = Scene(pos, np.full((3, 2), 1e-150), 0.05, boundary="walls")
+    with pytest.raises(granular.FrozenGasError, match="below .* float64 can no longer"):
+        Simulation(slow).run(t_stop=1e200)
+    rest = Scene(pos, np.zeros((3, 2)), 0.05, boundary="walls")
+    assert Simulation(rest).run(t_stop=1e200).stop_reason == "time"
+    s = Scene.random(3, 0.05, dim=2, boundary="walls", wall_restitution=1e-30, seed=1)
+    with pytest.raises(granular.FrozenGasError) as caught:
+        Simulation(s).run(t_stop=1e250)
+    assert caught.value.value < 1e-270  # underflowed to 0, possibly
+
+
+@pytest.mark.parametrize("target", [0.0, -1.0, 1e-300])
+def test_an_energy_target_float64_cannot_reach_is_refused(target):
+    """A cooling gas only approaches zero energy: a target of 0 used to run forever."""
+    s = Scene.random(20, 0.05, dim=3, restitution=0.9, seed=2)
+    with pytest.raises(ValueError, match="kinetic_energy .* is not above"):
+        Simulation(s).run(stop_when={"kinetic_energy": target})
