@@ -119,6 +119,19 @@ static PyArrayObject *as_f64(PyObject *obj, const char *name, int ndim, const np
     return a;
 }
 
+/* a * b for sizes (>= 0), or 0 with an OverflowError naming the buffer when the product
+ * does not fit npy_intp: a size check must not wrap round and pass a short buffer. */
+static int mul_size(npy_intp a, npy_intp b, npy_intp *out, const char *name)
+{
+    if (a < 0 || b < 0 || (b != 0 && a > NPY_MAX_INTP / b)) {
+        PyErr_Format(PyExc_OverflowError, "the size of %s, %zd x %zd elements, overflows",
+                     name, (Py_ssize_t)a, (Py_ssize_t)b);
+        return 0;
+    }
+    *out = a * b;
+    return 1;
+}
+
 /* ==== EDMD binding begin ============================================================ */
 
 typedef struct {
@@ -273,11 +286,16 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         Py_DECREF(times);
         return NULL;
     }
-    npy_intp nd = T * self->n * self->dim;
+    npy_intp nd, td;
+    if (!mul_size(T, self->n, &nd, "positions") || !mul_size(nd, self->dim, &nd, "positions") ||
+        !mul_size(T, self->dim, &td, "momentum")) {
+        Py_DECREF(times);
+        return NULL;
+    }
     if (!out_buffer(opos, "positions", NPY_FLOAT64, nd, (void **)&smp.pos) ||
         !out_buffer(ovel, "velocities", NPY_FLOAT64, nd, (void **)&smp.vel) ||
         !out_buffer(okin, "kinetic", NPY_FLOAT64, T, (void **)&smp.kinetic) ||
-        !out_buffer(omom, "momentum", NPY_FLOAT64, T * self->dim, (void **)&smp.momentum) ||
+        !out_buffer(omom, "momentum", NPY_FLOAT64, td, (void **)&smp.momentum) ||
         !out_buffer(opair, "pair", NPY_INT64, T, (void **)&smp.pair) ||
         !out_buffer(owall, "wall", NPY_INT64, T, (void **)&smp.wall) ||
         !out_buffer(ovir, "virial", NPY_FLOAT64, T, (void **)&smp.virial) ||
@@ -373,23 +391,47 @@ static void *inout(PyObject *obj, const char *name, int type, npy_intp size)
     return out_buffer(obj, name, type, size, &data) ? data : NULL;
 }
 
+/* Doubles of ring for the lags (each >= 1), or -1 with an exception set. */
+static int64_t ring_size_of(int dim, npy_intp L, const int64_t *lags)
+{
+    for (npy_intp l = 0; l < L; l++)
+        if (lags[l] < 1) {
+            PyErr_SetString(PyExc_ValueError, "lags must be >= 1 step");
+            return -1;
+        }
+    int64_t size = gr_sde_ring_size(dim, L, lags);
+    if (size < 0) PyErr_SetString(PyExc_OverflowError, "the ring of past positions for these lags overflows");
+    return size;
+}
+
 static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *kw)
 {
     static char *names[] = {"dim", "model", "scheme", "gamma0", "D0", "tau0", "dt", "key",
-                            "n", "first", "n_steps", "x", "v", "sample_steps", "x2", "v2",
-                            "positions", "lags", "tamsd", NULL};
+                            "n", "first", "step_from", "step_to", "n_steps", "x", "v",
+                            "sample_steps", "x2", "v2", "positions", "lags", "tamsd", "ring",
+                            NULL};
     gr_sde_config cfg;
     unsigned long long key;
-    long long n, first, n_steps;
-    PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLOOOOOOOO", names, &cfg.dim,
+    long long n, first, step_from, step_to, n_steps;
+    PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO", names, &cfg.dim,
                                      &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0, &cfg.tau0,
-                                     &cfg.dt, &key, &n, &first, &n_steps, &ox, &ov, &osteps,
-                                     &ox2, &ov2, &opos, &olags, &otamsd))
+                                     &cfg.dt, &key, &n, &first, &step_from, &step_to, &n_steps,
+                                     &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags, &otamsd,
+                                     &oring))
         return NULL;
     cfg.key = key;
-    if (cfg.dim < 1 || cfg.dim > 3 || n < 0 || first < 0 || n_steps < 0) {
-        PyErr_SetString(PyExc_ValueError, "dim must be 1..3 and counts non-negative");
+    if (cfg.dim < 1 || cfg.dim > 3 || n < 0 || first < 0) {
+        PyErr_SetString(PyExc_ValueError, "dim must be 1..3 and n, first non-negative");
+        return NULL;
+    }
+    if (n_steps < 0 || n_steps > GR_SDE_MAX_STEPS) {
+        PyErr_Format(PyExc_ValueError, "n_steps must lie in [0, 2**62], got %lld", n_steps);
+        return NULL;
+    }
+    if (step_from < 0 || step_from > step_to || step_to > n_steps) {
+        PyErr_Format(PyExc_ValueError, "need 0 <= step_from <= step_to <= n_steps, got %lld, %lld, %lld",
+                     step_from, step_to, n_steps);
         return NULL;
     }
     if (!PyArray_Check(ox) || !PyArray_Check(osteps) || !PyArray_Check(olags) ||
@@ -401,46 +443,50 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
         return NULL;
     }
     const npy_intp d = cfg.dim;
-    const npy_intp count = PyArray_SIZE((PyArrayObject *)ox) / d;
+    const npy_intp count = PyArray_SIZE((PyArrayObject *)ox) / d; /* count * d <= len(x) */
     const npy_intp T = PyArray_SIZE((PyArrayObject *)osteps);
     const npy_intp L = PyArray_SIZE((PyArrayObject *)olags);
-    if (first + count > n) {
+    if (first > n || count > n - first) {
         PyErr_SetString(PyExc_ValueError, "first + len(x) exceeds n");
         return NULL;
     }
+    if (!(step_from == 0 && step_to == n_steps) && count > 1) {
+        PyErr_SetString(PyExc_ValueError, "a segment of a run (not steps 0 to n_steps) takes one "
+                        "particle: its ring of past positions carries over to the next segment");
+        return NULL;
+    }
+    /* every size in checked arithmetic: n and the counts come from the caller */
+    npy_intp td, tnd = 0, nl;
+    if (!mul_size(T, d, &td, "x2") || !mul_size(n, L, &nl, "tamsd") ||
+        (opos != Py_None && (!mul_size(T, n, &tnd, "positions") || !mul_size(tnd, d, &tnd, "positions"))))
+        return NULL;
     gr_sde_output out;
     memset(&out, 0, sizeof out);
-    double *x = inout(ox, "x", NPY_FLOAT64, count * d);
-    double *v = x ? inout(ov, "v", NPY_FLOAT64, count * d) : NULL;
-    out.x2 = v ? inout(ox2, "x2", NPY_FLOAT64, T * d) : NULL;
-    out.v2 = out.x2 ? inout(ov2, "v2", NPY_FLOAT64, T * d) : NULL;
-    if (!out.v2) return NULL;
-    if (opos != Py_None && !(out.positions = inout(opos, "positions", NPY_FLOAT64, T * n * d)))
-        return NULL;
-    if (!(out.tamsd = inout(otamsd, "tamsd", NPY_FLOAT64, n * L))) return NULL;
     out.n_samples = T;
     out.sample_steps = PyArray_DATA((PyArrayObject *)osteps);
     out.n_lags = L;
     out.lags = PyArray_DATA((PyArrayObject *)olags);
+    const int64_t ring_size = ring_size_of(cfg.dim, L, out.lags);
+    if (ring_size < 0) return NULL;
+    double *x = inout(ox, "x", NPY_FLOAT64, count * d);
+    double *v = x ? inout(ov, "v", NPY_FLOAT64, count * d) : NULL;
+    out.x2 = v ? inout(ox2, "x2", NPY_FLOAT64, td) : NULL;
+    out.v2 = out.x2 ? inout(ov2, "v2", NPY_FLOAT64, td) : NULL;
+    out.tamsd = out.v2 ? inout(otamsd, "tamsd", NPY_FLOAT64, nl) : NULL;
+    out.ring = out.tamsd ? inout(oring, "ring", NPY_FLOAT64, ring_size) : NULL;
+    if (!out.ring) return NULL;
+    if (opos != Py_None && !(out.positions = inout(opos, "positions", NPY_FLOAT64, tnd)))
+        return NULL;
     for (npy_intp k = 0; k < T; k++)
         if (out.sample_steps[k] < 0 || (k > 0 && out.sample_steps[k] <= out.sample_steps[k - 1])) {
             PyErr_SetString(PyExc_ValueError, "sample_steps must be increasing and >= 0");
             return NULL;
         }
-    for (npy_intp l = 0; l < L; l++)
-        if (out.lags[l] < 1) {
-            PyErr_SetString(PyExc_ValueError, "lags must be >= 1 step");
-            return NULL;
-        }
-    /* scratch: per-lag strides, ring lengths, counters and the ring of past positions */
-    int64_t *ints = PyMem_Malloc((size_t)(6 * L + 1) * sizeof(int64_t));
-    int64_t ring_size = gr_sde_ring_size(cfg.dim, L, out.lags);
-    double *ring = PyMem_Malloc((size_t)(ring_size + 1) * sizeof(double));
-    if (!ints || !ring) {
-        PyMem_Free(ints);
-        PyMem_Free(ring);
-        return PyErr_NoMemory();
-    }
+    /* scratch: per-lag strides, ring lengths and counters (6 per lag; +1: never 0 bytes) */
+    npy_intp n_ints;
+    if (!mul_size(L, 6, &n_ints, "the lags' scratch")) return NULL;
+    int64_t *ints = PyMem_Calloc((size_t)n_ints + 1, sizeof(int64_t));
+    if (!ints) return PyErr_NoMemory();
     for (npy_intp l = 0; l < L; l++) {
         ints[l] = gr_sde_lag_stride(out.lags[l]);
         ints[L + l] = gr_sde_ring_len(out.lags[l]);
@@ -448,23 +494,40 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     out.lag_stride = ints;
     out.lag_len = ints + L;
     out.lag_work = ints + 2 * L;
-    out.ring = ring;
-    /* the per-step coefficient table of exact UDSBM, when it is not too large (else the
-     * core computes the coefficients inline: slower, same numbers) */
+    /* the per-step coefficient table of exact UDSBM, shared by the call's particles: only
+     * worth it for several, and only when not too large (else, or if the allocation fails,
+     * the core computes the coefficients inline: slower, the same numbers).  The bound
+     * keeps 5 x steps + 1 far from overflowing. */
     double *coef = NULL;
-    if (cfg.model == GR_SDE_UDSBM && cfg.scheme == GR_SDE_EXACT && n_steps <= (1LL << 22))
-        coef = PyMem_Malloc((size_t)(5 * n_steps + 1) * sizeof(double));
+    const int64_t seg = step_to - step_from;
+    if (cfg.model == GR_SDE_UDSBM && cfg.scheme == GR_SDE_EXACT && count > 1 && seg <= (1LL << 22))
+        coef = PyMem_Calloc((size_t)(5 * seg + 1), sizeof(double));
     out.step_coef = coef;
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
     int status;
     Py_BEGIN_ALLOW_THREADS
-    status = gr_sde_run(&cfg, n, first, count, n_steps, x, v, &out, &err);
+    status = gr_sde_run(&cfg, n, first, count, step_from, step_to, n_steps, x, v, &out, &err);
     Py_END_ALLOW_THREADS
     PyMem_Free(ints);
-    PyMem_Free(ring);
     PyMem_Free(coef);
     if (status != GR_OK) return raise_status(status, &err);
     Py_RETURN_NONE;
+}
+
+static PyObject *sde_ring_size(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    int dim;
+    PyObject *olags;
+    if (!PyArg_ParseTuple(args, "iO", &dim, &olags)) return NULL;
+    if (dim < 1 || dim > 3) {
+        PyErr_SetString(PyExc_ValueError, "dim must be 1..3");
+        return NULL;
+    }
+    PyArrayObject *lags = (PyArrayObject *)PyArray_FROMANY(olags, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
+    if (!lags) return NULL;
+    int64_t size = ring_size_of(dim, PyArray_SIZE(lags), PyArray_DATA(lags));
+    Py_DECREF(lags);
+    return size < 0 ? NULL : PyLong_FromLongLong(size);
 }
 
 static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *arg)
@@ -487,10 +550,14 @@ static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *arg)
 static PyMethodDef core_methods[] = {
     /* ==== SDE methods begin ==== */
     {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
-     "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, n_steps, x, v,"
-     " sample_steps, x2, v2, positions, lags, tamsd): advance particles first..first+len(x)"
-     " by n_steps, accumulating into the given arrays (internal: use granular.langevin)."},
+     "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
+     " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring): advance particles"
+     " first..first+len(x) over the steps [step_from, step_to) of a run of n_steps,"
+     " accumulating into the given arrays; ring (sde_ring_size doubles) carries one particle"
+     " from segment to segment (internal: use granular.langevin)."},
     {"sde_lag_stride", sde_lag_stride, METH_O, "spacing of TAMSD window starts for a lag (steps)"},
+    {"sde_ring_size", sde_ring_size, METH_VARARGS,
+     "sde_ring_size(dim, lags): doubles of sde_run's ring for these lags (steps, each >= 1)"},
     /* ==== SDE methods end ==== */
     {NULL, NULL, 0, NULL}
 };
@@ -518,6 +585,14 @@ PyMODINIT_FUNC PyInit__core(void)
     PyModule_AddIntConstant(m, "STOP_COLLISIONS", GR_STOP_COLLISIONS);
     PyModule_AddIntConstant(m, "STOP_ENERGY", GR_STOP_ENERGY);
     PyModule_AddIntConstant(m, "STOP_IDLE", GR_STOP_IDLE);
+    /* ==== SDE constants ==== */
+    PyObject *max_steps = PyLong_FromLongLong(GR_SDE_MAX_STEPS);
+    if (!max_steps || PyModule_AddObjectRef(m, "SDE_MAX_STEPS", max_steps) < 0) {
+        Py_XDECREF(max_steps);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_DECREF(max_steps);
     gr_rng_init();
     return m;
 }

@@ -23,14 +23,18 @@ int64_t gr_sde_lag_stride(int64_t lag)
 
 int64_t gr_sde_ring_len(int64_t lag)
 {
-    int64_t s = gr_sde_lag_stride(lag);
-    return (lag + s - 1) / s + 1;
+    /* ceil(lag / s) + 1, written so that no intermediate exceeds lag */
+    return (lag - 1) / gr_sde_lag_stride(lag) + 2;
 }
 
 int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags)
 {
     int64_t total = 0;
-    for (int64_t l = 0; l < n_lags; l++) total += gr_sde_ring_len(lags[l]) * dim;
+    for (int64_t l = 0; l < n_lags; l++) {
+        const int64_t need = gr_sde_ring_len(lags[l]) * dim; /* <= 32 x 3 */
+        if (total > INT64_MAX - need) return -1;
+        total += need;
+    }
     return total;
 }
 
@@ -72,6 +76,7 @@ typedef struct {
     int udsbm, em;
     exact_coef ex0;
     const exact_coef *table; /* the exact scheme's UDSBM coefficients per step, or NULL */
+    int64_t table_from;      /* the step that table[0] starts from */
 } step_params;
 
 /* Steps from+1 .. to of particle i (the step numbered k goes from t = (k-1) dt to k dt and
@@ -105,7 +110,7 @@ static GR_ALWAYS_INLINE void run_steps(
         } else {
             exact_coef e = p->ex0;
             if (p->table) {
-                e = p->table[step - 1];
+                e = p->table[step - 1 - p->table_from];
             } else if (p->udsbm) { /* coefficients frozen at the midpoint of the step,
                                     * computed exactly as the table does */
                 double s = 1.0 / (1.0 + ((double)(step - 1) + 0.5) * dt / p->tau0);
@@ -120,14 +125,30 @@ static GR_ALWAYS_INLINE void run_steps(
     }
 }
 
+/* The first sample at or after a step (binary search: sample_steps increase). */
+static int64_t first_sample_from(const gr_sde_output *out, int64_t step)
+{
+    int64_t lo = 0, hi = out->n_samples;
+    while (lo < hi) {
+        const int64_t mid = lo + (hi - lo) / 2;
+        if (out->sample_steps[mid] < step) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
 int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
-               int64_t n_steps, double *x, double *v, gr_sde_output *out, gr_error *err)
+               int64_t step_from, int64_t step_to, int64_t n_steps, double *x, double *v,
+               gr_sde_output *out, gr_error *err)
 {
     const int d = cfg->dim;
     const double dt = cfg->dt, g0 = cfg->gamma0, D0 = cfg->D0, tau0 = cfg->tau0;
     const int udsbm = cfg->model == GR_SDE_UDSBM;
+    const int whole = step_from == 0 && step_to == n_steps;
     if (d < 1 || d > 3 || !(dt > 0.0) || !(g0 > 0.0) || !(D0 > 0.0) || !(tau0 > 0.0) ||
-        n_steps < 0 || first < 0 || count < 0 || first + count > n) {
+        n_steps < 0 || n_steps > GR_SDE_MAX_STEPS || step_from < 0 || step_from > step_to ||
+        step_to > n_steps || first < 0 || count < 0 || first > n || count > n - first ||
+        (!whole && count > 1)) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, "invalid SDE parameters");
         return GR_ERR_VALUE;
     }
@@ -143,13 +164,16 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
     exact_coef *table = NULL;
     if (udsbm && cfg->scheme == GR_SDE_EXACT && out->step_coef) {
         table = (exact_coef *)out->step_coef;
-        for (int64_t st = 0; st < n_steps; st++) {
+        for (int64_t st = step_from; st < step_to; st++) {
             double s = 1.0 / (1.0 + ((double)st + 0.5) * dt / tau0);
-            table[st] = exact_for(g0 * s, D0 * s, dt);
+            table[st - step_from] = exact_for(g0 * s, D0 * s, dt);
         }
     }
 
-    const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, udsbm, cfg->scheme == GR_SDE_EM, ex0, table};
+    const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, udsbm, cfg->scheme == GR_SDE_EM,
+                            ex0, table, step_from};
+    /* where the segment starts among the samples */
+    const int64_t ks0 = first_sample_from(out, step_from);
     for (int64_t local = 0; local < count; local++) {
         const int64_t i = first + local;
         double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0};
@@ -157,20 +181,27 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
             xi[a] = x[local * d + a];
             vi[a] = v[local * d + a];
         }
-        int64_t ks = 0;
-        /* per lag: next window end, next store, their ring slots (no divisions per step) */
+        int64_t ks = ks0;
+        /* Per lag: next window end, next store, their ring slots (no divisions per step).
+         * The k-th store (k = 0, 1, ...) is at step k stride into slot k mod len, the k-th
+         * window ends at lag + k stride and reads that slot: so the counters at step_from
+         * follow from step_from alone, and only the ring carries over between segments. */
         int64_t *next_end = out->lag_work, *next_store = next_end + out->n_lags;
         int64_t *slot_end = next_store + out->n_lags, *slot_store = slot_end + out->n_lags;
         for (int64_t l = 0; l < out->n_lags; l++) {
-            next_end[l] = out->lags[l];
-            next_store[l] = 0;
-            slot_end[l] = 0;
-            slot_store[l] = 0;
+            const int64_t lag = out->lags[l], stride = out->lag_stride[l], len = out->lag_len[l];
+            int64_t k = step_from / stride + (step_from % stride != 0);
+            next_store[l] = k * stride;
+            slot_store[l] = k % len;
+            k = step_from <= lag ? 0 : (step_from - lag - 1) / stride + 1;
+            next_end[l] = lag + k * stride;
+            slot_end[l] = k % len;
         }
         /* Bookkeeping (samples, TAMSD windows) happens at few steps; between them the
          * particle is stepped in a tight loop.  Step 0, the start, is a sample and a
          * window start for every lag. */
-        for (int64_t step = 0;;) {
+        for (int64_t step = step_from;;) {
+            if (step == step_to && step_to < n_steps) break; /* booked by the next segment */
             while (ks < out->n_samples && out->sample_steps[ks] == step) {
                 for (int a = 0; a < d; a++) {
                     out->x2[ks * d + a] += xi[a] * xi[a];
@@ -179,7 +210,7 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
                 }
                 ks++;
             }
-            int64_t next = n_steps; /* the next step that needs bookkeeping */
+            int64_t next = step_to; /* the next step that needs bookkeeping */
             if (ks < out->n_samples && out->sample_steps[ks] < next) next = out->sample_steps[ks];
             double *r = out->ring;
             for (int64_t l = 0; l < out->n_lags; l++) {

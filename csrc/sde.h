@@ -26,9 +26,13 @@ typedef struct {
     uint64_t key;            /* random stream key */
 } gr_sde_config;
 
+/* Largest step count of a run: step counters plus a lag's stride then stay far from
+ * INT64_MAX (a stride is at most lag/16 and lags beyond the run are never reached). */
+#define GR_SDE_MAX_STEPS ((int64_t)1 << 62)
+
 /* What a run accumulates.  Sample k is taken after step sample_steps[k] (0 = the start);
  * lags are in steps.  Sums run over particles in index order, so they are the same
- * however the particles are chunked. */
+ * however the particles and steps are chunked. */
 typedef struct {
     int64_t n_samples;
     const int64_t *sample_steps; /* increasing, >= 0 */
@@ -41,26 +45,34 @@ typedef struct {
     const int64_t *lag_len;      /* per lag: ring length (gr_sde_ring_len) */
     int64_t *lag_work;           /* scratch: 4 x n_lags */
     double *tamsd;               /* n x n_lags: per particle, sum over windows of |dx|^2 */
-    int64_t *windows;            /* n_lags: windows per particle */
-    double *ring;                /* scratch: sum over lags of (lag/stride + 1) * dim */
-    double *step_coef;           /* optional scratch, 5 x n_steps: the exact scheme's UDSBM
-                                    coefficients per step, computed once per call instead
-                                    of once per particle and step; NULL computes them inline */
+    double *ring;                /* gr_sde_ring_size doubles: one particle's past positions
+                                    per lag.  Scratch for a whole run; carried from call to
+                                    call when a run is split into step segments */
+    double *step_coef;           /* optional scratch, 5 x (step_to - step_from): the exact
+                                    scheme's UDSBM coefficients per step, computed once per
+                                    call instead of once per particle and step; NULL
+                                    computes them inline (the same numbers) */
 } gr_sde_output;
 
 /* Stride of TAMSD window starts for a lag: windows start every max(1, lag/16) steps, so
- * each particle keeps at most 17 past positions per lag. */
+ * each particle keeps at most 32 past positions per lag (lag 31, stride 1). */
 int64_t gr_sde_lag_stride(int64_t lag);
-/* Past positions one particle keeps for a lag: lag/stride rounded up, plus one. */
+/* Past positions one particle keeps for a lag (>= 1): lag/stride rounded up, plus one. */
 int64_t gr_sde_ring_len(int64_t lag);
-/* Doubles of ring scratch needed for the lags. */
+/* Doubles of ring needed for the lags (each >= 1), or -1 if that overflows int64. */
 int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags);
 
-/* Advance particles [first, first + count) of n from step 0 to n_steps: positions x and
- * velocities v (count x dim, starting values in, final values out; x starts at the
- * particle's origin).  Returns GR_OK, GR_ERR_VALUE or GR_ERR_UNSTABLE (Euler-Maruyama
- * with gamma0 dt >= 2). */
+/* Advance particles [first, first + count) of n over the steps [step_from, step_to) of a
+ * run of n_steps <= GR_SDE_MAX_STEPS steps: positions x and velocities v (count x dim)
+ * hold the state at step_from in (x = 0 at the particle's origin at step 0) and at
+ * step_to out.  Samples and TAMSD windows are booked at the steps step_from .. step_to-1,
+ * and at n_steps when step_to = n_steps, so a run is one call over [0, n_steps] or calls
+ * over consecutive segments [s0 = 0, s1), [s1, s2), ..., ending at n_steps, with the same
+ * results to the bit.  A segment that is not the whole run takes one particle (count <= 1)
+ * and the ring its previous segment left.  Returns GR_OK, GR_ERR_VALUE, GR_ERR_NONFINITE
+ * or GR_ERR_UNSTABLE (Euler-Maruyama with gamma0 dt >= 2). */
 int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
-               int64_t n_steps, double *x, double *v, gr_sde_output *out, gr_error *err);
+               int64_t step_from, int64_t step_to, int64_t n_steps, double *x, double *v,
+               gr_sde_output *out, gr_error *err);
 
 #endif

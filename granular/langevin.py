@@ -24,11 +24,13 @@ midpoint; since they change on the time scale 1 + t/tau0, the local error per st
 O((dt / tau0)^2) relative, and the integrated error O(dt^2 / (tau0 (tau0 + t))) -- far
 below Euler-Maruyama's O(gamma0 dt) bias.
 
+The exact scheme is the default; Euler-Maruyama, the thesis' scheme, is one keyword away.
+
 Random numbers are counter-based (see ``csrc/rng.h``): each particle's noise at each step
 is a function of (seed, step, particle) only, so results are bit-identical whatever the
 chunking.  Nothing of size N x steps is stored: the ensemble MSD at the sample times and
 the time-averaged MSD at the requested lags are accumulated on the fly (window starts every
-max(1, lag/16) steps, so each particle needs at most 17 past positions per lag).
+max(1, lag/16) steps, so each particle needs at most 32 past positions per lag).
 """
 from __future__ import annotations
 
@@ -41,7 +43,10 @@ from . import _core
 MODELS = ("langevin", "udsbm")
 SCHEMES = ("em", "exact")
 INITIAL = ("thermal", "udsbm", "fixed")
-_CHUNK_PARTICLE_STEPS = 20_000_000  # per call into C: ~0.2 s, so Ctrl-C is prompt
+# Work per call into C, in particle-steps: a block of particles over the whole run, or one
+# particle over a segment of its steps -- at most ~0.6 s (exact UDSBM, ~60 ns a step),
+# so Ctrl-C is prompt however few the particles and many the steps.
+_CHUNK_PARTICLE_STEPS = 10_000_000
 
 
 class LangevinResult:
@@ -121,7 +126,7 @@ def _positive(name, value):
     return value
 
 
-def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="em", dim=3,
+def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="exact", dim=3,
         sample_times=None, tamsd_lags=None, initial="thermal", speed=None,
         store_positions=False, seed=None, progress=False):
     """Integrate N independent particles from a common start at the origin.
@@ -132,8 +137,10 @@ def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="em", di
     gamma0, D0 : friction and diffusivity (per dimension) at t = 0
     tau0 : UDSBM time scale (infinite: the Langevin model)
     model : "langevin" or "udsbm" (default: "udsbm" when tau0 is finite)
-    scheme : "em" (Euler-Maruyama, thesis 2.92/2.110) or "exact"
-    dt, t_stop : step and duration (t_stop is rounded to whole steps)
+    scheme : "exact" (the default: exact OU update, stable at any step) or "em"
+        (Euler-Maruyama, thesis 2.92/2.110)
+    dt, t_stop : step and duration (t_stop is rounded to whole steps, at most
+        ``_core.SDE_MAX_STEPS`` = 2**62 of them)
     dim : 1, 2 or 3
     sample_times : increasing times to sample the ensemble MSD, rounded to whole steps
         (times that round to the same step are sampled once: ``result.times`` has the
@@ -147,7 +154,7 @@ def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="em", di
         speed) in an isotropic random direction (thesis 3.3, made isotropic).
     store_positions : keep (T, N, d) positions at the sample times
     seed : anything ``numpy.random.SeedSequence`` takes
-    progress : tqdm bar over particle chunks
+    progress : tqdm bar over particle-steps
     """
     n = int(n)
     if n < 1:
@@ -176,31 +183,38 @@ def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="em", di
             f"Euler-Maruyama diverges for gamma0*dt >= 2 (here {gamma0 * dt:.4g}); take "
             f"dt < {2 / gamma0:.4g} or scheme='exact', which is stable at any step",
             value=gamma0 * dt)
-    n_steps = int(round(t_stop / dt))
+    n_steps_f = t_stop / dt  # in float first: it may be past any int64, or infinite
+    if not n_steps_f <= _core.SDE_MAX_STEPS:
+        raise ValueError(f"t_stop / dt = {t_stop!r} / {dt!r} = {n_steps_f:.4g} steps; a run "
+                         f"takes at most 2**62 = {_core.SDE_MAX_STEPS:.4g}")
+    n_steps = int(round(n_steps_f))
     if n_steps < 1:
         raise ValueError("t_stop must be at least one step")
 
+    # sample steps and lags are compared with n_steps as floats, before they become int64
     if sample_times is None:
-        steps = np.unique(np.concatenate([[0], np.rint(np.logspace(0, math.log10(n_steps), 60))]))
+        steps_f = np.minimum(np.rint(np.logspace(0, math.log10(n_steps), 60)), n_steps)
+        steps_f = np.concatenate([[0], steps_f, [n_steps]])
     else:
         st = np.asarray(sample_times, dtype=np.float64).reshape(-1)
         if not np.all(np.isfinite(st)) or np.any(st < 0):
             raise ValueError("sample_times must be finite and >= 0")
         if np.any(np.diff(st) <= 0):
             raise ValueError("sample_times must be strictly increasing")
-        steps = np.unique(np.rint(st / dt))  # whole steps; times within one step merge
-    steps = steps.astype(np.int64)
-    if len(steps) and steps[-1] > n_steps:
-        raise ValueError(f"sample_times reach past t_stop = {n_steps * dt}")
+        steps_f = np.rint(st / dt)  # whole steps; times within one step merge
+        if len(steps_f) and not steps_f[-1] <= n_steps:
+            raise ValueError(f"sample_times reach past t_stop = {n_steps * dt}")
+    steps = np.unique(steps_f).astype(np.int64)
     if tamsd_lags is None:
         lags = np.zeros(0, dtype=np.int64)
     else:
         lag_t = np.asarray(tamsd_lags, dtype=np.float64).reshape(-1)
         if np.any(np.diff(lag_t) <= 0):
             raise ValueError("tamsd_lags must be strictly increasing")
-        lags = np.unique(np.rint(lag_t / dt)).astype(np.int64)  # whole steps, merged
-        if np.any(lags < 1) or np.any(lags > n_steps):
+        lag_f = np.rint(lag_t / dt)  # whole steps, merged below
+        if not np.all((lag_f >= 1) & (lag_f <= n_steps)):  # NaN fails too
             raise ValueError("tamsd_lags must be at least dt and at most t_stop")
+        lags = np.unique(lag_f).astype(np.int64)
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     key_seq, vel_seq = ss.spawn(2)
@@ -239,22 +253,32 @@ def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="em", di
     tamsd_sum = np.zeros((n, L))
     model_code = MODELS.index(model)
     scheme_code = SCHEMES.index(scheme)
-    per_call = max(1, _CHUNK_PARTICLE_STEPS // max(1, n_steps))
+    # Chunk by work: blocks of particles over all steps while a particle's run is short,
+    # else one particle at a time over segments of its steps (the C core carries such a
+    # particle's past positions from segment to segment in `ring`).  The same numbers to
+    # the bit either way.
+    work = max(1, _CHUNK_PARTICLE_STEPS)
+    per_call = max(1, work // n_steps)
+    steps_per_call = min(n_steps, work)
+    ring = np.zeros(_core.sde_ring_size(dim, lags))
     bar = None
     if progress:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=n, unit="particle", leave=False)
+        bar = tqdm(total=n * n_steps, unit="particle-step", unit_scale=True, leave=False)
     try:
         for first in range(0, n, per_call):
             xs = np.ascontiguousarray(x[first:first + per_call])
             vs = np.ascontiguousarray(v[first:first + per_call])
-            _core.sde_run(dim, model_code, scheme_code, gamma0, D0, tau0, dt, key, n, first,
-                          n_steps, xs, vs, steps, x2, v2, positions, lags, tamsd_sum)
+            for step_from in range(0, n_steps, steps_per_call):
+                step_to = min(step_from + steps_per_call, n_steps)
+                _core.sde_run(dim, model_code, scheme_code, gamma0, D0, tau0, dt, key, n, first,
+                              step_from, step_to, n_steps, xs, vs, steps, x2, v2, positions,
+                              lags, tamsd_sum, ring)
+                if bar is not None:
+                    bar.update(len(xs) * (step_to - step_from))
             x[first:first + len(xs)] = xs
             v[first:first + len(vs)] = vs
-            if bar is not None:
-                bar.update(len(xs))
     finally:
         if bar is not None:
             bar.close()
@@ -281,7 +305,7 @@ def coefficients_from_scene(scene):
                                         scene.temperature, mass, scene.dim)
 
 
-def from_scene(scene, *, dt, t_stop, scheme="em", n=None, **kwargs):
+def from_scene(scene, *, dt, t_stop, scheme="exact", n=None, **kwargs):
     """A Langevin run (xi = 1) or UDSBM run (xi < 1) with the scene's coefficients, so it
     can be set beside an EDMD run of the same scene.  ``n`` defaults to the scene's N;
     other arguments as in ``run``."""

@@ -4,6 +4,13 @@ probability of 5.7e-7 per comparison (two-sided Gaussian tail at 5 sigma), so by
 bound even a test comparing at all its ~60 sample times fails by chance less than once in
 10^4 runs."""
 import math
+import os
+import re
+import signal
+import subprocess
+import sys
+import textwrap
+import time
 
 import numpy as np
 import pytest
@@ -169,26 +176,126 @@ def test_tamsd_equals_msd_for_langevin_but_not_for_udsbm():
     np.testing.assert_array_less(5 * se, u.theory_msd(lags) - u.tamsd)
 
 
-def test_same_seed_same_result_whatever_the_chunking(monkeypatch):
-    kw = dict(gamma0=G0, D0=D0, tau0=TAU0, dt=0.01, t_stop=2.0, tamsd_lags=[0.1, 1.0],
+@pytest.mark.parametrize("model,tau0", [("langevin", math.inf), ("udsbm", TAU0)])
+@pytest.mark.parametrize("scheme", ["em", "exact"])
+def test_same_seed_same_result_whatever_the_chunking(monkeypatch, model, tau0, scheme):
+    """Bit-identical results (np.array_equal) whether the work goes to C in one call, in
+    blocks of particles, or one particle at a time in segments of a few steps -- 1, 7 or 13,
+    so that segment ends fall before, on and after sample steps and TAMSD window starts and
+    ends (samples at every step; lags of 1, 7, 30, 100 and all 200 steps)."""
+    kw = dict(gamma0=G0, D0=D0, tau0=tau0, model=model, scheme=scheme, dt=0.01, t_stop=2.0,
+              sample_times=np.arange(201) * 0.01, tamsd_lags=[0.01, 0.07, 0.3, 1.0, 2.0],
               store_positions=True, seed=7)
-    a = langevin.run(300, **kw)
-    monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", 200 * 7)  # 7 particles a call
-    b = langevin.run(300, **kw)
-    for name in ("msd", "v2", "tamsd", "positions", "final_velocities"):
-        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
-    c = langevin.run(300, **{**kw, "seed": 8})
+    names = ("msd", "v2", "tamsd_per_particle", "positions", "final_positions", "final_velocities")
+    a = langevin.run(30, **kw)  # one call: 30 x 200 particle-steps
+    for chunk in (200 * 7, 13, 7, 1):  # 7 particles a call; then one particle, 13, 7, 1 steps a call
+        monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", chunk)
+        b = langevin.run(30, **kw)
+        for name in names:
+            assert np.array_equal(getattr(a, name), getattr(b, name)), (chunk, name)
+    c = langevin.run(30, **{**kw, "seed": 8})
     assert not np.array_equal(a.positions, c.positions)
+
+
+def test_ctrl_c_stops_a_long_run_of_one_particle():
+    """SIGINT reaches a run of one particle and many steps between calls into C: the work
+    is chunked by particle-steps, not by particles.  The run is 2e9 Euler-Maruyama steps,
+    which in one call into C (the chunking by particles alone) took 31 s (15.7 ns a step,
+    measured on a 2-core machine), far past the bound.  In a child process, so that a
+    failure costs a kill, not the test run.  The bound, 3 s from the signal to the exit
+    with KeyboardInterrupt, is generous: a call takes ~0.2 s."""
+    code = textwrap.dedent("""
+        import sys
+        from granular import langevin
+        print("start", flush=True)
+        try:
+            langevin.run(1, gamma0=1.0, D0=1.0, dt=0.01, t_stop=2e7, scheme="em",
+                         sample_times=[0.0], seed=1)
+        except KeyboardInterrupt:
+            print("interrupted", flush=True)
+            sys.exit(0)
+        print("finished", flush=True)
+        """)
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                            cwd=os.path.dirname(__file__))
+    try:
+        assert proc.stdout.readline() == "start\n"
+        time.sleep(1.0)  # well inside the run
+        proc.send_signal(signal.SIGINT)
+        sent = time.monotonic()
+        out, _ = proc.communicate(timeout=30)
+        waited = time.monotonic() - sent
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert out.strip() == "interrupted" and proc.returncode == 0
+    assert waited < 3.0, f"the run took {waited:.1f} s to stop after SIGINT"
+
+
+@pytest.mark.parametrize("case,error", [
+    # positions: T x n x dim = 4 x 2**62 x 1 wraps to 0 in int64
+    ("dict(n=2**62, sample_steps=np.arange(4), positions=np.zeros(0))", "OverflowError: .*positions"),
+    # tamsd: n x L = 2**62 x 4 wraps to 0
+    ("dict(n=2**62, lags=np.arange(1, 5), tamsd=np.zeros(0))", "OverflowError: .*tamsd"),
+    # first + len(x) past int64
+    ("dict(n=2**63 - 1, first=2**63 - 1)", "ValueError: first \\+ len\\(x\\) exceeds n"),
+    ("dict(n_steps=2**62 + 1, step_to=2**62 + 1)", "ValueError: n_steps must lie in"),
+])
+def test_core_sde_run_checks_sizes_without_overflow(case, error):
+    """_core.sde_run called directly with sizes whose products overflow int64 raises a
+    clean exception instead of accepting a short buffer and writing past it (a child
+    process, so that a crash fails the test instead of ending the test run)."""
+    code = textwrap.dedent(f"""
+        import numpy as np
+        from granular import _core
+        args = dict(dim=1, model=0, scheme=0, gamma0=1.0, D0=1.0, tau0=float("inf"), dt=0.01,
+                    key=1, n=1, first=0, step_from=0, step_to=3, n_steps=3, x=np.zeros(1),
+                    v=np.zeros(1), sample_steps=np.zeros(1, dtype=np.int64), x2=None, v2=None,
+                    positions=None, lags=np.zeros(0, dtype=np.int64), tamsd=np.zeros(0),
+                    ring=None)
+        args.update({case})
+        args.update(x2=np.zeros(len(args["sample_steps"])), v2=np.zeros(len(args["sample_steps"])),
+                    ring=np.zeros(_core.sde_ring_size(1, args["lags"])))
+        try:
+            _core.sde_run(**args)
+            print("no error")
+        except Exception as exc:
+            print(f"{{type(exc).__name__}}: {{exc}}")
+        """)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=os.path.dirname(__file__), timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert re.match(error, done.stdout), done.stdout
 
 
 def test_refuses_unstable_euler_maruyama():
     with pytest.raises(granular.UnstableStepError, match="gamma0\\*dt >= 2.*exact") as info:
-        langevin.run(10, gamma0=10.0, D0=0.1, dt=0.2, t_stop=1.0)
+        langevin.run(10, gamma0=10.0, D0=0.1, dt=0.2, t_stop=1.0, scheme="em")
     assert info.value.value == pytest.approx(2.0)
     # the exact scheme takes the same step
     r = langevin.run(1000, gamma0=10.0, D0=0.1, dt=0.2, t_stop=100.0, scheme="exact", seed=1,
                      sample_times=[100.0])
     assert r.v2[-1] / 3 == pytest.approx(1.0, rel=5 * rel_se_msd(1000))
+
+
+def test_exact_scheme_is_the_default():
+    s = granular.Scene.random(100, 0.025, restitution=0.8, seed=1)
+    assert langevin.run(10, gamma0=G0, D0=D0, dt=0.01, t_stop=0.1, seed=1).scheme == "exact"
+    assert langevin.from_scene(s, dt=0.01, t_stop=0.1, n=10, seed=1).scheme == "exact"
+    assert langevin.from_scene(s, dt=0.01, t_stop=0.1, n=10, scheme="em", seed=1).scheme == "em"
+
+
+def test_default_samples_end_at_t_stop_for_any_step_count(monkeypatch):
+    """The default log-spaced samples end at the last step even where float rounding of
+    logspace overshoots it (10^15 + 3 steps: 10^15 + 4); no stepping is needed to see it,
+    so the C core is replaced by a stub (called once)."""
+    seen = []
+    monkeypatch.setattr(langevin._core, "sde_run", lambda *args: seen.append(args[15]))
+    monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", 10**16)
+    r = langevin.run(1, gamma0=G0, D0=D0, dt=1.0, t_stop=1e15 + 3, seed=1)
+    assert r.times[-1] == 1e15 + 3 and np.all(np.diff(r.times) > 0)
+    assert len(seen) == 1 and seen[0][-1] == 10**15 + 3
 
 
 def test_from_scene_uses_the_thesis_coefficients():
@@ -215,6 +322,12 @@ def test_from_scene_uses_the_thesis_coefficients():
     (dict(initial="hot"), "initial must be one of"),
     (dict(model="udsbm"), "finite tau0"),
     (dict(initial="udsbm"), "App. C"),
+    # step counts past int64 (or infinite) are refused with the numbers, before any cast
+    (dict(t_stop=1e300), "t_stop / dt = 1e\\+300 / 0.01 = 1e\\+302 steps; a run takes at most 2\\*\\*62"),
+    (dict(dt=5e-324), "t_stop / dt = 1.0 / 5e-324 = inf steps"),
+    (dict(sample_times=[0.0, 1e300]), "past t_stop"),
+    (dict(tamsd_lags=[1e300]), "tamsd_lags must be at least dt and at most t_stop"),
+    (dict(tamsd_lags=[float("nan")]), "tamsd_lags must be at least dt and at most t_stop"),
 ])
 def test_bad_input(kwargs, match):
     base = dict(gamma0=G0, D0=D0, dt=0.01, t_stop=1.0)
