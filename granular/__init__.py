@@ -10,7 +10,7 @@ that checks them against theory.
 from . import errors
 from .errors import (FrozenGasError, GranularError, HeatedWallsError, InelasticCollapseError,
                      NoProgressError, NonFiniteError, OutsideBoxError, OverlapError,
-                     UnstableStepError)
+                     ProcessBackendError, UnstableStepError)
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
@@ -38,4 +38,4 @@ def __dir__():
 __all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "analysis",
            "langevin", "theory", "errors", "GranularError", "OverlapError",
            "OutsideBoxError", "InelasticCollapseError", "HeatedWallsError", "NoProgressError",
-           "FrozenGasError", "NonFiniteError", "UnstableStepError"]
+           "FrozenGasError", "NonFiniteError", "ProcessBackendError", "UnstableStepError"]

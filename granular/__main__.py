@@ -2,7 +2,19 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import sys
+
+# Optional modules a command imports only when it draws, and the extra that installs each:
+# checked before the command starts, so that a missing one never loses minutes of work.
+_NEEDS = {"demo": ("matplotlib",), "reproduce": ("matplotlib",),
+          "bench --speed-accuracy": ("matplotlib",)}
+_EXTRA = {"matplotlib": "plot"}
+
+
+def _missing(modules):
+    """The modules among ``modules`` that cannot be imported."""
+    return [m for m in modules if importlib.util.find_spec(m) is None]
 
 
 def main(argv=None):
@@ -24,6 +36,14 @@ def main(argv=None):
                        help="chart error against cost and map where methods fail")
     bench.add_argument("--out", default="speed-accuracy", help="output folder (--speed-accuracy)")
     args = parser.parse_args(argv)
+
+    command = "bench --speed-accuracy" if getattr(args, "speed_accuracy", False) else args.command
+    missing = _missing(_NEEDS.get(command, ()))
+    if missing:
+        extras = ",".join(sorted({_EXTRA[m] for m in missing}))
+        print(f"python -m granular {command} needs {', '.join(missing)}, which is not "
+              f"installed: pip install 'granular[{extras}]'", file=sys.stderr)
+        return 2
 
     if args.command == "demo":
         from . import demo as demo_module

@@ -9,12 +9,14 @@ however many workers ran them.
 """
 from __future__ import annotations
 
+import ast
 import os
 import sys
 import traceback
 
 import numpy as np
 
+from .errors import ProcessBackendError
 from .scene import Scene
 from .simulation import Simulation
 
@@ -37,6 +39,15 @@ class RunFailure:
         return f"RunFailure(run {self.index}, seed={self.seed}, error={self.error!r})"
 
 
+_GUARD_ADVICE = (
+    "Worker processes start by importing the main script, so its top-level code, this "
+    "ensemble call included, runs again in each of them. Put the script's work under a "
+    "main guard (the functions the runs call stay at top level, where workers find them):\n\n"
+    "    if __name__ == \"__main__\":\n"
+    "        result = granular.ensemble(...)\n\n"
+    "or pass backend=\"serial\" or backend=\"threads\".")
+
+
 class EnsembleResult:
     """Per-run results and their ensemble statistics.
 
@@ -47,7 +58,8 @@ class EnsembleResult:
     mean, error : dict
         Per quantity: the mean over successful runs and its standard error
         ``std(ddof=1) / sqrt(K)`` (central limit theorem, thesis 2.120-2.122); NaN error
-        for K = 1.
+        for K = 1.  An entry equal in every run (inf included, e.g. a Langevin run's
+        ``tau0``) keeps that value, with error 0.
     count : int
         Number of successful runs.
     failures : list of RunFailure
@@ -66,6 +78,13 @@ class EnsembleResult:
     def __repr__(self):
         q = ", ".join(sorted(self.mean))
         return f"EnsembleResult({self.count} runs, {len(self.failures)} failed; {q})"
+
+
+def _difference(v, mean):
+    """``v - mean``, but 0 where they are equal: an entry that is the same in every run,
+    inf included (tau0 = inf of a Langevin run), keeps its value and gets error 0, where
+    inf - inf would make both NaN."""
+    return np.where(v == mean, 0.0, v - mean)
 
 
 class _Accumulator:
@@ -92,10 +111,11 @@ class _Accumulator:
                 self.ragged.add(k)
                 del self.mean[k], self.m2[k]
                 continue
-            with np.errstate(invalid="ignore"):  # inf parameters (tau0 = inf) stay inf
-                delta = v - self.mean[k]
+            # runs with inf in some entries and finite numbers in others: mean inf, error NaN
+            with np.errstate(invalid="ignore"):
+                delta = _difference(v, self.mean[k])
                 self.mean[k] += delta / self.count
-                self.m2[k] += delta * (v - self.mean[k])
+                self.m2[k] += delta * _difference(v, self.mean[k])
 
     def result(self):
         error = {}
@@ -178,14 +198,74 @@ def _progress_bar(total, progress):
     return tqdm(total=total, unit="run", disable=not progress)
 
 
+def _process_context():
+    """The multiprocessing context of the process backend (forkserver on Linux, else spawn:
+    either way, workers re-import the main script)."""
+    import multiprocessing as mp
+
+    return mp.get_context("forkserver" if sys.platform.startswith("linux") else "spawn")
+
+
 def _executor(backend, workers):
     import concurrent.futures as cf
-    import multiprocessing as mp
 
     if backend == "threads":
         return cf.ThreadPoolExecutor(max_workers=workers)
-    ctx = mp.get_context("forkserver" if sys.platform.startswith("linux") else "spawn")
-    return cf.ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    return cf.ProcessPoolExecutor(max_workers=workers, mp_context=_process_context())
+
+
+def _main_guard_lines(tree):
+    """Line ranges of the blocks that run only when a script is run, not imported:
+    ``if __name__ == "__main__":`` (either operand order) and the ``else`` of ``!=``."""
+    def is_name(node):
+        return isinstance(node, ast.Name) and node.id == "__name__"
+
+    def is_main(node):
+        return isinstance(node, ast.Constant) and node.value == "__main__"
+
+    for node in ast.walk(tree):
+        test = node.test if isinstance(node, ast.If) else None
+        if not (isinstance(test, ast.Compare) and len(test.ops) == 1):
+            continue
+        left, right = test.left, test.comparators[0]
+        if not ((is_name(left) and is_main(right)) or (is_main(left) and is_name(right))):
+            continue
+        block = {ast.Eq: node.body, ast.NotEq: node.orelse}.get(type(test.ops[0]))
+        if block:
+            yield block[0].lineno, block[-1].end_lineno
+
+
+def _unguarded_main_call(start_method):
+    """(script, line) when this call comes from the main script's top level outside a main
+    guard -- directly, or through functions that such a line calls -- and worker processes
+    started by ``start_method`` re-run that script; None otherwise.
+
+    Only ``spawn`` and ``forkserver`` workers re-run the main script, and only when it is a
+    file: not in a notebook, an interactive session or ``python -c``, nor for a package's
+    ``__main__`` (multiprocessing skips those), so no false alarm there."""
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    spec = getattr(main, "__spec__", None)
+    if (start_method == "fork" or not isinstance(path, str)
+            or (spec is not None and spec.name.rpartition(".")[2] == "__main__")):
+        return None
+    frame = sys._getframe(1)
+    while frame is not None and not (frame.f_globals is vars(main)
+                                     and frame.f_code.co_name == "<module>"
+                                     and os.path.abspath(frame.f_code.co_filename)
+                                     == os.path.abspath(path)):
+        frame = frame.f_back
+    if frame is None:
+        return None  # not called from the script's top level (e.g. from another thread)
+    try:
+        with open(path, "rb") as f:
+            tree = ast.parse(f.read(), path)
+    except (OSError, SyntaxError, ValueError):
+        return None  # cannot tell; a broken pool still gets the advice
+    line = frame.f_lineno
+    if any(first <= line <= last for first, last in _main_guard_lines(tree)):
+        return None
+    return path, line
 
 
 def _windowed(calls, submit, wait_any, window):
@@ -220,12 +300,21 @@ def _windowed(calls, submit, wait_any, window):
 
 def _pool_results(calls, backend, workers):
     import concurrent.futures as cf
+    from concurrent.futures.process import BrokenProcessPool
 
     with _executor(backend, workers) as pool:
-        yield from _windowed(
-            calls, lambda call: pool.submit(_call_task, *call),
-            lambda futures: cf.wait(futures, return_when=cf.FIRST_COMPLETED).done,
-            window=2 * workers)  # a run queued behind each running one: no worker waits for us
+        try:
+            yield from _windowed(
+                calls, lambda call: pool.submit(_call_task, *call),
+                lambda futures: cf.wait(futures, return_when=cf.FIRST_COMPLETED).done,
+                window=2 * workers)  # a run queued behind each running one: no worker waits
+        except BrokenProcessPool as exc:
+            raise ProcessBackendError(
+                "A worker process of ensemble(backend=\"processes\") died (BrokenProcessPool). "
+                "The usual cause: the script calls ensemble outside an "
+                "`if __name__ == \"__main__\":` block. " + _GUARD_ADVICE + "\nIf the script "
+                "has that guard, a run crashed its worker or ran out of memory: "
+                "backend=\"serial\" shows the run's own error.") from exc
 
 
 def _dask_results(calls, client):
@@ -333,7 +422,8 @@ def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progr
     backend : "processes" (default: all local cores), "serial", "threads", or a
         ``dask.distributed.Client`` (a real cluster, or a ``LocalCluster``).  Worker
         processes import the calling script, so in a script call ``ensemble`` under
-        ``if __name__ == "__main__":`` (as for any process pool; notebooks need nothing).
+        ``if __name__ == "__main__":`` (as for any process pool; notebooks need nothing);
+        without it ``ProcessBackendError`` says so before any run starts.
     workers : int, optional
         Local worker count (default: all cores).
     progress : bool, optional
@@ -366,6 +456,12 @@ def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progr
     bad = set(quantities) - set(EDMD_QUANTITIES)
     if bad:
         raise ValueError(f"unknown quantities {sorted(bad)}; choose from {EDMD_QUANTITIES}")
+    if isinstance(backend, str) and backend == "processes":
+        where = _unguarded_main_call(_process_context().get_start_method())
+        if where is not None:
+            raise ProcessBackendError(
+                f"ensemble(backend=\"processes\") is called from {where[0]}, line {where[1]}, "
+                "outside an `if __name__ == \"__main__\":` block. " + _GUARD_ADVICE)
     seeds = _seeds(seed, runs, len(models) if sweep else None)
     tasks = [_Task(m, run_kwargs, tuple(quantities)) for m in models]
     # call index p * runs + r: run r of point p, the order in which runs are reduced

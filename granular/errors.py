@@ -52,6 +52,12 @@ class UnstableStepError(GranularError, ValueError):
     """An integrator step is at or past its stability limit (``.value`` is gamma*dt)."""
 
 
+class ProcessBackendError(GranularError, RuntimeError):
+    """The process backend cannot run this ensemble: the script calls ``ensemble`` outside
+    an ``if __name__ == "__main__":`` block, which the worker processes re-run as they start
+    (found before any run starts), or a worker process died (``BrokenProcessPool``)."""
+
+
 class NoProgressError(GranularError, RuntimeError):
     """A run without a time limit made no progress towards its stop criterion (no
     collision in a great many events), so it would never end."""

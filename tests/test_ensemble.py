@@ -183,3 +183,120 @@ def test_dask_submission_is_windowed(dask_client):
         assert a.runs == [] and a.count == 12
         np.testing.assert_array_equal(a.mean["x"], b.mean["x"])
         np.testing.assert_array_equal(a.error["x"], b.error["x"])
+
+
+# Runs constant across the ensemble keep their value, inf included (issue 13, item 16).
+
+def test_langevin_ensemble_keeps_infinite_tau0():
+    """The Langevin model has tau0 = inf in every run: the mean is inf with error 0, like any
+    parameter equal in every run, while the MSD is the plain mean over runs."""
+    model = functools.partial(granular.langevin.run, 20, gamma0=2.0, D0=0.5, dt=0.05,
+                              t_stop=2.0, model="langevin")
+    res = granular.ensemble(model, 4, seed=3, backend="serial")
+    assert res.mean["tau0"] == math.inf and res.error["tau0"] == 0
+    assert res.mean["gamma0"] == 2.0 and res.error["gamma0"] == 0
+    msd = np.array([r["msd"] for r in res.runs])
+    np.testing.assert_allclose(res.mean["msd"], msd.mean(0), rtol=1e-13)
+    np.testing.assert_allclose(res.error["msd"], msd.std(0, ddof=1) / 2, rtol=1e-12)
+    assert np.all(res.error["msd"][1:] > 0)
+
+
+def test_reducer_with_infinite_and_varying_entries():
+    """The running reduction equals numpy's mean and std(ddof=1)/sqrt(K) for varying
+    entries (rtol 1e-13 / 1e-12: Welford against two-pass rounding), keeps constant entries
+    exactly, +-inf included, with error 0, and gives error NaN for K = 1."""
+    from granular.ensemble import _Accumulator
+
+    rng = np.random.default_rng(0)
+    k = 7
+    runs = [{"v": rng.normal(size=5) * 1e3 + 1e6,
+             "c": np.array([math.inf, -math.inf, 1.5, 0.0]), "tau0": math.inf} for _ in range(k)]
+    acc = _Accumulator()
+    for r in runs:
+        acc.add(r)
+    mean, error = acc.result()
+    v = np.array([r["v"] for r in runs])
+    np.testing.assert_allclose(mean["v"], v.mean(0), rtol=1e-13)
+    np.testing.assert_allclose(error["v"], v.std(0, ddof=1) / math.sqrt(k), rtol=1e-12)
+    np.testing.assert_array_equal(mean["c"], [math.inf, -math.inf, 1.5, 0.0])
+    np.testing.assert_array_equal(error["c"], 0.0)
+    assert mean["tau0"] == math.inf and error["tau0"] == 0
+    one = _Accumulator()
+    one.add(runs[0])
+    assert math.isnan(one.result()[1]["tau0"]) and one.result()[0]["tau0"] == math.inf
+
+
+# A script without `if __name__ == "__main__":` (issue 13, item 10).  The process backend
+# starts its workers with forkserver (Linux) or spawn, which re-run the main script: an
+# unguarded ensemble call there broke the pool (BrokenProcessPool).  These tests run real
+# scripts in a fresh interpreter, as a user would.
+
+MODEL = """import functools
+import granular
+
+model = functools.partial(granular.langevin.run, 5, gamma0=1.0, D0=1.0, dt=0.1, t_stop=1.0)
+"""
+
+
+def run_script(tmp_path, text, *args):
+    """Run ``text`` with the default process backend: (exit code, stdout, stderr).  The
+    timeout makes a hang fail the test."""
+    import subprocess
+    import sys
+
+    if not args:
+        (tmp_path / "script.py").write_text(text)
+        args = ("script.py",)
+    done = subprocess.run([sys.executable, *args], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    return done.returncode, done.stdout, done.stderr
+
+
+GUARD_TO_WRITE = 'if __name__ == "__main__":\n        result = granular.ensemble(...)'
+
+
+@pytest.mark.parametrize("call, line", [
+    ("res = granular.ensemble(model, 4, seed=1, workers=2)\n", 6),
+    ("def main():\n    return granular.ensemble(model, 4, seed=1, workers=2)\n\n\nres = main()\n", 10),
+])
+def test_unguarded_script_gets_told_to_add_the_guard(tmp_path, call, line):
+    """Called at top level, directly or through a function: the error names the script's
+    line and shows the guard to write, before any worker starts."""
+    code, out, err = run_script(tmp_path, MODEL + "\n" + call + 'print("count", res.count)\n')
+    assert code == 1 and "count" not in out
+    assert "ProcessBackendError" in err and "BrokenProcessPool" not in err
+    assert f"script.py, line {line}, outside an `if __name__ == \"__main__\":` block" in err
+    assert GUARD_TO_WRITE in err
+
+
+def test_guarded_scripts_and_scripts_without_a_file_run(tmp_path):
+    """No false alarm: under the guard (directly or in a function), the reversed test,
+    and ``python -c`` (no script to re-run, as in a notebook) all run."""
+    for body in ('if __name__ == "__main__":\n    res = granular.ensemble(model, 4, seed=1, workers=2)\n'
+                 '    print("count", res.count)\n',
+                 'def main():\n    res = granular.ensemble(model, 4, seed=1, workers=2)\n'
+                 '    print("count", res.count)\n\n\nif "__main__" == __name__:\n    main()\n',
+                 'if __name__ != "__main__":\n    pass\nelse:\n'
+                 '    print("count", granular.ensemble(model, 4, seed=1, workers=2).count)\n'):
+        code, out, err = run_script(tmp_path, MODEL + "\n" + body)
+        assert (code, out) == (0, "count 4\n"), err
+    code, out, err = run_script(tmp_path, None, "-c", MODEL + "\nres = granular.ensemble("
+                                "model, 4, seed=1, workers=2)\nprint('count', res.count)\n")
+    assert (code, out) == (0, "count 4\n"), err
+
+
+def _kills_its_worker(seed):
+    import os
+
+    os._exit(3)
+
+
+def test_a_dead_worker_gets_the_same_advice():
+    """Any BrokenProcessPool (here a worker that exits mid-run) becomes a
+    ProcessBackendError that shows the guard, and says what else kills a worker."""
+    from granular import ProcessBackendError
+
+    with pytest.raises(ProcessBackendError, match="died") as info:
+        granular.ensemble(_kills_its_worker, 2, seed=1, workers=2)
+    assert GUARD_TO_WRITE in str(info.value) and 'backend="serial"' in str(info.value)
+    assert isinstance(info.value, granular.GranularError)
