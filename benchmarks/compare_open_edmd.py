@@ -39,7 +39,7 @@ import time
 
 import numpy as np
 
-from granular.bench import edmd_workload
+from granular.cli.bench import edmd_workload
 
 # name -> (N, packing fraction, the other code's maxtime: 2-3 M pair collisions)
 WORKLOADS = {

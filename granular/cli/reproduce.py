@@ -38,11 +38,8 @@ import time
 
 import numpy as np
 
-from . import analysis, langevin, plot, theory
-from .demo import write_json
-from .ensemble import ensemble
-from .scene import Scene
-from .simulation import Simulation
+from .. import Scene, Simulation, analysis, ensemble, langevin, plot, theory
+from .output import write_json
 
 QUICK_RUNS = 20  # runs per experiment in quick mode: enough for Student-t error bars
 SIGMA = 3.0  # the report calls a value "in agreement" within this many standard errors
