@@ -13,8 +13,9 @@ import subprocess
 import sys
 
 import pytest
-from margins import haff_margin, msd_margin_bound
 from scipy import stats
+
+from helpers.margins import haff_margin, msd_margin_bound
 
 FALSE_ALARM = 1e-4  # per check, two-sided
 
@@ -65,7 +66,7 @@ def _euler_maruyama_margin():
     return 2 / (2 - g * 0.01) - 1
 
 
-# The theories' systematic accuracy, relative (tests/margins.py says where each comes from).
+# The theories' systematic accuracy, relative (tests/helpers/margins.py says where each comes from).
 REPRODUCE_MARGINS = {
     # finite N: the speeds of N particles sharing a fixed energy, and the standard deviation
     # over N particles (ddof = 0), shift <v> and std(v) by less than 0.4% for the quick sizes

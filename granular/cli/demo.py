@@ -14,7 +14,7 @@ that the error bars are reliable enough for the tests.
 The theories are approximations, and the demo prints how far the gases are from them, with the
 standard error: the MSDs use Enskog's D0 (2.50)/(2.52), which ignores correlated collisions
 and so underestimates diffusion by a few percent at eta = 0.065 (the thesis measured +4 % for
-this gas; tests/margins.py); Haff's law uses the Maxwellian (Enskog) cooling rate, with the
+this gas; tests/helpers/margins.py); Haff's law uses the Maxwellian (Enskog) cooling rate, with the
 same approximation, and the real gas cools more slowly (the thesis' Fig. 4.10).
 """
 from __future__ import annotations
