@@ -1,12 +1,13 @@
 # Two commands from a fresh machine (Python >= 3.10, pip, a C compiler):
 #   make demo   -- set up .venv and run the main job
-#   make test   -- set up .venv and run the whole test suite
+#   make test   -- set up .venv and run the whole test suite (CI)
+#   make test-quick -- the same without the tests marked slow, for daily work
 # and for the C core: make test-asan (the suite against an ASan + UBSan build, in its own venv)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: setup demo test test-asan test-asan-ci bench clean
+.PHONY: setup demo test test-quick test-asan test-asan-ci bench clean
 
 $(VENV)/.installed: pyproject.toml setup.py $(wildcard csrc/*.c csrc/*.h)
 	$(PYTHON) -m venv $(VENV)
@@ -22,6 +23,10 @@ demo: setup
 test: setup
 	$(PY) -m pytest -q
 
+# the slowest tests (pytest.mark.slow: the CLI runs, long physics checks) left out
+test-quick: setup
+	$(PY) -m pytest -q -m "not slow"
+
 bench: setup
 	$(PY) -m granular bench --json bench.json
 
@@ -30,8 +35,9 @@ bench: setup
 # which setuptools passes to both compiling and linking; -fno-sanitize-recover makes undefined
 # behaviour abort, so a test sees it), installed non-editable into its own venv: the in-place
 # granular/_core*.so of .venv stays as it is. Built from a copy of the sources, so no object
-# file of an ordinary build is reused. The tests run from a copy of tests/ so that
-# `import granular` finds the sanitized install, not the source tree. Under build/: git ignores it.
+# file of an ordinary build is reused. The tests run from a copy of tests/ (and of benchmarks/,
+# which tests/test_benchmarks.py runs) so that `import granular` finds the sanitized install,
+# not the source tree. Under build/: git ignores it.
 ASAN_VENV  := build/venv-asan
 ASAN_PY    := $(ASAN_VENV)/bin/python
 ASAN_CFLAGS := -fsanitize=undefined -fno-sanitize-recover=undefined
@@ -44,18 +50,19 @@ ASAN_ENV   := LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file
               ASAN_OPTIONS=detect_leaks=0:allocator_may_return_null=1 \
               UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 GRANULAR_FUZZ_TIMEOUT=30
 
-$(ASAN_VENV)/.installed: pyproject.toml setup.py MANIFEST.in $(wildcard csrc/*.c csrc/*.h granular/*.py)
+$(ASAN_VENV)/.installed: pyproject.toml setup.py MANIFEST.in $(wildcard csrc/*.c csrc/*.h granular/*.py granular/cli/*.py)
 	$(PYTHON) -m venv $(ASAN_VENV)
 	$(ASAN_PY) -m pip install --quiet --upgrade pip
-	rm -rf $(ASAN_VENV)/src && mkdir -p $(ASAN_VENV)/src/granular
+	rm -rf $(ASAN_VENV)/src && mkdir -p $(ASAN_VENV)/src/granular/cli
 	cp setup.py pyproject.toml README.md MANIFEST.in $(ASAN_VENV)/src/
 	cp -r csrc $(ASAN_VENV)/src/ && cp granular/*.py $(ASAN_VENV)/src/granular/
+	cp granular/cli/*.py $(ASAN_VENV)/src/granular/cli/
 	GRANULAR_ASAN=1 CFLAGS="$(ASAN_CFLAGS)" $(ASAN_PY) -m pip install --quiet --force-reinstall \
 	    "$(ASAN_VENV)/src[test]"
 	touch $@
 
 test-asan: $(ASAN_VENV)/.installed
-	rm -rf $(ASAN_VENV)/tests && cp -r tests $(ASAN_VENV)/tests
+	rm -rf $(ASAN_VENV)/tests $(ASAN_VENV)/benchmarks && cp -r tests benchmarks $(ASAN_VENV)/
 	cd $(ASAN_VENV)/tests && $(ASAN_ENV) ../bin/python -c "import granular._core, sys; \
 	    f = granular.__file__; sys.exit(0 if 'site-packages' in f else 'not the install: ' + f)"
 	cd $(ASAN_VENV)/tests && $(ASAN_ENV) ../bin/python -m pytest -q -p no:cacheprovider $(ASAN_TESTS)

@@ -25,6 +25,8 @@ Then, for example:
     python benchmarks/compare_open_edmd.py --other 3d-1e5-0.065=/tmp/sm/cell_1e5 \\
         --other 3d-1e4-0.45=/tmp/sm/single_1e4 --repeats 2
 
+(`--tiny` runs only granular's side and the lattice writer at a tiny size: what CI checks.)
+
 The other code's throughput is the pair collisions between its first and last reports
 ("Simtime: t, Collisions: c"; its output is made line-buffered) over the wall time between
 them: its setup (8 s at N = 1e6) and final snapshot are not timed.  granular then runs the
@@ -33,13 +35,15 @@ which is not timed either (bench.edmd_workload with one window).
 """
 import argparse
 import math
+import os
 import re
 import subprocess
+import tempfile
 import time
 
 import numpy as np
 
-from granular.bench import edmd_workload
+from granular.cli.bench import edmd_workload
 
 # name -> (N, packing fraction, the other code's maxtime: 2-3 M pair collisions)
 WORKLOADS = {
@@ -106,7 +110,19 @@ def main():
     p.add_argument("--plot", metavar="FILE", help="also chart the figures into FILE (PNG)")
     p.add_argument("--write-init", nargs=3, metavar=("M", "ETA", "FILE"),
                    help="write an M**3 simple cubic lattice at packing fraction ETA and exit")
+    p.add_argument("--tiny", action="store_true",
+                   help="granular's side and --write-init at a tiny size, no other code (CI)")
     args = p.parse_args()
+    if args.tiny:
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "init.sph")
+            write_init(path, 4, 0.065)
+            with open(path) as f:
+                if len(f.readlines()) != 2 + 4 ** 3:
+                    raise RuntimeError(f"{path}: not the N + 2 lines of an init.sph")
+        r = edmd_workload("3d-tiny-0.065", 3, 500, 0.065, 2.0, windows=1)
+        print(f"{r['name']:14s} {'granular':12s} {r['pair_collisions']:16d} {r['seconds']:8.2f}")
+        return
     if args.write_init:
         m, eta, path = args.write_init
         try:

@@ -24,11 +24,22 @@ __version__ = "0.1.0"
 _LAZY = ("plot", "interop")
 
 
-def __getattr__(name):
-    if name in _LAZY:
-        import importlib
+# the applications moved to granular.cli (issue 14); the old names work for one more
+# release, with a DeprecationWarning
+_MOVED = ("demo", "reproduce", "speed_accuracy", "bench", "bench_langevin")
 
+
+def __getattr__(name):
+    import importlib
+
+    if name in _LAZY:
         return importlib.import_module(f".{name}", __name__)
+    if name in _MOVED:
+        import warnings
+
+        warnings.warn(f"granular.{name} moved to granular.cli.{name}; the old name goes in the "
+                      f"next release", DeprecationWarning, stacklevel=2)
+        return importlib.import_module(f".cli.{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

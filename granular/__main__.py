@@ -1,4 +1,8 @@
-"""Command line: ``python -m granular demo | bench``."""
+"""Command line: ``python -m granular demo | reproduce | bench``.
+
+Thin on purpose: it parses the arguments, checks the optional modules the command needs and
+only then imports the application from granular.cli (applications built on the library,
+which the library never imports)."""
 from __future__ import annotations
 
 import argparse
@@ -46,20 +50,20 @@ def main(argv=None):
         return 2
 
     if args.command == "demo":
-        from . import demo as demo_module
+        from .cli import demo as demo_module
 
         demo_module.main(out=args.out, quick=args.quick)
     elif args.command == "reproduce":
-        from . import reproduce
+        from .cli import reproduce
 
         reproduce.main(out=args.out, quick=args.quick, runs=args.runs)
     elif args.command == "bench":
         if args.speed_accuracy:
-            from . import speed_accuracy
+            from .cli import speed_accuracy
 
             speed_accuracy.main(out=args.out, quick=args.quick)
         else:
-            from . import bench as bench_module
+            from .cli import bench as bench_module
 
             bench_module.main(json_path=args.json, quick=args.quick, large=args.large)
     return 0

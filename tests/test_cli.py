@@ -13,8 +13,9 @@ import subprocess
 import sys
 
 import pytest
-from margins import haff_margin, msd_margin_bound
 from scipy import stats
+
+from helpers.margins import haff_margin, msd_margin_bound
 
 FALSE_ALARM = 1e-4  # per check, two-sided
 
@@ -38,7 +39,7 @@ def test_json_files_are_strict(tmp_path):
     summaries parse with strict parsers; demo, reproduce and the benchmarks all write this way."""
     import numpy as np
 
-    from granular.demo import write_json
+    from granular.cli.output import write_json
 
     write_json(tmp_path / "s.json", [dict(tau0=float("inf"), x=np.float64("nan"), ok=1.5, row=(2, -math.inf))])
     assert strict_json(tmp_path / "s.json") == [dict(tau0=None, x=None, ok=1.5, row=[2, None])]
@@ -56,7 +57,8 @@ def _euler_maruyama_margin():
     """Euler-Maruyama at dt = 0.01 biases the stationary <v^2> by 2 / (2 - gamma0 dt) - 1
     (granular.langevin); the MSD and the time-averaged MSD by at most that.  For the
     largest gamma0 of the quick reproduction's Langevin systems."""
-    from granular import reproduce, theory
+    from granular import theory
+    from granular.cli import reproduce
 
     cfg = reproduce.Config(quick=True)
     g = max(theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, reproduce.THESIS_T0).gamma0
@@ -64,7 +66,7 @@ def _euler_maruyama_margin():
     return 2 / (2 - g * 0.01) - 1
 
 
-# The theories' systematic accuracy, relative (tests/margins.py says where each comes from).
+# The theories' systematic accuracy, relative (tests/helpers/margins.py says where each comes from).
 REPRODUCE_MARGINS = {
     # finite N: the speeds of N particles sharing a fixed energy, and the standard deviation
     # over N particles (ddof = 0), shift <v> and std(v) by less than 0.4% for the quick sizes
@@ -129,7 +131,7 @@ def test_reproduce_quick(tmp_path):
     over runs agrees with theory within its error bars and the theory's stated accuracy
     (REPRODUCE_MARGINS), energy is conserved to rounding, and report.md's verdicts are the
     ones the numbers give."""
-    from granular import reproduce
+    from granular.cli import reproduce
 
     run("reproduce", "--quick", "--out", "rep", cwd=tmp_path)
     rows = {r["id"]: r for r in strict_json(tmp_path / "rep" / "summary.json")}

@@ -10,7 +10,7 @@ import pytest
 import granular
 from granular import Scene
 
-import ensemble_tasks
+from helpers import ensemble_tasks
 
 RUN = dict(t_stop=1.0, sample_times=np.linspace(0.0, 1.0, 6))
 

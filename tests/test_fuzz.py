@@ -1,5 +1,5 @@
 """Fuzz: COUNT (1500) seeded random bad and edge inputs to Scene, Scene.random, Simulation.run and
-langevin.run (tests/fuzz_cases.py makes them and says what passes). Each ends in a clear
+langevin.run (tests/helpers/fuzz_cases.py makes them and says what passes). Each ends in a clear
 exception or a result that keeps the invariants -- never a crash, a hang or garbage.
 
 One worker process runs the cases one after another and answers each over a pipe; a case that
@@ -17,7 +17,7 @@ import time
 from collections import Counter
 from pathlib import Path
 
-from fuzz_cases import describe, make_cases
+from helpers.fuzz_cases import describe, make_cases
 
 SEED = 20261125
 COUNT = 1500
@@ -36,7 +36,7 @@ class Worker:
 
     def __init__(self):
         self.log = tempfile.TemporaryFile()
-        code = (f"import sys; sys.path.insert(0, {str(HERE)!r}); import fuzz_cases, resource\n"
+        code = (f"import sys; sys.path.insert(0, {str(HERE)!r}); import resource; from helpers import fuzz_cases\n"
                 f"if 'asan' not in __import__('os').environ.get('LD_PRELOAD', ''):\n"
                 f"    resource.setrlimit(resource.RLIMIT_AS, ({MEMORY_CAP}, {MEMORY_CAP}))\n"
                 f"fuzz_cases.worker({SEED}, {COUNT})")

@@ -17,13 +17,10 @@ ADVICE = "needs matplotlib, which is not installed: pip install 'granular[plot]'
 @pytest.fixture
 def commands_recorded(monkeypatch):
     """Replace every command's work by a recorder of the call."""
-    import granular.bench
-    import granular.demo
-    import granular.reproduce
-    import granular.speed_accuracy
+    from granular.cli import bench, demo, reproduce, speed_accuracy
 
     calls = []
-    for module in (granular.demo, granular.reproduce, granular.speed_accuracy, granular.bench):
+    for module in (demo, reproduce, speed_accuracy, bench):
         monkeypatch.setattr(module, "main",
                             lambda *a, _name=module.__name__, **k: calls.append(_name))
     return calls
@@ -48,7 +45,7 @@ def test_commands_run_when_what_they_need_is_there(monkeypatch, commands_recorde
         hidden.setitem(sys.modules, "matplotlib", None)
         assert cli.main(["bench", "--quick"]) == 0
     assert cli.main(["demo", "--quick"]) == 0
-    assert commands_recorded == ["granular.bench", "granular.demo"]
+    assert commands_recorded == ["granular.cli.bench", "granular.cli.demo"]
 
 
 def test_demo_without_matplotlib_stops_before_any_work(tmp_path):
@@ -62,3 +59,26 @@ def test_demo_without_matplotlib_stops_before_any_work(tmp_path):
     assert done.returncode == 2, done.stderr
     assert done.stderr == f"python -m granular demo {ADVICE}\n"
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("name", ["demo", "reproduce", "speed_accuracy", "bench", "bench_langevin"])
+def test_old_application_names_still_work_with_a_warning(name):
+    """granular.<app> moved to granular.cli.<app> (issue 14); the old name is the same module
+    for one more release, and says where it went."""
+    import importlib
+
+    import granular
+
+    with pytest.warns(DeprecationWarning, match=f"granular.cli.{name}"):
+        old = getattr(granular, name)
+    assert old is importlib.import_module(f"granular.cli.{name}")
+
+
+def test_the_library_never_imports_the_applications():
+    """granular.cli is built on the library, never the other way round: importing the whole
+    library (lazy modules too) loads nothing from granular.cli."""
+    code = ("import sys, granular, granular.plot, granular.interop\n"
+            "print(*(m for m in sys.modules if m.startswith('granular.cli')))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          check=True)
+    assert done.stdout.strip() == ""

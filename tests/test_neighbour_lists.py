@@ -10,9 +10,8 @@ import pytest
 from granular import Scene, Simulation
 
 import granular
-import reference_edmd
-from test_scene import three_in_line
-from test_simulation import _tracer_scene, min_distance_ratio, reference_scene
+from helpers import reference_edmd
+from helpers.scenes import min_distance_ratio, reference_scene, three_in_line, tracer_scene
 
 
 def _dense(n, eta, dim=3, boundary="periodic", seed=1, **kw):
@@ -128,7 +127,7 @@ def test_lists_grow_around_a_large_particle():
     mode's (which keeps the big particle out of the grid: independent code; short run,
     1e-8 as above) and the big particle must collide."""
     r, big = 0.012, 0.096
-    s = _tracer_scene(4000, r, big, 3, "periodic", 1.0, seed=6)
+    s = tracer_scene(4000, r, big, 3, "periodic", 1.0, seed=6)
     d = s.positions[1:] - s.positions[0]
     d -= np.round(d / s.lengths) * s.lengths
     reach = big + r + 2 * 0.25 * 2 * big
@@ -185,7 +184,7 @@ def test_bad_shell():
         with pytest.raises(ValueError, match="shell"):
             Simulation(s, shell=bad)
     # lists with a particle far wider than the rest: refused unless insisted on
-    tracer = _tracer_scene(500, 0.01, 0.08, 3, "periodic", 1.0, seed=1)
+    tracer = tracer_scene(500, 0.01, 0.08, 3, "periodic", 1.0, seed=1)
     with pytest.raises(ValueError, match="big_ratio"):
         Simulation(tracer, shell=0.25)
     assert Simulation(tracer, shell=0.25, big_ratio=math.inf).stats["shell"] == 0.25

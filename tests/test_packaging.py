@@ -16,10 +16,11 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-# Every tracked file under these directories belongs in the sdist: csrc/ builds the extension,
-# tests/ (with its helpers, not only test_*.py) and notebooks/ are the suite, docs/ the
-# README's images.
-SHIPPED_DIRS = ("csrc", "docs", "notebooks", "tests")
+# Every tracked file under these directories belongs in the sdist: granular/ (with its
+# subpackage cli/) and csrc/ build the package, tests/ (with tests/helpers/, not only
+# test_*.py), notebooks/ and benchmarks/ (tests/test_benchmarks.py runs them) are the suite,
+# docs/ the README's images.
+SHIPPED_DIRS = ("granular", "csrc", "docs", "notebooks", "tests", "benchmarks")
 
 
 def _tracked_files():
@@ -53,7 +54,7 @@ def sdist_names(tmp_path_factory):
 def test_sdist_holds_sources_tests_notebooks_and_images(sdist_names):
     tracked, shipped = sdist_names
     wanted = [name for name in tracked if name.split("/")[0] in SHIPPED_DIRS]
-    assert "tests/conftest.py" in wanted and "csrc/edmd.c" in wanted  # the check sees them
+    assert {"tests/conftest.py", "csrc/edmd.c", "granular/cli/demo.py"} <= set(wanted)  # seen
     missing = sorted(set(wanted) - shipped)
     assert not missing, f"tracked files missing from the sdist (add them to MANIFEST.in): {missing}"
     assert not [name for name in shipped if name.endswith((".pyc", ".so", ".o"))], \

@@ -11,7 +11,7 @@ import pytest
 from scipy import stats
 
 from granular import Scene, Simulation, theory
-from margins import diffusion_margin, haff_margin
+from helpers.margins import diffusion_margin, haff_margin
 
 
 def radius_for(n, eta, dim):

@@ -47,7 +47,7 @@ def test_demo_panels_read_well():
     and the speed histograms end at the fastest particle rather than far beyond it."""
     from types import SimpleNamespace
 
-    from granular import demo
+    from granular.cli import demo
 
     rng = np.random.default_rng(1)
     t = np.concatenate([[0.0], np.logspace(-2, 1, 20)])

@@ -8,6 +8,7 @@ from scipy import stats
 
 import granular
 from granular import Scene, Simulation
+from helpers.scenes import three_in_line
 
 
 def test_random_scene_is_uniform_isotropic_and_without_drift():
@@ -226,11 +227,6 @@ def test_heated_walls_report_non_finite_velocities():
 
 
 # -- inelastic collapse ------------------------------------------------------------------
-
-def three_in_line(xi, tc=0.0):
-    return Scene([[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]], [[1, 0], [0, 0], [-1, 0]], 0.05,
-                 boundary="walls", restitution=xi, contact_duration=tc)
-
 
 def test_collapse_of_three_disks_is_detected():
     """Three disks in a line collapse for xi < 7 - 4 sqrt 3 = 0.0718 (thesis 2.3): the

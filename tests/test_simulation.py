@@ -8,12 +8,12 @@ import threading
 
 import numpy as np
 import pytest
-from scipy.spatial import cKDTree
 
 import granular
 from granular import Scene, Simulation
 
-import reference_edmd
+from helpers import reference_edmd
+from helpers.scenes import min_distance_ratio, reference_scene, tracer_scene
 
 
 def two_disks(v1, v2, xi=1.0, dim=2, boundary="walls", m=(1.0, 1.0), y2=0.5):
@@ -106,23 +106,6 @@ def test_momentum_conserved_and_restitution_holds_for_mixtures(masses):
 
 # -- conservation over many collisions ---------------------------------------------------
 
-def min_distance_ratio(scene, positions):
-    """Smallest centre distance over contact distance among all pairs (periodic images
-    included), with a k-d tree."""
-    lo, L = scene.lower, scene.lengths
-    periodic = scene.boundary == "periodic"
-    x = np.mod(positions - lo, L) if periodic else positions - lo
-    tree = cKDTree(x, boxsize=L if periodic else None)
-    pairs = tree.query_pairs(2 * scene.radii.max(), output_type="ndarray")
-    if len(pairs) == 0:
-        return np.inf
-    d = x[pairs[:, 1]] - x[pairs[:, 0]]
-    if periodic:
-        d -= L * np.round(d / L)
-    dist = np.linalg.norm(d, axis=1)
-    return float(np.min(dist / (scene.radii[pairs[:, 0]] + scene.radii[pairs[:, 1]])))
-
-
 @pytest.mark.parametrize("dim,boundary", [(3, "periodic"), (2, "periodic"), (3, "walls"), (2, "walls")])
 def test_energy_and_momentum_conserved_over_a_million_collisions(dim, boundary):
     """xi = 1: kinetic energy constant to 1e-13 relative over >= 1e6 pair collisions; total
@@ -189,16 +172,6 @@ def test_centre_of_mass_moves_with_total_momentum(n):
 
 
 # -- against the slow reference ------------------------------------------------------------
-
-def reference_scene(dim, boundary, xi, mixture, n=12):
-    """A small scene for comparisons with the O(N^2) reference."""
-    radius = 0.08 if dim == 2 else 0.1
-    if mixture:
-        radius = radius * np.linspace(0.6, 1.2, n)
-    return Scene.random(n, radius, dim=dim, boundary=boundary, restitution=xi,
-                        mass=(np.asarray(radius) / 0.1) ** dim if mixture else 1.0,
-                        wall_restitution=0.9 if boundary == "walls" and xi < 1 else 1.0, seed=7)
-
 
 @pytest.mark.parametrize("dim,boundary,xi,mixture", [(2, "walls", 1.0, False), (2, "periodic", 0.7, False),
                                                      (3, "periodic", 1.0, False), (3, "walls", 0.8, False),
@@ -431,13 +404,6 @@ def test_collapse_keeps_the_samples_taken_before_it():
 
 # -- a large tracer among small particles ---------------------------------------------------
 
-def _tracer_scene(n, r, big, dim, boundary, xi, seed):
-    """One particle of radius `big` among n of radius r, masses proportional to volume."""
-    radii = np.r_[big, np.full(n, r)]
-    return Scene.random(n + 1, radii, dim=dim, boundary=boundary, restitution=xi,
-                        mass=(radii / r) ** dim, seed=seed)
-
-
 @pytest.mark.parametrize("dim,boundary", [(2, "periodic"), (2, "walls"), (3, "periodic"), (3, "walls")])
 def test_large_tracer_agrees_with_slow_reference(dim, boundary):
     """A tracer five times wider than the rest stays out of the cell grid (cells sized by
@@ -445,7 +411,7 @@ def test_large_tracer_agrees_with_slow_reference(dim, boundary):
     of the O(N^2) reference.  Short runs (~1-2 collisions per particle), where chaos has
     amplified rounding differences to ~1e-9 at most (measured), so agreement to 1e-8."""
     n, r, big = (40, 0.02, 0.1) if dim == 2 else (60, 0.03, 0.15)
-    s = _tracer_scene(n, r, big, dim, boundary, 0.9, seed=3)
+    s = tracer_scene(n, r, big, dim, boundary, 0.9, seed=3)
     times = np.linspace(0.0, 0.5, 11)
     sim = Simulation(s)
     tr = sim.run(t_stop=0.5, sample_times=times)
@@ -467,7 +433,7 @@ def test_large_tracer_long_run_conserves_and_never_overlaps(dim):
     (an interval without a collision has probability e^-4 ~ 2% in 3D); at least 15 of 20
     are required.  big_ratio=inf puts everyone in one grid, coarse as the tracer."""
     n, r = (1500, 0.004) if dim == 2 else (1500, 0.006)
-    s = _tracer_scene(n, r, 12 * r, dim, "periodic", 1.0, seed=4)
+    s = tracer_scene(n, r, 12 * r, dim, "periodic", 1.0, seed=4)
     times = np.linspace(0.0, 2.0, 21)
     sim = Simulation(s)
     tr = sim.run(t_stop=2.0, sample_times=times)

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from granular import speed_accuracy
+from granular.cli import speed_accuracy
 from granular.simulation import _LIST_SHELL
 
 

@@ -39,7 +39,7 @@ plot.haff(traj.times, traj.temperature, tau0=c.tau0)''',
 
 repro = [
 "md:# The thesis' chapter 4, the story\nThe same experiments as `python -m granular reproduce`, one at a time. `reproduce.figure(name, quick=...)` runs one of them on the thesis' system with five times its number of runs (`QUICK` shrinks it), writes its figures and returns their paths and its summary rows: our value with its standard error over the runs, the thesis' value and theory's. `reproduce.FIGURES` lists the names.",
-setup + "\nfrom granular import reproduce\nfrom IPython.display import Image, display",
+setup + "\nfrom granular.cli import reproduce\nfrom IPython.display import Image, display",
 """out = "reproduction"
 rows = []
 list(reproduce.FIGURES)""",

@@ -15,7 +15,7 @@ import tracemalloc
 
 import numpy as np
 
-from . import langevin
+from .. import langevin
 
 G0, D0 = 9.26, 0.072  # the thesis' standard gas
 _NOT_EDMD = dict.fromkeys(("packing_fraction", "boundary", "restitution", "pair_collisions",

@@ -7,9 +7,8 @@ import math
 import platform
 import time
 
-from .demo import write_json
-from .scene import Scene
-from .simulation import Simulation
+from .. import Scene, Simulation
+from .output import write_json
 
 
 def _radius_for(n, eta, dim, box=1.0):

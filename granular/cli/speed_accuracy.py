@@ -38,13 +38,11 @@ import time
 
 import numpy as np
 
-from . import analysis, langevin, theory
+from .. import (InelasticCollapseError, Scene, Simulation, UnstableStepError, analysis, ensemble,
+                langevin, theory)
+from ..simulation import _LIST_SHELL  # the shell of shell="auto": dense_cost measures it
 from .bench_langevin import log_lags
-from .demo import write_json
-from .ensemble import ensemble
-from .errors import InelasticCollapseError, UnstableStepError
-from .scene import Scene
-from .simulation import _LIST_SHELL, Simulation
+from .output import write_json
 
 T0 = 2.0 / 3.0
 R = 0.025

@@ -14,40 +14,19 @@ that the error bars are reliable enough for the tests.
 The theories are approximations, and the demo prints how far the gases are from them, with the
 standard error: the MSDs use Enskog's D0 (2.50)/(2.52), which ignores correlated collisions
 and so underestimates diffusion by a few percent at eta = 0.065 (the thesis measured +4 % for
-this gas; tests/margins.py); Haff's law uses the Maxwellian (Enskog) cooling rate, with the
+this gas; tests/helpers/margins.py); Haff's law uses the Maxwellian (Enskog) cooling rate, with the
 same approximation, and the real gas cools more slowly (the thesis' Fig. 4.10).
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 import time
 
 import numpy as np
 
-from . import plot, theory
-from .ensemble import ensemble
-from .scene import Scene
-from .simulation import Simulation
-
-
-def _json_safe(value):
-    """``value`` with every non-finite float replaced by None, for strict JSON."""
-    if isinstance(value, dict):
-        return {k: _json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
-def write_json(path, value):
-    """Write ``value`` as strict JSON (non-finite numbers as null; ``allow_nan=False`` so
-    that no Infinity or NaN, which strict parsers reject, can slip through)."""
-    with open(path, "w") as f:
-        json.dump(_json_safe(value), f, indent=1, allow_nan=False)
+from .. import Scene, Simulation, ensemble, plot, theory
+from .output import write_json
 
 
 def _equilibrated(n, radius, seed):
