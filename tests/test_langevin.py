@@ -59,8 +59,8 @@ def test_exact_scheme_msd_matches_theory(model, tau0, initial, limit):
     th = r.theory_msd()
     ok = r.times > 0
     tol = 5 * rel_se_msd(n)
-    np.testing.assert_array_less(np.abs(r.msd[ok] / th[ok] - 1), tol)
-    assert r.msd[0] == 0.0
+    np.testing.assert_array_less(np.abs(r.msd()[ok] / th[ok] - 1), tol)
+    assert r.msd()[0] == 0.0
     if limit is None:
         return
     # from t = 5 (gamma0 t = 46, t = 5 tau0) the limits equal the full MSD to 1e-6
@@ -80,7 +80,7 @@ def test_euler_maruyama_msd_matches_theory_at_small_steps():
                          initial="udsbm" if tau0 < math.inf else "thermal", seed=2)
         ok = r.times > 0
         bias = 2 / (2 - G0 * 0.001) - 1
-        np.testing.assert_array_less(np.abs(r.msd[ok] / r.theory_msd()[ok] - 1),
+        np.testing.assert_array_less(np.abs(r.msd()[ok] / r.theory_msd()[ok] - 1),
                                      5 * rel_se_msd(n) + bias)
 
 
@@ -103,7 +103,7 @@ def test_ballistic_limit(tau0, initial, v0_sq):
     assert r.v0_sq == pytest.approx(v0_sq)
     ballistic = theory.msd_ballistic(t, v0_sq)
     off_limit = np.abs(r.theory_msd(t) / ballistic - 1)
-    np.testing.assert_array_less(np.abs(r.msd / ballistic - 1), 5 * rel_se_msd(n) + off_limit)
+    np.testing.assert_array_less(np.abs(r.msd() / ballistic - 1), 5 * rel_se_msd(n) + off_limit)
 
 
 def test_euler_maruyama_first_step_is_exact_free_flight():
@@ -111,7 +111,7 @@ def test_euler_maruyama_first_step_is_exact_free_flight():
     velocity only), so MSD(dt) = speed^2 dt^2 to rounding."""
     r = langevin.run(100, gamma0=G0, D0=D0, dt=1e-4, t_stop=1e-3, speed=1.5, initial="fixed",
                      scheme="em", sample_times=[0, 1e-4], seed=3)
-    assert r.msd[1] == pytest.approx(1.5**2 * 1e-8, rel=1e-13)
+    assert r.msd()[1] == pytest.approx(1.5**2 * 1e-8, rel=1e-13)
     assert r.v0_sq == pytest.approx(0.75)
 
 
@@ -167,13 +167,13 @@ def test_tamsd_equals_msd_for_langevin_but_not_for_udsbm():
     r = langevin.run(n, gamma0=G0, D0=D0, dt=0.01, t_stop=100.0, scheme="exact", tamsd_lags=lags, seed=6)
     se = r.tamsd_per_particle.std(0, ddof=1) / math.sqrt(n)
     expected = theory.msd_langevin(lags, D0, G0)
-    np.testing.assert_array_less(np.abs(r.tamsd - expected), 5 * se)
+    np.testing.assert_array_less(np.abs(r.tamsd() - expected), 5 * se)
     u = langevin.run(n, gamma0=G0, D0=D0, tau0=TAU0, dt=0.01, t_stop=100.0, scheme="exact",
                      initial="udsbm", tamsd_lags=lags, seed=6)
     se = u.tamsd_per_particle.std(0, ddof=1) / math.sqrt(n)
-    np.testing.assert_array_less(np.abs(u.tamsd - u.theory_tamsd()), 5 * se)
+    np.testing.assert_array_less(np.abs(u.tamsd() - u.theory_tamsd()), 5 * se)
     # non-ergodic: the ensemble MSD lies many standard errors above the time average
-    np.testing.assert_array_less(5 * se, u.theory_msd(lags) - u.tamsd)
+    np.testing.assert_array_less(5 * se, u.theory_msd(lags) - u.tamsd())
 
 
 @pytest.mark.parametrize("model,tau0", [("langevin", math.inf), ("udsbm", TAU0)])
@@ -186,7 +186,8 @@ def test_same_seed_same_result_whatever_the_chunking(monkeypatch, model, tau0, s
     kw = dict(gamma0=G0, D0=D0, tau0=tau0, model=model, scheme=scheme, dt=0.01, t_stop=2.0,
               sample_times=np.arange(201) * 0.01, tamsd_lags=[0.01, 0.07, 0.3, 1.0, 2.0],
               store_positions=True, seed=7)
-    names = ("msd", "v2", "tamsd_per_particle", "positions", "final_positions", "final_velocities")
+    names = ("msd_total", "msd_per_dimension", "v2", "tamsd_per_particle", "positions",
+             "final_positions", "final_velocities")
     a = langevin.run(30, **kw)  # one call: 30 x 200 particle-steps
     for chunk in (200 * 7, 13, 7, 1):  # 7 particles a call; then one particle, 13, 7, 1 steps a call
         monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", chunk)
