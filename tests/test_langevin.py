@@ -18,6 +18,8 @@ import pytest
 import granular
 from granular import langevin, theory
 
+import sde_reference  # tests/ is on sys.path (conftest.py)
+
 G0, D0 = 9.26, 0.072          # the thesis' standard gas, xi = 0.8 (theory.langevin_coefficients)
 TAU0 = 0.972
 VT = G0 * D0                  # T0 / m
@@ -335,3 +337,76 @@ def test_bad_input(kwargs, match):
     base.update(kwargs)
     with pytest.raises(ValueError, match=match):
         langevin.run(10, **base)
+
+
+# -- the engine against a slow NumPy reference fed the same random numbers ------------------
+#
+# tests/sde_reference.py redraws csrc/rng.h's stream in Python and integrates from the
+# equations (its own formulas and order of operations).  Tolerance: 1e-12 of the largest
+# magnitude.  The two differ by a few ulps a step (other rounding); velocities forget such
+# differences (they contract by exp(-gamma dt) a step), positions add them up, so after
+# n steps they differ by about n x (a few) x 2.2e-16 -- 1e-13 for the 60 steps here,
+# ~4e-15 measured.  One wrong random number would differ by O(1).
+
+
+def _assert_rounding_close(got, want):
+    scale = float(np.max(np.abs(want)))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * scale)
+
+
+@pytest.mark.parametrize("model,scheme,dim", [
+    ("langevin", "em", 3), ("langevin", "exact", 3), ("udsbm", "em", 3), ("udsbm", "exact", 3),
+    ("langevin", "exact", 1), ("udsbm", "em", 2)])
+def test_the_engine_is_the_reference_integrator_to_rounding(model, scheme, dim):
+    """Every position at every step, the final velocities, the ensemble MSD sums and the
+    TAMSD over the engine's windows (lags 1 and 33 and 60 steps: strides 1, 2, 3)."""
+    v0 = np.random.default_rng(1).normal(scale=0.8, size=(4, dim))
+    kw = dict(model=model, scheme=scheme, gamma0=G0, D0=D0, tau0=TAU0, dt=0.05, n_steps=60)
+    key, lags = 0xDEADBEEF12345678, [1, 33, 60]
+    pos, v, x2, tamsd = sde_reference.engine(v0, key, lags=lags, **kw)
+    xs, vs = sde_reference.run(v0, key, **kw)
+    _assert_rounding_close(pos, xs)
+    _assert_rounding_close(v, vs[-1])
+    _assert_rounding_close(x2, (xs * xs).sum(axis=1))
+    for m, lag in enumerate(lags):
+        stride = granular._core.sde_lag_stride(lag)
+        windows = len(range(0, 61 - lag, stride))
+        _assert_rounding_close(tamsd[:, m] / windows,
+                               sde_reference.tamsd_per_particle(xs, lag, stride))
+
+
+def test_the_reference_covers_the_ziggurat_tail_and_wedges():
+    """300 particles x 10 steps x 3 axes x 2 normals: draws from the rare paths of the
+    ziggurat (beyond r = 3.44 and in the layers' wedges) are among them, and match."""
+    key, n, n_steps = 12345, 300, 10
+    tails = 0
+    for k in range(n_steps):
+        for i in range(n):
+            rs = sde_reference.Stream(key, k, i)
+            tails += sum(abs(rs.normal()) > sde_reference.ZIG_R for _ in range(6))
+    assert tails >= 3
+    v0 = np.zeros((n, 3))
+    kw = dict(model="udsbm", scheme="exact", gamma0=G0, D0=D0, tau0=TAU0, dt=0.05,
+              n_steps=n_steps)
+    pos, v, _, _ = sde_reference.engine(v0, key, **kw)
+    xs, vs = sde_reference.run(v0, key, **kw)
+    _assert_rounding_close(pos, xs)
+    _assert_rounding_close(v, vs[-1])
+
+
+def test_run_draws_from_its_seed_as_documented():
+    """langevin.run: key and initial velocities from SeedSequence(seed).spawn(2), then the
+    engine; particles numbered from 0 whatever the chunking (first > 0 here)."""
+    r = langevin.run(5, gamma0=G0, D0=D0, dt=0.05, t_stop=1.0, scheme="em",
+                     sample_times=np.arange(21) * 0.05, store_positions=True, seed=42)
+    key_seq, vel_seq = np.random.SeedSequence(42).spawn(2)
+    key = int(key_seq.generate_state(1, dtype=np.uint64)[0])
+    v0 = np.random.default_rng(vel_seq).normal(scale=math.sqrt(VT), size=(5, 3))
+    xs, vs = sde_reference.run(v0, key, model="langevin", scheme="em", gamma0=G0, D0=D0,
+                               tau0=math.inf, dt=0.05, n_steps=20)
+    _assert_rounding_close(r.positions, xs)
+    _assert_rounding_close(r.final_velocities, vs[-1])
+    part, _, _, _ = sde_reference.engine(v0[2:4], key, model="langevin", scheme="em",
+                                         gamma0=G0, D0=D0, tau0=math.inf, dt=0.05,
+                                         n_steps=20, first=2, n=5)
+    np.testing.assert_array_equal(part, r.positions[:, 2:4])
