@@ -298,7 +298,9 @@ def fit_haff_tau0(times, temperature_values, t_max=None):
 def ensemble_mean(values, axis=0):
     """Mean over runs and its central-limit standard error ``std(ddof=1) / sqrt(M)``
     (thesis 2.120-2.122)."""
-    a = np.asarray(values, dtype=np.float64)
+    # C order: NumPy's pairwise sums follow the memory layout, so a Fortran-order input
+    # would give other roundings
+    a = np.ascontiguousarray(values, dtype=np.float64)
     m = a.shape[axis]
     if m < 2:
         raise ValueError("ensemble_mean needs at least two runs for an error")
