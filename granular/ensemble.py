@@ -13,6 +13,7 @@ import ast
 import os
 import sys
 import traceback
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -472,8 +473,12 @@ def _reduce_in_order(results, reducers, runs, bar):
         bar.update(1)
 
 
-def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progress=None,
-             keep_runs=True, quantities=("msd", "temperature"), **run_kwargs):
+def ensemble(model: Scene | Callable[..., Any] | Sequence[Scene | Callable[..., Any]],
+             runs: int, *, seed: int | np.random.SeedSequence | None = None,
+             backend: Any = "processes", workers: int | None = None,
+             progress: bool | None = None, keep_runs: bool = True,
+             quantities: Sequence[str] = ("msd", "temperature"),
+             **run_kwargs: Any) -> EnsembleResult | list[EnsembleResult]:
     """Run ``runs`` independent realizations of a model, or of every model of a sweep, and
     return their results with ensemble means and standard errors.
 
@@ -525,8 +530,10 @@ def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progr
     runs = int(runs)
     if runs < 1:
         raise ValueError(f"runs must be >= 1, got {runs}")
-    sweep = isinstance(model, (list, tuple))
-    models = list(model) if sweep else [model]
+    if isinstance(model, (list, tuple)):
+        sweep, models = True, list(model)
+    else:
+        sweep, models = False, [model]
     if not models:
         raise ValueError("a sweep needs at least one model")
     for m in models:

@@ -38,12 +38,16 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+
+if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but stay light
+    from .scene import Scene
+    from .theory import LangevinCoefficients
 
 MODELS = ("langevin", "udsbm")
 SCHEMES = ("em", "exact")
@@ -61,7 +65,7 @@ class _ArrayAndMethod(np.ndarray):
     arithmetic, NumPy functions), it is the old array and warns that this use is
     deprecated.  Results of array use are plain arrays."""
 
-    _method: Callable[..., NDArray[np.float64]]
+    _method: Any  # the bound method (None only on views made by NumPy itself)
     _name: str
 
     def __new__(cls, values: NDArray[np.float64], method: Callable[..., NDArray[np.float64]],
@@ -272,7 +276,8 @@ class LangevinResult:
             out[name] = np.asarray(getattr(self, name))
         return out
 
-    def theory_msd(self, t: ArrayLike | None = None) -> NDArray[np.float64]:
+    def theory_msd(self, t: float | NDArray[np.float64] | None = None,
+                   ) -> float | NDArray[np.float64]:
         """The analytic ensemble MSD of this model from ``granular.theory`` (with this
         run's initial speed) at the sample times or at t."""
         from . import theory
@@ -295,7 +300,9 @@ class LangevinResult:
                 f"lags={len(self.tamsd_lags)})")
 
 
-def theory_tamsd(lags, *, gamma0, D0, dt, t_stop, tau0=math.inf, dim=3, v0_sq=None):
+def theory_tamsd(lags: ArrayLike, *, gamma0: float, D0: float, dt: float, t_stop: float,
+                 tau0: float = math.inf, dim: int = 3,
+                 v0_sq: float | None = None) -> NDArray[np.float64]:
     """The expected time-averaged MSD of a run, total over ``dim``: for each lag the mean,
     over the windows the engine averages (starting every ``sde_lag_stride`` steps from 0
     while they end by ``t_stop``), of the mean squared displacement over the window --
@@ -320,16 +327,18 @@ def theory_tamsd(lags, *, gamma0, D0, dt, t_stop, tau0=math.inf, dim=3, v0_sq=No
     return np.array(out)
 
 
-def _positive(name, value):
+def _positive(name: str, value: float) -> float:
     value = float(value)
     if not (value > 0 and math.isfinite(value)):
         raise ValueError(f"{name} must be positive and finite, got {value}")
     return value
 
 
-def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="exact", dim=3,
-        sample_times=None, tamsd_lags=None, initial="thermal", speed=None,
-        store_positions=False, seed=None, progress=False):
+def run(n: int, *, gamma0: float, D0: float, dt: float, t_stop: float, tau0: float = math.inf,
+        model: str | None = None, scheme: str = "exact", dim: int = 3,
+        sample_times: ArrayLike | None = None, tamsd_lags: ArrayLike | None = None,
+        initial: str = "thermal", speed: float | None = None, store_positions: bool = False,
+        seed: Any = None, progress: bool = False) -> LangevinResult:
     """Integrate N independent particles from a common start at the origin.
 
     Parameters
@@ -488,15 +497,15 @@ def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="exact",
     windows = (n_steps - lags) // np.maximum(strides, 1) + 1
     per_particle = tamsd_sum / windows if L else tamsd_sum
     return LangevinResult(
-        times=steps * dt, steps=steps, msd_total=x2.sum(1) / n, msd_per_dimension=x2 / n,
-        v2=v2.sum(1) / n, tamsd_lags=lags * dt,
+        times=(steps * dt).astype(np.float64, copy=False), steps=steps, msd_total=x2.sum(1) / n, msd_per_dimension=x2 / n,
+        v2=v2.sum(1) / n, tamsd_lags=(lags * dt).astype(np.float64, copy=False),
         tamsd_mean=per_particle.mean(0) if L else np.zeros(0),
         tamsd_per_particle=per_particle, positions=positions, final_positions=x,
         final_velocities=v, model=model, scheme=scheme, gamma0=gamma0, D0=D0, tau0=tau0, dt=dt,
         n=n, dim=dim, t_stop=n_steps * dt, v0_sq=v0_sq)
 
 
-def coefficients_from_scene(scene):
+def coefficients_from_scene(scene: Scene) -> LangevinCoefficients:
     """gamma0, D0, tau0 of a Scene exactly as the thesis derives them (2.45, 2.52, 2.55),
     from its N, radius, mass, restitution, box and temperature."""
     from . import theory
@@ -507,7 +516,8 @@ def coefficients_from_scene(scene):
                                         scene.temperature, mass, scene.dim)
 
 
-def from_scene(scene, *, dt, t_stop, scheme="exact", n=None, **kwargs):
+def from_scene(scene: Scene, *, dt: float, t_stop: float, scheme: str = "exact",
+               n: int | None = None, **kwargs: Any) -> LangevinResult:
     """A Langevin run (xi = 1) or UDSBM run (xi < 1) with the scene's coefficients, so it
     can be set beside an EDMD run of the same scene.  ``n`` defaults to the scene's N;
     other arguments as in ``run``."""
