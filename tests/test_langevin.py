@@ -346,7 +346,8 @@ def test_bad_input(kwargs, match):
 # magnitude.  The two differ by a few ulps a step (other rounding); velocities forget such
 # differences (they contract by exp(-gamma dt) a step), positions add them up, so after
 # n steps they differ by about n x (a few) x 2.2e-16 -- 1e-13 for the 60 steps here,
-# ~4e-15 measured.  One wrong random number would differ by O(1).
+# at most 5e-15 measured (all models, schemes, d = 1..3).  One wrong random number would
+# differ by O(1).
 
 
 def _assert_rounding_close(got, want):
