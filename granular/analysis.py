@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 
 def _positions(positions):
@@ -52,7 +53,8 @@ def _select(x, particles):
     return x[:, p, :]
 
 
-def msd(positions, per_dimension=False, particles=None):
+def msd(positions: ArrayLike, per_dimension: bool = False,
+        particles: ArrayLike | None = None) -> NDArray[np.float64]:
     """Ensemble MSD ``<|x(t) - x(0)|^2>`` over particles at every sample (any spacing).
 
     Returns (T,) summed over dimensions, or (T, d) with ``per_dimension=True``.
@@ -70,8 +72,9 @@ def _uniform(times):
     return len(dt) > 0 and np.allclose(dt, dt[0], rtol=1e-9, atol=0)
 
 
-def tamsd(positions, lags=None, times=None, *, lag_samples=None, method="auto",
-          per_particle=False, particles=None):
+def tamsd(positions: ArrayLike, lags: ArrayLike | None = None, times: ArrayLike | None = None,
+          *, lag_samples: ArrayLike | None = None, method: str = "auto",
+          per_particle: bool = False, particles: ArrayLike | None = None) -> NDArray[np.float64]:
     """Time-averaged MSD (thesis 2.114-2.115) at the given lags, averaged over particles.
 
     For each particle, ``delta^2(lag) = mean_k |x(t_k + lag) - x(t_k)|^2`` over all sample
@@ -182,7 +185,7 @@ def _tamsd_direct(x, t, lags):
     return out
 
 
-def diffusivity(times, msd_values, dim=3):
+def diffusivity(times: ArrayLike, msd_values: ArrayLike, dim: int = 3) -> NDArray[np.float64]:
     """Time-dependent diffusivity ``D(t) = (1 / 2d) d MSD / dt`` (3D form of 2.64), with
     the derivative taken as the mean of the forward and backward differences (4.1, 4.2)
     on any grid; one-sided at the two ends."""
@@ -198,7 +201,8 @@ def diffusivity(times, msd_values, dim=3):
     return deriv / (2.0 * dim)
 
 
-def fit_slope(times, values, t_min=None, t_max=None, log=False):
+def fit_slope(times: ArrayLike, values: ArrayLike, t_min: float | None = None,
+              t_max: float | None = None, log: bool = False) -> tuple[float, float, float]:
     """Least-squares straight line through ``values`` against ``times`` (or against
     ``ln(times)`` with ``log=True``: the long-time MSD of a granular gas grows like
     ln t) between t_min and t_max, as in the thesis' App. F.
@@ -227,7 +231,7 @@ def fit_slope(times, values, t_min=None, t_max=None, log=False):
 
 # -- velocities ------------------------------------------------------------------------------
 
-def temperature(velocities, masses=1.0):
+def temperature(velocities: ArrayLike, masses: ArrayLike = 1.0) -> float | NDArray[np.float64]:
     """Granular temperature ``T = 2 E_kin / (d N)`` of each snapshot ((N, d) -> scalar,
     (T, N, d) -> (T,))."""
     v = np.asarray(velocities, dtype=np.float64)
@@ -246,7 +250,9 @@ def _speeds(velocities):
     return np.linalg.norm(v, axis=-1).ravel(), v.shape[-1]
 
 
-def speed_histogram(velocities, bins=50, range=None):
+def speed_histogram(velocities: ArrayLike, bins: int | ArrayLike = 50,
+                    range: tuple[float, float] | None = None,
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Normalised histogram of the speeds in one or more snapshots.
 
     Returns (bin centres, density, standard error of the density) -- the error from the
@@ -259,7 +265,8 @@ def speed_histogram(velocities, bins=50, range=None):
     return 0.5 * (edges[1:] + edges[:-1]), counts / (total * width), np.sqrt(counts) / (total * width)
 
 
-def speed_statistics(velocities, temperature=None, masses=1.0):
+def speed_statistics(velocities: ArrayLike, temperature: float | None = None,
+                     masses: ArrayLike = 1.0) -> dict[str, dict[str, float]]:
     """Mean speed, mean squared speed and standard deviation of the speed (Table 4.1),
     with the Maxwell-Boltzmann values at ``temperature`` (default: the snapshots' own
     temperature) and the relative errors ``ours / theory - 1``.  As in the thesis, the
@@ -268,7 +275,7 @@ def speed_statistics(velocities, temperature=None, masses=1.0):
 
     v = np.asarray(velocities, dtype=np.float64)
     speed, dim = _speeds(v)
-    mass = float(np.mean(masses))
+    mass = float(np.mean(np.asarray(masses, dtype=np.float64)))
     T = float(np.mean(_snapshot_temperature(v, masses))) if temperature is None else temperature
     mb = theory.maxwell_boltzmann_moments(T, mass, dim)
     ours = {"mean": speed.mean(), "mean_sq": np.mean(speed**2), "std": speed.std()}
@@ -276,7 +283,8 @@ def speed_statistics(velocities, temperature=None, masses=1.0):
             for k in ours}
 
 
-def fit_haff_tau0(times, temperature_values, t_max=None):
+def fit_haff_tau0(times: ArrayLike, temperature_values: ArrayLike,
+                  t_max: float | None = None) -> tuple[float, float]:
     """Fit Haff's tau0 to a cooling curve: Haff's law makes ``sqrt(T0 / T(t)) - 1 = t/tau0``
     a straight line through the origin; least squares with T0 the first sample.
 
@@ -295,10 +303,13 @@ def fit_haff_tau0(times, temperature_values, t_max=None):
     return 1.0 / k, err_k / k**2
 
 
-def ensemble_mean(values, axis=0):
+def ensemble_mean(values: ArrayLike,
+                  axis: int = 0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Mean over runs and its central-limit standard error ``std(ddof=1) / sqrt(M)``
     (thesis 2.120-2.122)."""
-    a = np.asarray(values, dtype=np.float64)
+    # C order: NumPy's pairwise sums follow the memory layout, so a Fortran-order input
+    # would give other roundings
+    a = np.ascontiguousarray(values, dtype=np.float64)
     m = a.shape[axis]
     if m < 2:
         raise ValueError("ensemble_mean needs at least two runs for an error")

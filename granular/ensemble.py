@@ -13,8 +13,12 @@ import ast
 import os
 import sys
 import traceback
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from .errors import ProcessBackendError
 from .scene import Scene
@@ -25,17 +29,32 @@ EDMD_QUANTITIES = ("msd", "msd_per_dimension", "temperature", "kinetic_energy",
                    "velocities")
 
 
+@dataclass(frozen=True)
 class RunFailure:
-    """A run that raised: its index, its seed (``SeedSequence`` entropy and spawn key,
-    enough to rerun it alone) and the error."""
+    """A run that raised.
 
-    def __init__(self, index, seed, error, traceback_text):
-        self.index = index
-        self.seed = seed
-        self.error = error
-        self.traceback = traceback_text
+    Attributes
+    ----------
+    index : int
+        The run's index in its point (``SeedSequence(seed).spawn(runs)[index]``).
+    seed : dict
+        ``{"entropy": ..., "spawn_key": ...}`` of the run's ``SeedSequence``, enough to
+        rerun it alone: ``np.random.SeedSequence(**failure.seed)``.
+    error : str
+        ``repr`` of the exception.
+    traceback : str
+        The formatted traceback, from the worker that ran it.
+    error_type : str
+        The exception's class name (e.g. ``"InelasticCollapseError"``).
+    """
 
-    def __repr__(self):
+    index: int
+    seed: dict[str, Any]
+    error: str
+    traceback: str
+    error_type: str = ""
+
+    def __repr__(self) -> str:
         return f"RunFailure(run {self.index}, seed={self.seed}, error={self.error!r})"
 
 
@@ -48,8 +67,13 @@ _GUARD_ADVICE = (
     "or pass backend=\"serial\" or backend=\"threads\".")
 
 
+@dataclass(frozen=True, eq=False, repr=False)
 class EnsembleResult:
     """Per-run results and their ensemble statistics.
+
+    The MSDs are reached as on a ``Trajectory`` and a ``LangevinResult``:
+    ``result.msd(per_dimension=False)`` and ``result.tamsd(lags=None, *, lag_samples=None)``
+    give the ensemble means (errors in ``error["msd"]``, ``error["tamsd"]``, ...).
 
     Attributes
     ----------
@@ -67,15 +91,69 @@ class EnsembleResult:
         The sample times, when the runs share them.
     """
 
-    def __init__(self, runs, mean, error, count, failures, times):
-        self.runs = runs
-        self.mean = mean
-        self.error = error
-        self.count = count
-        self.failures = failures
-        self.times = times
+    runs: list[dict[str, NDArray[Any]]]
+    mean: dict[str, NDArray[np.float64]]
+    error: dict[str, NDArray[np.float64]]
+    count: int
+    failures: list[RunFailure]
+    times: NDArray[np.float64] | None
 
-    def __repr__(self):
+    def _quantity(self, name: str, hint: str) -> NDArray[np.float64]:
+        if name not in self.mean:
+            raise ValueError(f"this ensemble collected no {name!r} ({hint}); it has "
+                             f"{sorted(self.mean)}")
+        return self.mean[name]
+
+    def msd(self, per_dimension: bool = False,
+            particles: ArrayLike | None = None) -> NDArray[np.float64]:
+        """The ensemble mean of the runs' MSDs at the sample times: (T,) summed over
+        dimensions, or (T, d) with ``per_dimension=True`` (for EDMD, collect
+        ``"msd_per_dimension"`` among ``quantities``).  Its standard error is
+        ``error["msd"]`` (``error["msd_per_dimension"]``).
+
+        ``particles`` cannot apply: each run's MSD is already averaged over its particles
+        before the runs are reduced; a tracer is chosen in the runs themselves (e.g. a
+        model function returning ``langevin.run(...)``'s tracer MSD, or
+        ``quantities=("positions",)`` and ``analysis.msd(run["positions"], particles=...)``
+        over ``runs``)."""
+        if particles is not None:
+            raise TypeError("an ensemble holds each run's MSD averaged over its particles; "
+                            "particles= cannot apply here (choose particles in the runs: "
+                            "see EnsembleResult.msd)")
+        if per_dimension:
+            return self._quantity("msd_per_dimension", 'ensemble(quantities=(..., '
+                                  '"msd_per_dimension"))')
+        return self._quantity("msd", 'ensemble(quantities=(..., "msd"))')
+
+    @property
+    def tamsd_lags(self) -> NDArray[np.float64]:
+        """(L,) lags in time of ``tamsd()``: those of the runs (Langevin ensembles)."""
+        return self._quantity("tamsd_lags", "a TAMSD comes from Langevin runs with tamsd_lags")
+
+    def tamsd(self, lags: ArrayLike | None = None, *, lag_samples: ArrayLike | None = None,
+              particles: ArrayLike | None = None,
+              per_particle: bool = False) -> NDArray[np.float64]:
+        """The ensemble mean of the runs' time-averaged MSDs, (L,), at the lags the runs
+        accumulated (``tamsd_lags``: Langevin runs with ``tamsd_lags``), or at those of
+        them chosen by ``lags`` (in time) or ``lag_samples`` (in steps), as
+        ``LangevinResult.tamsd``.  Its standard error is ``error["tamsd"]``.
+
+        ``particles`` and ``per_particle`` cannot apply: the runs are reduced to means
+        over their particles (``runs[r]["tamsd_per_particle"]`` keeps each run's rows).
+        EDMD ensembles collect no TAMSD: collect ``"positions"`` and apply
+        ``granular.analysis.tamsd`` to each run."""
+        if particles is not None or per_particle:
+            raise TypeError("an ensemble holds each run's TAMSD averaged over its particles; "
+                            "particles= and per_particle= cannot apply here (each run's rows "
+                            "are in runs[r]['tamsd_per_particle'])")
+        values = self._quantity("tamsd", "a TAMSD comes from Langevin runs with tamsd_lags; "
+                                "for EDMD collect positions and use analysis.tamsd")
+        from .langevin import _lag_indices
+
+        dt = float(self._quantity("dt", "the runs' step"))
+        return values[_lag_indices(self.tamsd_lags, dt, lags, lag_samples)]
+
+    def __repr__(self) -> str:
         q = ", ".join(sorted(self.mean))
         return f"EnsembleResult({self.count} runs, {len(self.failures)} failed; {q})"
 
@@ -153,7 +231,10 @@ def _edmd_quantities(scene, run_kwargs, quantities):
 
 
 def _arrays_of(result):
-    """The NumPy arrays and numbers among a result's attributes (or dict entries)."""
+    """The NumPy arrays and numbers of a result: its own ``arrays()`` (a
+    ``LangevinResult``), else those among its attributes (or dict entries)."""
+    if callable(getattr(result, "arrays", None)):
+        return dict(result.arrays())
     items = result.items() if isinstance(result, dict) else vars(result).items()
     return {k: np.asarray(v) for k, v in items
             if isinstance(v, (np.ndarray, float, np.floating, np.integer))}
@@ -367,7 +448,7 @@ class _PointReducer:
         else:
             s = self.seeds[run]
             self.failures.append(RunFailure(run, {"entropy": s.entropy, "spawn_key": s.spawn_key},
-                                            payload[0], payload[2]))
+                                            payload[0], payload[2], payload[1]))
 
     def result(self):
         mean, error = self.acc.result()
@@ -392,8 +473,12 @@ def _reduce_in_order(results, reducers, runs, bar):
         bar.update(1)
 
 
-def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progress=None,
-             keep_runs=True, quantities=("msd", "temperature"), **run_kwargs):
+def ensemble(model: Scene | Callable[..., Any] | Sequence[Scene | Callable[..., Any]],
+             runs: int, *, seed: int | np.random.SeedSequence | None = None,
+             backend: Any = "processes", workers: int | None = None,
+             progress: bool | None = None, keep_runs: bool = True,
+             quantities: Sequence[str] = ("msd", "temperature"),
+             **run_kwargs: Any) -> EnsembleResult | list[EnsembleResult]:
     """Run ``runs`` independent realizations of a model, or of every model of a sweep, and
     return their results with ensemble means and standard errors.
 
@@ -445,8 +530,10 @@ def ensemble(model, runs, *, seed=None, backend="processes", workers=None, progr
     runs = int(runs)
     if runs < 1:
         raise ValueError(f"runs must be >= 1, got {runs}")
-    sweep = isinstance(model, (list, tuple))
-    models = list(model) if sweep else [model]
+    if isinstance(model, (list, tuple)):
+        sweep, models = True, list(model)
+    else:
+        sweep, models = False, [model]
     if not models:
         raise ValueError("a sweep needs at least one model")
     for m in models:

@@ -8,7 +8,11 @@ coordinates in float32 (about 7 significant digits) and gives frames evenly spac
 """
 from __future__ import annotations
 
+import os
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 def _mda():
@@ -37,7 +41,8 @@ def _dimensions(box, dim):
     return np.concatenate([lengths, [90.0, 90.0, 90.0]]).astype(np.float32)
 
 
-def to_universe(times, positions, box=None, radii=None):
+def to_universe(times: ArrayLike, positions: ArrayLike, box: ArrayLike | None = None,
+                radii: ArrayLike | None = None) -> Any:
     """An in-memory ``MDAnalysis.Universe`` with one atom per particle and one frame per
     sample (unwrapped positions).
 
@@ -61,7 +66,9 @@ def to_universe(times, positions, box=None, radii=None):
     return u
 
 
-def write_trajectory(path, times, positions, velocities=None, box=None):
+def write_trajectory(path: str | os.PathLike[str], times: ArrayLike, positions: ArrayLike,
+                     velocities: ArrayLike | None = None,
+                     box: ArrayLike | None = None) -> str:
     """Write a GROMACS TRR file (through MDAnalysis' TRRWriter): per frame its real time,
     unwrapped positions and optionally velocities, in float32.  MDAnalysis, OVITO, VMD and
     GROMACS read it; 2D scenes are written in the plane z = 0.

@@ -35,10 +35,19 @@ max(1, lag/16) steps, so each particle needs at most 32 past positions per lag).
 from __future__ import annotations
 
 import math
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+
+if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but stay light
+    from .scene import Scene
+    from .theory import LangevinCoefficients
 
 MODELS = ("langevin", "udsbm")
 SCHEMES = ("em", "exact")
@@ -49,29 +58,226 @@ INITIAL = ("thermal", "udsbm", "fixed")
 _CHUNK_PARTICLE_STEPS = 10_000_000
 
 
+class _ArrayAndMethod(np.ndarray):
+    """The transition from an array attribute to a method of the same name:
+    ``result.msd`` used to be the (T,) array and is now the method ``result.msd()``.
+    This object is both -- called, it runs the method; used as an array (indexing,
+    arithmetic, NumPy functions), it is the old array and warns that this use is
+    deprecated.  Results of array use are plain arrays."""
+
+    _method: Any  # the bound method (None only on views made by NumPy itself)
+    _name: str
+
+    def __new__(cls, values: NDArray[np.float64], method: Callable[..., NDArray[np.float64]],
+                name: str) -> _ArrayAndMethod:
+        obj = np.asarray(values).view(cls)
+        obj._method, obj._name = method, name
+        return obj
+
+    def __array_finalize__(self, obj: object) -> None:
+        self._method = getattr(obj, "_method", None)
+        self._name = getattr(obj, "_name", "")
+
+    def __call__(self, *args: Any, **kwargs: Any) -> NDArray[np.float64]:
+        return self._method(*args, **kwargs)
+
+    def _deprecated(self) -> None:
+        warnings.warn(f"using result.{self._name} as an array is deprecated; call "
+                      f"result.{self._name}() (the same numbers)", DeprecationWarning,
+                      stacklevel=3)
+
+    def __getitem__(self, index: Any) -> Any:
+        self._deprecated()
+        return self.view(np.ndarray)[index]
+
+    def __array_ufunc__(self, ufunc: np.ufunc, method: str, *inputs: Any, **kwargs: Any) -> Any:
+        self._deprecated()
+        plain = tuple(x.view(np.ndarray) if isinstance(x, _ArrayAndMethod) else x for x in inputs)
+        if "out" in kwargs:
+            kwargs["out"] = tuple(x.view(np.ndarray) if isinstance(x, _ArrayAndMethod) else x
+                                  for x in kwargs["out"])
+        return getattr(ufunc, method)(*plain, **kwargs)
+
+    def __array_function__(self, func: Any, types: Any, args: Any, kwargs: Any) -> Any:
+        self._deprecated()
+        def plain(x: Any) -> Any:
+            if isinstance(x, _ArrayAndMethod):
+                return x.view(np.ndarray)
+            if isinstance(x, (list, tuple)):
+                return type(x)(plain(y) for y in x)
+            return x
+        return func(*plain(args), **{k: plain(v) for k, v in kwargs.items()})
+
+    def __repr__(self) -> str:
+        return repr(self.view(np.ndarray))
+
+    def __reduce__(self) -> Any:  # pickles as the plain array it holds
+        return self.view(np.ndarray).__reduce__()
+
+
+def _lag_indices(available: NDArray[np.float64], dt: float, lags: ArrayLike | None,
+                 lag_samples: ArrayLike | None) -> NDArray[np.intp]:
+    """Indices into ``available`` (lags in time, whole multiples of ``dt``) of the lags
+    asked for: all of them when neither ``lags`` (in time) nor ``lag_samples`` (in steps)
+    is given.  An engine that accumulates the TAMSD on the fly has it at those lags
+    only, so any other lag is refused by name."""
+    if lags is not None and lag_samples is not None:
+        raise TypeError("give at most one of lags (in time) and lag_samples (in steps)")
+    have = np.rint(np.asarray(available, dtype=np.float64) / dt).astype(np.int64)
+    if lags is None and lag_samples is None:
+        return np.arange(len(have))
+    if lag_samples is not None:
+        k = np.atleast_1d(np.asarray(lag_samples))
+        if k.size and not np.issubdtype(k.dtype, np.integer):
+            if not np.all(np.isfinite(k)) or np.any(k != np.rint(k)):
+                raise ValueError(f"lag_samples must be whole numbers of steps, got {k}")
+        k = k.astype(np.int64).reshape(-1)
+    else:
+        t = np.atleast_1d(np.asarray(lags, dtype=np.float64)).reshape(-1)
+        k = np.rint(t / dt).astype(np.int64) if np.all(np.isfinite(t)) else np.full(t.shape, -1)
+        off = ~np.isclose(t, k * dt, rtol=1e-9, atol=0.0)
+        k[off] = -1  # not a whole number of steps: never accumulated
+    pos = np.searchsorted(have, k)
+    found = (pos < len(have)) & (have[np.minimum(pos, len(have) - 1)] == k) if len(have) else \
+        np.zeros(k.shape, dtype=bool)
+    if not np.all(found):
+        asked = (np.asarray(lag_samples) if lags is None else np.asarray(lags)).reshape(-1)
+        raise ValueError(
+            f"lag {asked[~found][0]!r} was not accumulated: the engine keeps the TAMSD only at "
+            f"the lags given to run(tamsd_lags=...), here {list(np.asarray(available))} in time "
+            f"({list(have)} in steps)")
+    return pos
+
+
+@dataclass(frozen=True, eq=False, repr=False)
 class LangevinResult:
     """What a Langevin/UDSBM run measured.
+
+    The ensemble MSD and the time-averaged MSD are reached as on a ``Trajectory`` and an
+    ``EnsembleResult``: ``result.msd(per_dimension=False, particles=None)`` and
+    ``result.tamsd(lags=None, *, lag_samples=None, particles=None, per_particle=False)``.
 
     Attributes
     ----------
     times : (T,) sample times (whole steps: ``steps * dt``)
-    msd, msd_per_dimension : (T,), (T, d) ensemble MSD from the common start
+    steps : (T,) the sample steps
+    msd_total, msd_per_dimension : (T,), (T, d) ensemble MSD from the common start at the
+        origin, summed over dimensions and per dimension (``msd()`` returns them)
     v2 : (T,) mean squared speed; ``temperature = mass * v2 / d``
-    tamsd_lags : (L,) lags in time; tamsd : (L,) particle-averaged time-averaged MSD;
+    tamsd_lags : (L,) lags in time at which the TAMSD was accumulated
+    tamsd_mean : (L,) particle-averaged time-averaged MSD (``tamsd()`` returns it)
     tamsd_per_particle : (N, L)
-    positions : (T, N, d) or None
-    model, scheme, gamma0, D0, tau0, dt, n, dim, t_stop, v0_sq (initial mean squared
-    velocity per component)
+    positions : (T, N, d) positions at the sample times, or None (``store_positions``)
+    final_positions, final_velocities : (N, d) the state at ``t_stop``
+    model, scheme : as given to ``run``
+    gamma0, D0, tau0, dt, t_stop : the coefficients, step and duration (whole steps)
+    n, dim : particles and dimensions
+    v0_sq : initial mean squared velocity per component
     """
 
-    def __init__(self, **fields):
-        self.__dict__.update(fields)
+    times: NDArray[np.float64]
+    steps: NDArray[np.int64]
+    msd_total: NDArray[np.float64]
+    msd_per_dimension: NDArray[np.float64]
+    v2: NDArray[np.float64]
+    tamsd_lags: NDArray[np.float64]
+    tamsd_mean: NDArray[np.float64]
+    tamsd_per_particle: NDArray[np.float64]
+    positions: NDArray[np.float64] | None
+    final_positions: NDArray[np.float64]
+    final_velocities: NDArray[np.float64]
+    model: str
+    scheme: str
+    gamma0: float
+    D0: float
+    tau0: float
+    dt: float
+    n: int
+    dim: int
+    t_stop: float
+    v0_sq: float
 
     @property
-    def temperature(self):
+    def msd(self) -> _ArrayAndMethod:
+        """``msd(per_dimension=False, particles=None)``: the ensemble MSD at the sample
+        times, (T,) summed over dimensions or (T, d) per dimension.
+
+        particles : array_like of int or bool, optional
+            Average over these particles only (indices, or a boolean mask over all N);
+            needs the positions (``run(store_positions=True)``), since the engine
+            accumulates the MSD of all particles only.
+
+        (Used as an array, ``result.msd`` is still the (T,) MSD, deprecated.)"""
+        return _ArrayAndMethod(self.msd_total, self._msd, "msd")
+
+    def _msd(self, per_dimension: bool = False,
+             particles: ArrayLike | None = None) -> NDArray[np.float64]:
+        if particles is None:
+            return self.msd_per_dimension if per_dimension else self.msd_total
+        if self.positions is None:
+            raise ValueError("msd(particles=...) needs the positions: run with "
+                             "store_positions=True (the engine accumulates the MSD of all "
+                             "particles only)")
+        from .analysis import _select
+
+        # every particle starts at the origin, so |x|^2 is the squared displacement
+        x = _select(self.positions, particles)
+        per = np.einsum("tna,tna->ta", x, x) / x.shape[1]
+        return per if per_dimension else per.sum(axis=1)
+
+    @property
+    def tamsd(self) -> _ArrayAndMethod:
+        """``tamsd(lags=None, *, lag_samples=None, particles=None, per_particle=False)``:
+        the time-averaged MSD, (L,) averaged over particles or (N, L) per particle.
+
+        The engine accumulates it on the fly at the lags given to ``run(tamsd_lags=...)``
+        (``tamsd_lags``) and only there: by default all of them; ``lags`` (in time) or
+        ``lag_samples`` (in steps, the engine's samples of the path) pick some of them,
+        and any other lag is refused.
+        particles : array_like of int or bool, optional
+            Average over these particles only (indices, or a boolean mask over all N).
+        per_particle : bool
+            Return (N, L) (or one row per chosen particle) instead of the mean.
+
+        (Used as an array, ``result.tamsd`` is still the (L,) TAMSD, deprecated.)"""
+        return _ArrayAndMethod(self.tamsd_mean, self._tamsd, "tamsd")
+
+    def _tamsd(self, lags: ArrayLike | None = None, *, lag_samples: ArrayLike | None = None,
+               particles: ArrayLike | None = None,
+               per_particle: bool = False) -> NDArray[np.float64]:
+        pick = _lag_indices(self.tamsd_lags, self.dt, lags, lag_samples)
+        if particles is None and not per_particle:
+            return self.tamsd_mean[pick]
+        from .analysis import _select
+
+        # (N, L) as (1, N, L) "positions" so that the particle choice is analysis' own
+        per = self.tamsd_per_particle[:, pick]
+        if particles is not None:
+            per = _select(per[None], particles)[0]
+        return per if per_particle else per.mean(axis=0)
+
+    @property
+    def temperature(self) -> NDArray[np.float64]:
+        """(T,) temperature per unit mass, ``v2 / dim``."""
         return self.v2 / self.dim
 
-    def theory_msd(self, t=None):
+    def arrays(self) -> dict[str, NDArray[Any]]:
+        """The NumPy arrays and numbers of this result by name, as ``granular.ensemble``
+        collects them from each run (``msd`` and ``tamsd`` under those names)."""
+        out = {"times": self.times, "steps": self.steps, "msd": self.msd_total,
+               "msd_per_dimension": self.msd_per_dimension, "v2": self.v2,
+               "tamsd_lags": self.tamsd_lags, "tamsd": self.tamsd_mean,
+               "tamsd_per_particle": self.tamsd_per_particle,
+               "final_positions": self.final_positions,
+               "final_velocities": self.final_velocities}
+        if self.positions is not None:
+            out["positions"] = self.positions
+        for name in ("gamma0", "D0", "tau0", "dt", "t_stop", "v0_sq"):
+            out[name] = np.asarray(getattr(self, name))
+        return out
+
+    def theory_msd(self, t: float | NDArray[np.float64] | None = None,
+                   ) -> float | NDArray[np.float64]:
         """The analytic ensemble MSD of this model from ``granular.theory`` (with this
         run's initial speed) at the sample times or at t."""
         from . import theory
@@ -81,20 +287,22 @@ class LangevinResult:
             return theory.msd_langevin(t, self.D0, self.gamma0, self.dim, v0_sq=self.v0_sq)
         return theory.msd_udsbm(t, self.D0, self.gamma0, self.tau0, self.dim, v0_sq=self.v0_sq)
 
-    def theory_tamsd(self, lags=None):
+    def theory_tamsd(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected time-averaged MSD of this run at its lags (or at ``lags``), as the
         engine measures it: see ``theory_tamsd``."""
         return theory_tamsd(self.tamsd_lags if lags is None else lags, gamma0=self.gamma0,
                             D0=self.D0, tau0=self.tau0, dt=self.dt, t_stop=self.t_stop,
                             dim=self.dim, v0_sq=self.v0_sq)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return (f"LangevinResult(model={self.model!r}, scheme={self.scheme!r}, n={self.n}, "
                 f"dim={self.dim}, dt={self.dt}, t_stop={self.t_stop}, samples={len(self.times)}, "
                 f"lags={len(self.tamsd_lags)})")
 
 
-def theory_tamsd(lags, *, gamma0, D0, dt, t_stop, tau0=math.inf, dim=3, v0_sq=None):
+def theory_tamsd(lags: ArrayLike, *, gamma0: float, D0: float, dt: float, t_stop: float,
+                 tau0: float = math.inf, dim: int = 3,
+                 v0_sq: float | None = None) -> NDArray[np.float64]:
     """The expected time-averaged MSD of a run, total over ``dim``: for each lag the mean,
     over the windows the engine averages (starting every ``sde_lag_stride`` steps from 0
     while they end by ``t_stop``), of the mean squared displacement over the window --
@@ -119,16 +327,18 @@ def theory_tamsd(lags, *, gamma0, D0, dt, t_stop, tau0=math.inf, dim=3, v0_sq=No
     return np.array(out)
 
 
-def _positive(name, value):
+def _positive(name: str, value: float) -> float:
     value = float(value)
     if not (value > 0 and math.isfinite(value)):
         raise ValueError(f"{name} must be positive and finite, got {value}")
     return value
 
 
-def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="exact", dim=3,
-        sample_times=None, tamsd_lags=None, initial="thermal", speed=None,
-        store_positions=False, seed=None, progress=False):
+def run(n: int, *, gamma0: float, D0: float, dt: float, t_stop: float, tau0: float = math.inf,
+        model: str | None = None, scheme: str = "exact", dim: int = 3,
+        sample_times: ArrayLike | None = None, tamsd_lags: ArrayLike | None = None,
+        initial: str = "thermal", speed: float | None = None, store_positions: bool = False,
+        seed: Any = None, progress: bool = False) -> LangevinResult:
     """Integrate N independent particles from a common start at the origin.
 
     Parameters
@@ -287,14 +497,15 @@ def run(n, *, gamma0, D0, dt, t_stop, tau0=math.inf, model=None, scheme="exact",
     windows = (n_steps - lags) // np.maximum(strides, 1) + 1
     per_particle = tamsd_sum / windows if L else tamsd_sum
     return LangevinResult(
-        times=steps * dt, steps=steps, msd=x2.sum(1) / n, msd_per_dimension=x2 / n,
-        v2=v2.sum(1) / n, tamsd_lags=lags * dt, tamsd=per_particle.mean(0) if L else np.zeros(0),
+        times=(steps * dt).astype(np.float64, copy=False), steps=steps, msd_total=x2.sum(1) / n, msd_per_dimension=x2 / n,
+        v2=v2.sum(1) / n, tamsd_lags=(lags * dt).astype(np.float64, copy=False),
+        tamsd_mean=per_particle.mean(0) if L else np.zeros(0),
         tamsd_per_particle=per_particle, positions=positions, final_positions=x,
         final_velocities=v, model=model, scheme=scheme, gamma0=gamma0, D0=D0, tau0=tau0, dt=dt,
         n=n, dim=dim, t_stop=n_steps * dt, v0_sq=v0_sq)
 
 
-def coefficients_from_scene(scene):
+def coefficients_from_scene(scene: Scene) -> LangevinCoefficients:
     """gamma0, D0, tau0 of a Scene exactly as the thesis derives them (2.45, 2.52, 2.55),
     from its N, radius, mass, restitution, box and temperature."""
     from . import theory
@@ -305,7 +516,8 @@ def coefficients_from_scene(scene):
                                         scene.temperature, mass, scene.dim)
 
 
-def from_scene(scene, *, dt, t_stop, scheme="exact", n=None, **kwargs):
+def from_scene(scene: Scene, *, dt: float, t_stop: float, scheme: str = "exact",
+               n: int | None = None, **kwargs: Any) -> LangevinResult:
     """A Langevin run (xi = 1) or UDSBM run (xi < 1) with the scene's coefficients, so it
     can be set beside an EDMD run of the same scene.  ``n`` defaults to the scene's N;
     other arguments as in ``run``."""

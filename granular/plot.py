@@ -16,7 +16,13 @@ Ratios and counts are marked dimensionless.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:  # matplotlib is an extra, imported only when a figure is drawn
+    from matplotlib.axes import Axes
 
 
 # Axis labels with their units (mathtext).
@@ -34,7 +40,7 @@ DIFFUSIVITY = r"diffusivity $D(t)$ [$L\sqrt{\varepsilon/m}$]"
 POSITION = r"${}$ [$L$]"
 
 
-def _axes(ax):
+def _axes(ax: Axes | None) -> Axes:
     if ax is None:
         import matplotlib.pyplot as plt
 
@@ -42,7 +48,8 @@ def _axes(ax):
     return ax
 
 
-def energy(times, kinetic_energy, ax=None, label=None, relative=True):
+def energy(times: ArrayLike, kinetic_energy: ArrayLike, ax: Axes | None = None,
+           label: str | None = None, relative: bool = True) -> Axes:
     """Kinetic energy against time; with ``relative`` the deviation E(t)/E(0) - 1 (thesis
     Fig. 4.2: rounding-level for a molecular gas)."""
     ax = _axes(ax)
@@ -56,7 +63,8 @@ def energy(times, kinetic_energy, ax=None, label=None, relative=True):
     return ax
 
 
-def collisions_per_particle(times, collisions, ax=None, label=None):
+def collisions_per_particle(times: ArrayLike, collisions: ArrayLike, ax: Axes | None = None,
+                            label: str | None = None) -> Axes:
     """Mean collisions per particle against time (thesis Figs 4.3-4.4)."""
     ax = _axes(ax)
     ax.plot(times, collisions, label=label)
@@ -67,7 +75,9 @@ def collisions_per_particle(times, collisions, ax=None, label=None):
     return ax
 
 
-def speed_distribution(velocities, temperature=None, mass=1.0, bins=40, ax=None, label="simulation"):
+def speed_distribution(velocities: ArrayLike, temperature: float | None = None,
+                       mass: float = 1.0, bins: int = 40, ax: Axes | None = None,
+                       label: str = "simulation") -> Axes:
     """Histogram of speeds with Poisson error bars against Maxwell-Boltzmann (Figs 4.5-4.6)."""
     from . import analysis, theory
 
@@ -88,7 +98,9 @@ def speed_distribution(velocities, temperature=None, mass=1.0, bins=40, ax=None,
     return ax
 
 
-def haff(times, temperature, tau0, temperature0=None, ax=None, label="simulation", error=None):
+def haff(times: ArrayLike, temperature: ArrayLike, tau0: float,
+         temperature0: float | None = None, ax: Axes | None = None, label: str = "simulation",
+         error: ArrayLike | None = None) -> Axes:
     """Granular temperature against Haff's law T0 / (1 + t/tau0)^2 on log-log axes
     (Figs 4.8, 4.10)."""
     from . import theory
@@ -112,8 +124,10 @@ def haff(times, temperature, tau0, temperature0=None, ax=None, label="simulation
     return ax
 
 
-def msd(times, values, error=None, theory_values=None, ax=None, label="simulation",
-        theory_label="theory", loglog=True, theory_style="k--"):
+def msd(times: ArrayLike, values: ArrayLike, error: ArrayLike | None = None,
+        theory_values: ArrayLike | None = None, ax: Axes | None = None,
+        label: str = "simulation", theory_label: str = "theory", loglog: bool = True,
+        theory_style: str = "k--") -> Axes:
     """MSD against time with error bars and a theory curve (Figs 4.11-4.13, 4.17-4.20);
     ``theory_style`` is its matplotlib format string, to tell several theories apart."""
     ax = _axes(ax)
@@ -135,7 +149,8 @@ def msd(times, values, error=None, theory_values=None, ax=None, label="simulatio
     return ax
 
 
-def diffusivity(times, values, theory_values=None, ax=None, label="simulation"):
+def diffusivity(times: ArrayLike, values: ArrayLike, theory_values: ArrayLike | None = None,
+                ax: Axes | None = None, label: str = "simulation") -> Axes:
     """Time-dependent diffusivity (Figs 4.14-4.16)."""
     ax = _axes(ax)
     t = np.asarray(times, dtype=np.float64)
@@ -151,7 +166,8 @@ def diffusivity(times, values, theory_values=None, ax=None, label="simulation"):
     return ax
 
 
-def msd_vs_tamsd(times, msd_values, lags, tamsd_values, ax=None, label=""):
+def msd_vs_tamsd(times: ArrayLike, msd_values: ArrayLike, lags: ArrayLike,
+                 tamsd_values: ArrayLike, ax: Axes | None = None, label: str = "") -> Axes:
     """Ensemble MSD and time-averaged MSD on one log-log plot (Figs 4.21-4.23): equal for an
     ergodic process, apart for a non-ergodic one."""
     ax = _axes(ax)
@@ -167,7 +183,8 @@ def msd_vs_tamsd(times, msd_values, lags, tamsd_values, ax=None, label=""):
     return ax
 
 
-def snapshot(positions, radii, lower, upper, ax=None, color="C0"):
+def snapshot(positions: ArrayLike, radii: ArrayLike, lower: ArrayLike, upper: ArrayLike,
+             ax: Axes | None = None, color: str = "C0") -> Axes:
     """Disks of a 2D configuration drawn to scale (Fig. 4.9)."""
     from matplotlib.collections import EllipseCollection
 
@@ -178,8 +195,9 @@ def snapshot(positions, radii, lower, upper, ax=None, color="C0"):
     d = 2 * np.broadcast_to(radii, (len(x),))
     ax.add_collection(EllipseCollection(d, d, np.zeros(len(x)), units="xy", offsets=x,
                                         offset_transform=ax.transData, facecolors=color))
-    ax.set_xlim(lower[0], upper[0])
-    ax.set_ylim(lower[1], upper[1])
+    lo, hi = np.asarray(lower, dtype=np.float64), np.asarray(upper, dtype=np.float64)
+    ax.set_xlim(float(lo[0]), float(hi[0]))
+    ax.set_ylim(float(lo[1]), float(hi[1]))
     ax.set_aspect("equal")
     ax.set_xlabel(POSITION.format("x"))
     ax.set_ylabel(POSITION.format("y"))

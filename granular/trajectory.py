@@ -1,7 +1,10 @@
 """Trajectory: what a run recorded, with the physics that follows from it."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 
 def _pressure_volume(lower, upper, radii, boundary):
@@ -31,9 +34,13 @@ class Trajectory:
     masses, radii, lower, upper, boundary : copied from the scene
     """
 
-    def __init__(self, times, positions, velocities, kinetic_energy, momentum,
-                 pair_collisions, wall_collisions, virial, wall_impulse, *, masses, radii,
-                 lower, upper, boundary, stop_reason):
+    def __init__(self, times: NDArray[np.float64], positions: NDArray[np.float64] | None,
+                 velocities: NDArray[np.float64] | None, kinetic_energy: NDArray[np.float64],
+                 momentum: NDArray[np.float64], pair_collisions: NDArray[np.int64],
+                 wall_collisions: NDArray[np.int64], virial: NDArray[np.float64],
+                 wall_impulse: NDArray[np.float64], *, masses: NDArray[np.float64],
+                 radii: NDArray[np.float64], lower: NDArray[np.float64],
+                 upper: NDArray[np.float64], boundary: str, stop_reason: str) -> None:
         self.times = times
         self.positions = positions
         self.velocities = velocities
@@ -51,35 +58,35 @@ class Trajectory:
         self.stop_reason = stop_reason
 
     @property
-    def n(self):
+    def n(self) -> int:
         return len(self.masses)
 
     @property
-    def dim(self):
+    def dim(self) -> int:
         return len(self.lower)
 
     @property
-    def volume(self):
+    def volume(self) -> float:
         return float(np.prod(self.upper - self.lower))
 
     @property
-    def temperature(self):
+    def temperature(self) -> NDArray[np.float64]:
         """(T,) granular temperature 2 E_kin / (d N), k_B = 1."""
         return 2.0 * self.kinetic_energy / (self.dim * self.n)
 
     @property
-    def collisions_per_particle(self):
+    def collisions_per_particle(self) -> NDArray[np.float64]:
         """(T,) mean collisions per particle, counting pair collisions for both partners
         and wall collisions once (as the thesis does)."""
         return (2.0 * self.pair_collisions + self.wall_collisions) / self.n
 
-    def _need(self, name):
+    def _need(self, name: str) -> Any:
         value = getattr(self, name)
         if value is None:
             raise ValueError(f"this trajectory did not store {name}; run with store including {name!r}")
         return value
 
-    def pressure(self):
+    def pressure(self) -> float:
         """Pressure over the run from the virial theorem, P = (2 <E_kin> + W / dt) / (d V),
         with W the virial of the pair collisions between the first and last sample and
         <E_kin> the time average of the kinetic energy (trapezoid over the samples: exact
@@ -100,7 +107,7 @@ class Trajectory:
         volume = _pressure_volume(self.lower, self.upper, self.radii, self.boundary)
         return float((2.0 * mean_k + w / span) / (self.dim * volume))
 
-    def wall_pressure(self):
+    def wall_pressure(self) -> float:
         """Mechanical pressure on the walls between the first and last sample: the normal
         momentum given to them per unit time, over the area the particle centres can
         reach (each face shrunk by one radius at each edge; exact for equal radii, the
@@ -115,9 +122,12 @@ class Trajectory:
         area = 2.0 * sum(np.prod(np.delete(reach, a)) for a in range(self.dim))
         return float((self.wall_impulse[-1] - self.wall_impulse[0]) / ((t[-1] - t[0]) * area))
 
-    def msd(self, per_dimension=False, particles=None):
-        """Ensemble mean squared displacement from the first sample, at every sample
-        (summed over dimensions, or (T, d) per dimension); see ``granular.analysis.msd``.
+    def msd(self, per_dimension: bool = False,
+            particles: ArrayLike | None = None) -> NDArray[np.float64]:
+        """Ensemble mean squared displacement from the first sample, at every sample:
+        (T,) summed over dimensions, or (T, d) with ``per_dimension=True``; see
+        ``granular.analysis.msd``.  The same call as ``LangevinResult.msd`` and
+        ``EnsembleResult.msd``.
 
         particles : array_like of int or bool, optional
             Average over these particles only (indices, or a boolean mask over all N),
@@ -126,34 +136,37 @@ class Trajectory:
         positions = self._need("positions")
         from . import analysis
 
-        # particles only when given, so that analysis.msd's own default applies
-        extra = {} if particles is None else {"particles": particles}
-        return analysis.msd(positions, per_dimension=per_dimension, **extra)
+        return analysis.msd(positions, per_dimension=per_dimension, particles=particles)
 
-    def tamsd(self, lags=None, *, lag_samples=None, particles=None, **kwargs):
-        """Time-averaged MSD at the given lags; see ``granular.analysis.tamsd``.
+    def tamsd(self, lags: ArrayLike | None = None, *, lag_samples: ArrayLike | None = None,
+              particles: ArrayLike | None = None, per_particle: bool = False,
+              method: str = "auto") -> NDArray[np.float64]:
+        """Time-averaged MSD, (L,) averaged over particles or (N, L) with
+        ``per_particle=True``; see ``granular.analysis.tamsd``.  The same call as
+        ``LangevinResult.tamsd`` and ``EnsembleResult.tamsd``, except that a trajectory
+        has no lags of its own (it can compute any): give exactly one of ``lags`` and
+        ``lag_samples``.
 
         lags : array_like of float, optional
-            Lags in time, multiples of the (uniform) sample spacing.
+            Lags in time, each a difference of sample times (with uniform sampling, a
+            multiple of the spacing).
         lag_samples : array_like of int, optional
-            Lags as whole numbers of samples instead (uniformly spaced samples).  Give
-            exactly one of ``lags`` and ``lag_samples``.
+            Lags as whole numbers of samples instead (uniformly spaced samples).
         particles : array_like of int or bool, optional
             Average over these particles only (indices or a boolean mask over all N).
-        **kwargs
-            Passed on (``method``, ``per_particle``).
+        per_particle : bool
+            Return (N, L) (a row per chosen particle) instead of the mean.
+        method : "auto", "fft" or "direct"
+            How ``analysis.tamsd`` computes it (a trajectory's choice only: the other
+            results hold a TAMSD accumulated by the engine).
         """
         positions = self._need("positions")
         from . import analysis
 
-        # only what was given is passed on, so that analysis.tamsd's own defaults and
-        # checks (exactly one of lags / lag_samples) apply
-        for name, value in (("lag_samples", lag_samples), ("particles", particles)):
-            if value is not None:
-                kwargs[name] = value
-        return analysis.tamsd(positions, lags, times=self.times, **kwargs)
+        return analysis.tamsd(positions, lags, times=self.times, lag_samples=lag_samples,
+                              method=method, per_particle=per_particle, particles=particles)
 
-    def to_universe(self):
+    def to_universe(self) -> Any:
         """An MDAnalysis Universe of the particles (see ``granular.interop.to_universe``)."""
         positions = self._need("positions")
         from . import interop
@@ -161,10 +174,10 @@ class Trajectory:
         box = (self.upper - self.lower) if self.boundary == "periodic" else None
         return interop.to_universe(self.times, positions, box=box, radii=self.radii)
 
-    def __len__(self):
+    def __len__(self) -> int:
         return len(self.times)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         span = f"t = {self.times[0]:.4g} .. {self.times[-1]:.4g}" if len(self.times) else "empty"
         return (f"Trajectory({len(self.times)} samples, {span}, n={self.n}, dim={self.dim}, "
                 f"stop_reason={self.stop_reason!r})")

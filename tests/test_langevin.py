@@ -18,6 +18,8 @@ import pytest
 import granular
 from granular import langevin, theory
 
+import sde_reference  # tests/ is on sys.path (conftest.py)
+
 G0, D0 = 9.26, 0.072          # the thesis' standard gas, xi = 0.8 (theory.langevin_coefficients)
 TAU0 = 0.972
 VT = G0 * D0                  # T0 / m
@@ -59,8 +61,8 @@ def test_exact_scheme_msd_matches_theory(model, tau0, initial, limit):
     th = r.theory_msd()
     ok = r.times > 0
     tol = 5 * rel_se_msd(n)
-    np.testing.assert_array_less(np.abs(r.msd[ok] / th[ok] - 1), tol)
-    assert r.msd[0] == 0.0
+    np.testing.assert_array_less(np.abs(r.msd()[ok] / th[ok] - 1), tol)
+    assert r.msd()[0] == 0.0
     if limit is None:
         return
     # from t = 5 (gamma0 t = 46, t = 5 tau0) the limits equal the full MSD to 1e-6
@@ -80,7 +82,7 @@ def test_euler_maruyama_msd_matches_theory_at_small_steps():
                          initial="udsbm" if tau0 < math.inf else "thermal", seed=2)
         ok = r.times > 0
         bias = 2 / (2 - G0 * 0.001) - 1
-        np.testing.assert_array_less(np.abs(r.msd[ok] / r.theory_msd()[ok] - 1),
+        np.testing.assert_array_less(np.abs(r.msd()[ok] / r.theory_msd()[ok] - 1),
                                      5 * rel_se_msd(n) + bias)
 
 
@@ -103,7 +105,7 @@ def test_ballistic_limit(tau0, initial, v0_sq):
     assert r.v0_sq == pytest.approx(v0_sq)
     ballistic = theory.msd_ballistic(t, v0_sq)
     off_limit = np.abs(r.theory_msd(t) / ballistic - 1)
-    np.testing.assert_array_less(np.abs(r.msd / ballistic - 1), 5 * rel_se_msd(n) + off_limit)
+    np.testing.assert_array_less(np.abs(r.msd() / ballistic - 1), 5 * rel_se_msd(n) + off_limit)
 
 
 def test_euler_maruyama_first_step_is_exact_free_flight():
@@ -111,7 +113,7 @@ def test_euler_maruyama_first_step_is_exact_free_flight():
     velocity only), so MSD(dt) = speed^2 dt^2 to rounding."""
     r = langevin.run(100, gamma0=G0, D0=D0, dt=1e-4, t_stop=1e-3, speed=1.5, initial="fixed",
                      scheme="em", sample_times=[0, 1e-4], seed=3)
-    assert r.msd[1] == pytest.approx(1.5**2 * 1e-8, rel=1e-13)
+    assert r.msd()[1] == pytest.approx(1.5**2 * 1e-8, rel=1e-13)
     assert r.v0_sq == pytest.approx(0.75)
 
 
@@ -167,13 +169,13 @@ def test_tamsd_equals_msd_for_langevin_but_not_for_udsbm():
     r = langevin.run(n, gamma0=G0, D0=D0, dt=0.01, t_stop=100.0, scheme="exact", tamsd_lags=lags, seed=6)
     se = r.tamsd_per_particle.std(0, ddof=1) / math.sqrt(n)
     expected = theory.msd_langevin(lags, D0, G0)
-    np.testing.assert_array_less(np.abs(r.tamsd - expected), 5 * se)
+    np.testing.assert_array_less(np.abs(r.tamsd() - expected), 5 * se)
     u = langevin.run(n, gamma0=G0, D0=D0, tau0=TAU0, dt=0.01, t_stop=100.0, scheme="exact",
                      initial="udsbm", tamsd_lags=lags, seed=6)
     se = u.tamsd_per_particle.std(0, ddof=1) / math.sqrt(n)
-    np.testing.assert_array_less(np.abs(u.tamsd - u.theory_tamsd()), 5 * se)
+    np.testing.assert_array_less(np.abs(u.tamsd() - u.theory_tamsd()), 5 * se)
     # non-ergodic: the ensemble MSD lies many standard errors above the time average
-    np.testing.assert_array_less(5 * se, u.theory_msd(lags) - u.tamsd)
+    np.testing.assert_array_less(5 * se, u.theory_msd(lags) - u.tamsd())
 
 
 @pytest.mark.parametrize("model,tau0", [("langevin", math.inf), ("udsbm", TAU0)])
@@ -186,7 +188,8 @@ def test_same_seed_same_result_whatever_the_chunking(monkeypatch, model, tau0, s
     kw = dict(gamma0=G0, D0=D0, tau0=tau0, model=model, scheme=scheme, dt=0.01, t_stop=2.0,
               sample_times=np.arange(201) * 0.01, tamsd_lags=[0.01, 0.07, 0.3, 1.0, 2.0],
               store_positions=True, seed=7)
-    names = ("msd", "v2", "tamsd_per_particle", "positions", "final_positions", "final_velocities")
+    names = ("msd_total", "msd_per_dimension", "v2", "tamsd_per_particle", "positions",
+             "final_positions", "final_velocities")
     a = langevin.run(30, **kw)  # one call: 30 x 200 particle-steps
     for chunk in (200 * 7, 13, 7, 1):  # 7 particles a call; then one particle, 13, 7, 1 steps a call
         monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", chunk)
@@ -334,3 +337,77 @@ def test_bad_input(kwargs, match):
     base.update(kwargs)
     with pytest.raises(ValueError, match=match):
         langevin.run(10, **base)
+
+
+# -- the engine against a slow NumPy reference fed the same random numbers ------------------
+#
+# tests/sde_reference.py redraws csrc/rng.h's stream in Python and integrates from the
+# equations (its own formulas and order of operations).  Tolerance: 1e-12 of the largest
+# magnitude.  The two differ by a few ulps a step (other rounding); velocities forget such
+# differences (they contract by exp(-gamma dt) a step), positions add them up, so after
+# n steps they differ by about n x (a few) x 2.2e-16 -- 1e-13 for the 60 steps here,
+# at most 5e-15 measured (all models, schemes, d = 1..3).  One wrong random number would
+# differ by O(1).
+
+
+def _assert_rounding_close(got, want):
+    scale = float(np.max(np.abs(want)))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * scale)
+
+
+@pytest.mark.parametrize("model,scheme,dim", [
+    ("langevin", "em", 3), ("langevin", "exact", 3), ("udsbm", "em", 3), ("udsbm", "exact", 3),
+    ("langevin", "exact", 1), ("udsbm", "em", 2)])
+def test_the_engine_is_the_reference_integrator_to_rounding(model, scheme, dim):
+    """Every position at every step, the final velocities, the ensemble MSD sums and the
+    TAMSD over the engine's windows (lags 1 and 33 and 60 steps: strides 1, 2, 3)."""
+    v0 = np.random.default_rng(1).normal(scale=0.8, size=(4, dim))
+    kw = dict(model=model, scheme=scheme, gamma0=G0, D0=D0, tau0=TAU0, dt=0.05, n_steps=60)
+    key, lags = 0xDEADBEEF12345678, [1, 33, 60]
+    pos, v, x2, tamsd = sde_reference.engine(v0, key, lags=lags, **kw)
+    xs, vs = sde_reference.run(v0, key, **kw)
+    _assert_rounding_close(pos, xs)
+    _assert_rounding_close(v, vs[-1])
+    _assert_rounding_close(x2, (xs * xs).sum(axis=1))
+    for m, lag in enumerate(lags):
+        stride = granular._core.sde_lag_stride(lag)
+        windows = len(range(0, 61 - lag, stride))
+        _assert_rounding_close(tamsd[:, m] / windows,
+                               sde_reference.tamsd_per_particle(xs, lag, stride))
+
+
+def test_the_reference_covers_the_ziggurat_tail_and_wedges():
+    """300 particles x 10 steps x 3 axes x 2 normals: draws from the rare paths of the
+    ziggurat (beyond r = 3.44 and in the layers' wedges) are among them, and match."""
+    key, n, n_steps = 12345, 300, 10
+    tails = 0
+    for k in range(n_steps):
+        for i in range(n):
+            rs = sde_reference.Stream(key, k, i)
+            tails += sum(abs(rs.normal()) > sde_reference.ZIG_R for _ in range(6))
+    assert tails >= 3
+    v0 = np.zeros((n, 3))
+    kw = dict(model="udsbm", scheme="exact", gamma0=G0, D0=D0, tau0=TAU0, dt=0.05,
+              n_steps=n_steps)
+    pos, v, _, _ = sde_reference.engine(v0, key, **kw)
+    xs, vs = sde_reference.run(v0, key, **kw)
+    _assert_rounding_close(pos, xs)
+    _assert_rounding_close(v, vs[-1])
+
+
+def test_run_draws_from_its_seed_as_documented():
+    """langevin.run: key and initial velocities from SeedSequence(seed).spawn(2), then the
+    engine; particles numbered from 0 whatever the chunking (first > 0 here)."""
+    r = langevin.run(5, gamma0=G0, D0=D0, dt=0.05, t_stop=1.0, scheme="em",
+                     sample_times=np.arange(21) * 0.05, store_positions=True, seed=42)
+    key_seq, vel_seq = np.random.SeedSequence(42).spawn(2)
+    key = int(key_seq.generate_state(1, dtype=np.uint64)[0])
+    v0 = np.random.default_rng(vel_seq).normal(scale=math.sqrt(VT), size=(5, 3))
+    xs, vs = sde_reference.run(v0, key, model="langevin", scheme="em", gamma0=G0, D0=D0,
+                               tau0=math.inf, dt=0.05, n_steps=20)
+    _assert_rounding_close(r.positions, xs)
+    _assert_rounding_close(r.final_velocities, vs[-1])
+    part, _, _, _ = sde_reference.engine(v0[2:4], key, model="langevin", scheme="em",
+                                         gamma0=G0, D0=D0, tau0=math.inf, dt=0.05,
+                                         n_steps=20, first=2, n=5)
+    np.testing.assert_array_equal(part, r.positions[:, 2:4])

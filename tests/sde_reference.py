@@ -1,0 +1,173 @@
+"""A slow, obvious Langevin/UDSBM integrator in Python: the reference the C engine
+(csrc/sde.c) is tested against, as reference_edmd.py is for EDMD.
+
+It draws the SAME random numbers as the engine -- csrc/rng.h's counter-based stream
+(SplitMix64 keyed by (key, step, particle)) and its 128-layer ziggurat, rewritten here in
+Python integers (exact 64-bit arithmetic by masking) with the tables computed by the same
+libm calls (Python's ``math`` module calls the C library's exp, log and sqrt) -- and then
+integrates each particle step by step, written from the equations rather than from the C:
+
+    dx = v dt,   dv = -gamma(t) v dt + sqrt(2 D(t)) gamma(t) dW
+    Langevin: gamma0, D0;   UDSBM: gamma0 / (1 + t/tau0), D0 / (1 + t/tau0)
+
+- "em": Euler-Maruyama, thesis (2.92)/(2.110), coefficients at the start of the step;
+- "exact": the exact Gaussian update of the Ornstein-Uhlenbeck process over a step (mean
+  and 2x2 covariance of (x, v) written out, sampled by a Cholesky factor with the
+  velocity first), coefficients frozen at the step's midpoint for UDSBM.
+
+Step k (1-based) goes from (k-1) dt to k dt and draws from the stream of (key, k-1,
+particle): for each axis in turn one normal (EM) or two (exact: the first drives v).
+O(N x steps) Python-level work: tests only.
+"""
+import math
+
+import numpy as np
+
+MASK = (1 << 64) - 1
+GOLDEN = 0x9E3779B97F4A7C15
+
+
+def mix64(z):
+    """SplitMix64's finaliser on a 64-bit integer."""
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & MASK
+    return z ^ (z >> 31)
+
+
+def _ziggurat_tables():
+    """Marsaglia & Tsang (2000), 128 layers: the start r of the tail and the area vn of
+    each layer give every layer's edge; k is the integer acceptance bound, w the scale
+    and f the density at each edge."""
+    m1, vn = 2147483648.0, 9.91256303526217e-3
+    dn = tn = 3.442619855899
+    q = vn / math.exp(-0.5 * dn * dn)
+    k, w, f = [0] * 128, [0.0] * 128, [0.0] * 128
+    k[0] = int((dn / q) * m1)
+    w[0], w[127] = q / m1, dn / m1
+    f[0], f[127] = 1.0, math.exp(-0.5 * dn * dn)
+    for i in range(126, 0, -1):
+        dn = math.sqrt(-2.0 * math.log(vn / dn + math.exp(-0.5 * dn * dn)))
+        k[i + 1] = int((dn / tn) * m1)
+        tn = dn
+        f[i] = math.exp(-0.5 * dn * dn)
+        w[i] = dn / m1
+    return k, w, f
+
+
+ZIG_K, ZIG_W, ZIG_F = _ziggurat_tables()
+ZIG_R = 3.442619855899
+
+
+class Stream:
+    """The draws of one (step, particle) under a key."""
+
+    def __init__(self, key, step, particle):
+        self.state = mix64((key + mix64((step * GOLDEN + particle) & MASK) * GOLDEN) & MASK)
+
+    def next64(self):
+        self.state = (self.state + GOLDEN) & MASK
+        return mix64(self.state)
+
+    def uniform(self):
+        """In (0, 1): the top 53 bits, centred in their interval."""
+        return (float(self.next64() >> 11) + 0.5) * (1.0 / 9007199254740992.0)
+
+    def normal(self):
+        """A standard normal: layer from the top 7 bits, signed magnitude from the low 32."""
+        while True:
+            u = self.next64()
+            iz = u >> 57
+            hz = u & 0xFFFFFFFF
+            hz = hz - (1 << 32) if hz >= 1 << 31 else hz
+            x = hz * ZIG_W[iz]
+            if abs(hz) < ZIG_K[iz]:
+                return x  # inside the layer's rectangle: most draws
+            if iz == 0:  # the tail beyond r
+                while True:
+                    xx = -math.log(self.uniform()) / ZIG_R
+                    yy = -math.log(self.uniform())
+                    if yy + yy >= xx * xx:
+                        return ZIG_R + xx if hz > 0 else -ZIG_R - xx
+            if ZIG_F[iz] + self.uniform() * (ZIG_F[iz - 1] - ZIG_F[iz]) < math.exp(-0.5 * x * x):
+                return x  # under the density in the layer's wedge
+
+
+def coefficients(model, gamma0, D0, tau0, t):
+    """gamma(t), D(t)."""
+    s = 1.0 if model == "langevin" else 1.0 / (1.0 + t / tau0)
+    return gamma0 * s, D0 * s
+
+
+def ou_step(gamma, D, dt):
+    """The exact update of (x, v) over dt at constant gamma, D: the mean is
+    (x + v (1 - c)/gamma, c v) with c = exp(-gamma dt), and the noise covariance
+    Var v = D gamma (1 - c^2), Cov(x, v) = D (1 - c)^2,
+    Var x = (D / gamma) (2 h - 3 + 4 c - c^2), h = gamma dt.
+    Returns c, (1 - c)/gamma and the lower Cholesky factor of the covariance ordered
+    (v, x), so that (noise_v, noise_x) = L @ (z1, z2)."""
+    h = gamma * dt
+    c = math.exp(-h)
+    cov = np.array([[D * gamma * (1 - c * c), D * (1 - c) ** 2],
+                    [D * (1 - c) ** 2, D / gamma * (2 * h - 3 + 4 * c - c * c)]])
+    return c, (1 - c) / gamma, np.linalg.cholesky(cov)
+
+
+def run(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, first=0):
+    """Positions (n_steps + 1, N, d) and velocities (n_steps + 1, N, d) at every step of
+    particles first .. first + N - 1 starting at the origin with velocities v0 (N, d)."""
+    v0 = np.asarray(v0, dtype=np.float64)
+    n, d = v0.shape
+    xs = np.zeros((n_steps + 1, n, d))
+    vs = np.zeros((n_steps + 1, n, d))
+    vs[0] = v0
+    for i in range(n):
+        x, v = [0.0] * d, list(v0[i])
+        for k in range(1, n_steps + 1):
+            rs = Stream(key, k - 1, first + i)
+            if scheme == "em":
+                g, D = coefficients(model, gamma0, D0, tau0, (k - 1) * dt)
+                for a in range(d):
+                    dW = math.sqrt(dt) * rs.normal()
+                    x[a], v[a] = x[a] + v[a] * dt, v[a] - g * v[a] * dt + math.sqrt(2 * D) * g * dW
+            else:
+                g, D = coefficients(model, gamma0, D0, tau0, (k - 0.5) * dt)
+                c, drift, L = ou_step(g, D, dt)
+                for a in range(d):
+                    z1, z2 = rs.normal(), rs.normal()
+                    x[a] += v[a] * drift + L[1, 0] * z1 + L[1, 1] * z2
+                    v[a] = c * v[a] + L[0, 0] * z1
+            xs[k, i], vs[k, i] = x, v
+    return xs, vs
+
+
+def tamsd_per_particle(xs, lag, stride):
+    """(N,) time-averaged MSD at a lag (in steps) over the windows the engine averages:
+    starting at steps 0, stride, 2 stride, ... while they end by the last step."""
+    starts = np.arange(0, len(xs) - lag, stride)
+    d = xs[starts + lag] - xs[starts]
+    return (d * d).sum(axis=2).mean(axis=0)
+
+
+def engine(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, lags=(), first=0,
+           n=None, sample_steps=None):
+    """The C engine's raw entry point (``_core.sde_run``) over a whole run, with fresh
+    buffers, for comparison with ``run``: samples at every step unless ``sample_steps``.
+    Returns positions (T, N, d), final velocities (N, d), x2 (T, d) summed over the
+    particles, and the per-particle TAMSD sums (N, L) over the windows."""
+    from granular import _core
+
+    v = np.array(v0, dtype=np.float64)
+    count, d = v.shape
+    n = count if n is None else n
+    steps = (np.arange(n_steps + 1, dtype=np.int64) if sample_steps is None
+             else np.asarray(sample_steps, dtype=np.int64))
+    lags = np.asarray(lags, dtype=np.int64).reshape(-1)
+    x = np.zeros((count, d))
+    x2, v2 = np.zeros((len(steps), d)), np.zeros((len(steps), d))
+    positions = np.zeros((len(steps), n, d))
+    tamsd = np.zeros((n, len(lags)))
+    ring = np.zeros(_core.sde_ring_size(d, lags))
+    _core.sde_run(d, ("langevin", "udsbm").index(model), ("em", "exact").index(scheme),
+                  gamma0, D0, tau0 if model == "udsbm" else math.inf, dt, key, n, first, 0,
+                  n_steps, n_steps, x, v, steps, x2, v2, positions, lags, tamsd, ring)
+    return positions[:, first:first + count], v, x2, tamsd[first:first + count]
