@@ -85,7 +85,7 @@ for _model, _tau0 in (("langevin", np.inf), ("udsbm", 0.972)):
             r = langevin.run(50, gamma0=9.26, D0=0.072, tau0=tau0, model=model, dt=0.01,
                              t_stop=5.0, scheme=scheme, dim=3, tamsd_lags=[0.1, 0.5, 2.0],
                              store_positions=True, seed=6)
-            return {"msd": _digest(r.times, r.msd, r.msd_per_dimension, r.v2),
+            return {"msd": _digest(r.times, r.msd(), r.msd(per_dimension=True), r.v2),
                     "tamsd": _digest(r.tamsd_per_particle),
                     "positions": _digest(r.positions)}
         CASES[f"langevin-{_model}-{_scheme}"] = _case

@@ -88,14 +88,14 @@ for ax, xi in zip(axes, (1.0, 0.8)):
     traj = granular.Simulation(gas).run(t_stop=t_stop, sample_times=times)
     for scheme in ("em", "exact"):
         sde = langevin.from_scene(gas, dt=0.01, t_stop=t_stop, scheme=scheme, n=4 * n, sample_times=times, seed=3)
-        ax.plot(sde.times[1:], sde.msd[1:], label=f"{sde.model}, {scheme}")
+        ax.plot(sde.times[1:], sde.msd()[1:], label=f"{sde.model}, {scheme}")
     plot.msd(traj.times, traj.msd(), ax=ax, label="EDMD")
     ax.set_title(f"xi = {xi}")''',
 "md:For the molecular gas the Langevin model matches: its velocity autocorrelation is the gas' (2.66). For the granular gas UDSBM tracks EDMD only up to O(1 - xi) (thesis 4.2.2): its velocity autocorrelation (2.111) differs from the granular gas' (2.77) unless gamma0 tau0 >> 1. Ergodicity is where they part for good: UDSBM's time average never catches its ensemble average.",
 '''lags = np.logspace(-2, np.log10(t_stop / 2), 15)
 c = langevin.coefficients_from_scene(eq.replace(restitution=0.8))
 u = langevin.run(n, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=0.01, t_stop=t_stop, scheme="exact", initial="udsbm", tamsd_lags=lags, seed=4)
-plot.msd_vs_tamsd(u.times, u.msd, u.tamsd_lags, u.tamsd, label="UDSBM")''',
+plot.msd_vs_tamsd(u.times, u.msd(), u.tamsd_lags, u.tamsd(), label="UDSBM")''',
 "md:Ensembles of EDMD runs on all local cores (the default backend), a sweep over xi:",
 '''import functools
 runs = 4 if not QUICK else 2

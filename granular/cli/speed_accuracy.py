@@ -131,7 +131,7 @@ def speed_accuracy_points(quick=False):
                 r = langevin.run(n_sde, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=dt, t_stop=t_max,
                                  scheme=scheme, sample_times=times, seed=5)
                 sec = clock() - t0
-                add(scheme, f"{r.model} {scheme}, dt={dt:.3g}", r.msd, sec, at=r.times, dt=dt,
+                add(scheme, f"{r.model} {scheme}, dt={dt:.3g}", r.msd(), sec, at=r.times, dt=dt,
                     n=n_sde, gamma_dt=c.gamma0 * dt)
     return points, refs
 
@@ -153,7 +153,7 @@ def em_stability(quick=False):
                 r = langevin.run(n, gamma0=c.gamma0, D0=c.D0, dt=dt, t_stop=t_max, scheme=scheme,
                                  sample_times=times, seed=1)
                 ok = r.times > 0
-                row[scheme] = float(np.max(np.abs(r.msd[ok] / th[ok] - 1)))
+                row[scheme] = float(np.max(np.abs(r.msd()[ok] / th[ok] - 1)))
                 row[f"{scheme}_v2_bias"] = float(r.v2[-1] / (3 * c.gamma0 * c.D0) - 1)
             except UnstableStepError:
                 row[scheme] = None

@@ -440,10 +440,10 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
 
 @_verified
 def _check_langevin(r):
-    for name in ("times", "msd", "v2", "tamsd", "positions"):
+    for name in ("times", "msd_total", "v2", "tamsd_mean", "positions"):
         a = getattr(r, name, None)
         _check(a is None or np.all(np.isfinite(a)), f"non-finite {name}")
-    _check(np.all(r.msd >= 0), "negative MSD")
+    _check(np.all(r.msd() >= 0), "negative MSD")
     _check(np.all(np.diff(r.times) > 0), "sample times not increasing")
 
 
