@@ -7,10 +7,20 @@ that checks them against theory.
 >>> scene = granular.Scene.random(1000, 0.025, restitution=0.8, seed=1)
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
+
 from . import errors
-from .errors import (FrozenGasError, GranularError, HeatedWallsError, InelasticCollapseError,
-                     NoProgressError, NonFiniteError, OutsideBoxError, OverlapError,
-                     ProcessBackendError, UnstableStepError)
+from .errors import (
+    FrozenGasError,
+    GranularError,
+    HeatedWallsError,
+    InelasticCollapseError,
+    NoProgressError,
+    NonFiniteError,
+    OutsideBoxError,
+    OverlapError,
+    ProcessBackendError,
+    UnstableStepError,
+)
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
@@ -37,8 +47,11 @@ def __getattr__(name):
     if name in _MOVED:
         import warnings
 
-        warnings.warn(f"granular.{name} moved to granular.cli.{name}; the old name goes in the "
-                      f"next release", DeprecationWarning, stacklevel=2)
+        warnings.warn(
+            f"granular.{name} moved to granular.cli.{name}; the old name goes in the next release",
+            DeprecationWarning,
+            stacklevel=2,
+        )
         return importlib.import_module(f".cli.{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
@@ -46,7 +59,25 @@ def __getattr__(name):
 def __dir__():
     return sorted(list(globals()) + list(_LAZY))
 
-__all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "analysis",
-           "langevin", "theory", "errors", "GranularError", "OverlapError",
-           "OutsideBoxError", "InelasticCollapseError", "HeatedWallsError", "NoProgressError",
-           "FrozenGasError", "NonFiniteError", "ProcessBackendError", "UnstableStepError"]
+
+__all__ = [
+    "Scene",
+    "Simulation",
+    "Trajectory",
+    "ensemble",
+    "EnsembleResult",
+    "analysis",
+    "langevin",
+    "theory",
+    "errors",
+    "GranularError",
+    "OverlapError",
+    "OutsideBoxError",
+    "InelasticCollapseError",
+    "HeatedWallsError",
+    "NoProgressError",
+    "FrozenGasError",
+    "NonFiniteError",
+    "ProcessBackendError",
+    "UnstableStepError",
+]
