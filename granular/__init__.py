@@ -8,14 +8,15 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 
-from . import errors
+from . import analysis, errors, langevin, theory
+from .ensemble import EnsembleResult, ensemble
 from .errors import (
     FrozenGasError,
     GranularError,
     HeatedWallsError,
     InelasticCollapseError,
-    NoProgressError,
     NonFiniteError,
+    NoProgressError,
     OutsideBoxError,
     OverlapError,
     ProcessBackendError,
@@ -24,8 +25,6 @@ from .errors import (
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
-from .ensemble import EnsembleResult, ensemble
-from . import analysis, langevin, theory
 
 __version__ = "0.1.0"
 
@@ -61,23 +60,23 @@ def __dir__():
 
 
 __all__ = [
+    "EnsembleResult",
+    "FrozenGasError",
+    "GranularError",
+    "HeatedWallsError",
+    "InelasticCollapseError",
+    "NoProgressError",
+    "NonFiniteError",
+    "OutsideBoxError",
+    "OverlapError",
+    "ProcessBackendError",
     "Scene",
     "Simulation",
     "Trajectory",
-    "ensemble",
-    "EnsembleResult",
+    "UnstableStepError",
     "analysis",
+    "ensemble",
+    "errors",
     "langevin",
     "theory",
-    "errors",
-    "GranularError",
-    "OverlapError",
-    "OutsideBoxError",
-    "InelasticCollapseError",
-    "HeatedWallsError",
-    "NoProgressError",
-    "FrozenGasError",
-    "NonFiniteError",
-    "ProcessBackendError",
-    "UnstableStepError",
 ]

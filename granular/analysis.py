@@ -167,7 +167,7 @@ def tamsd(
 def _tamsd_fft(x, k, chunk_bytes=2**27):
     """(N, L) TAMSD at integer lags k by the FFT algorithm, in chunks of particles."""
     T, N, d = x.shape
-    nfft = 1 << int(math.ceil(math.log2(2 * T)))
+    nfft = 1 << math.ceil(math.log2(2 * T))
     out = np.empty((N, len(k)))
     per_particle = 16 * (nfft // 2 + 1) * d + 8 * T * d
     step = max(1, int(chunk_bytes // per_particle))
@@ -243,7 +243,7 @@ def fit_slope(
         raise ValueError("fit_slope needs at least three points in [t_min, t_max]")
     xs = np.log(t[sel]) if log else t[sel]
     A = np.vstack([xs, np.ones_like(xs)]).T
-    coef, res, *_ = np.linalg.lstsq(A, v[sel], rcond=None)
+    coef, *_ = np.linalg.lstsq(A, v[sel], rcond=None)
     dof = len(xs) - 2
     resid = v[sel] - A @ coef
     s2 = float(resid @ resid) / dof if dof > 0 else np.nan

@@ -304,7 +304,8 @@ def _call_task(task, index, seed):
     so that one failing run never loses the others."""
     try:
         return index, "ok", task(seed)
-    except Exception as exc:  # reported with its seed, the other runs go on
+    # any error of the task (user code) is caught: reported with its seed, the other runs go on
+    except Exception as exc:  # noqa: BLE001
         return index, "error", (repr(exc), exc.__class__.__name__, traceback.format_exc())
 
 

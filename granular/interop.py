@@ -31,7 +31,7 @@ def _as_3d(positions):
     if x.ndim != 3 or x.shape[2] not in (2, 3):
         raise ValueError(f"positions must have shape (T, N, d) with d = 2 or 3, got {x.shape}")
     if x.shape[2] == 2:  # MDAnalysis is three-dimensional: disks lie in the plane z = 0
-        x = np.concatenate([x, np.zeros(x.shape[:2] + (1,))], axis=2)
+        x = np.concatenate([x, np.zeros((*x.shape[:2], 1))], axis=2)
     return x
 
 

@@ -358,10 +358,10 @@ def theory_tamsd(
     C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD."""
     from . import theory
 
-    n_steps = int(round(t_stop / dt))
+    n_steps = round(t_stop / dt)
     out = []
     for lag in np.atleast_1d(np.asarray(lags, dtype=np.float64)):
-        k = int(round(lag / dt))
+        k = round(lag / dt)
         starts = np.arange(0, n_steps - k + 1, _core.sde_lag_stride(k)) * dt
         if math.isinf(tau0):
             thermal = D0 * gamma0
@@ -465,7 +465,7 @@ def run(
             f"t_stop / dt = {t_stop!r} / {dt!r} = {n_steps_f:.4g} steps; a run "
             f"takes at most 2**62 = {_core.SDE_MAX_STEPS:.4g}"
         )
-    n_steps = int(round(n_steps_f))
+    n_steps = round(n_steps_f)
     if n_steps < 1:
         raise ValueError("t_stop must be at least one step")
 

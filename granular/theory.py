@@ -17,13 +17,13 @@ about 1% up to eta = 0.4 (3D) and 0.5 (2D).
 from __future__ import annotations
 
 import math
-from typing import NamedTuple, Union
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 # what the formulas return: a float for scalar arguments, else an array of their shape
-FloatOrArray = Union[float, NDArray[np.float64]]
+FloatOrArray = float | NDArray[np.float64]
 
 
 # -- geometry and equilibrium structure ---------------------------------------------------

@@ -167,7 +167,7 @@ def test_msd_and_tamsd_of_chosen_particles():
     )
     with pytest.raises(ValueError, match="one entry per particle"):
         analysis.msd(x, particles=mask[:10])
-    with pytest.raises(IndexError, match="outside 0..29"):
+    with pytest.raises(IndexError, match=r"outside 0\.\.29"):
         analysis.tamsd(x, lags, times=t, particles=[30])
     with pytest.raises(ValueError, match="selects no particle"):
         analysis.msd(x, particles=np.zeros(30, dtype=bool))

@@ -19,7 +19,7 @@ import sde_reference
 
 def _strided(a):
     """A non-contiguous view of a's values (every other row of a larger array)."""
-    big = np.zeros((2 * a.shape[0],) + a.shape[1:], dtype=a.dtype) if a.ndim else a
+    big = np.zeros((2 * a.shape[0], *a.shape[1:]), dtype=a.dtype) if a.ndim else a
     if a.ndim:
         big[::2] = a
         return big[::2]
@@ -231,7 +231,7 @@ def _raw(x=None, v=None, steps=None, lags=None, v0=None):
 
 def test_the_raw_sde_run_is_the_reference():
     v0 = np.array([[0.5, -0.2], [0.1, 0.3], [-0.4, 0.0]])
-    x, v, _, pos, _ = _raw()
+    _, v, _, pos, _ = _raw()
     xs, vs = sde_reference.run(v0, 77, **SDE)
     np.testing.assert_allclose(pos, xs[[0, 5, 20, 40]], rtol=0, atol=1e-13)
     np.testing.assert_allclose(v, vs[-1], rtol=0, atol=1e-13)
@@ -267,7 +267,7 @@ def test_the_raw_sde_run_reads_its_inputs_right_or_refuses_them(which, label):
     except ValueError as exc:
         assert "C-contiguous int64" in str(exc), exc
     else:
-        for a, b in zip(got, plain):
+        for a, b in zip(got, plain, strict=True):
             np.testing.assert_array_equal(a, b)
     _unchanged(value, before)
 
@@ -323,7 +323,7 @@ def _same(got, want, label):
         for k in want:
             _same(got[k], want[k], label)
     elif isinstance(want, tuple):
-        for g, w in zip(got, want):
+        for g, w in zip(got, want, strict=True):
             _same(g, w, label)
     else:
         np.testing.assert_array_equal(got, want, err_msg=label)

@@ -51,7 +51,7 @@ class CountingClient:
 def _assert_identical(x, y):
     """Two EnsembleResults agree bit for bit: every run's arrays, the means and errors."""
     assert len(x.runs) == len(y.runs) and x.mean.keys() == y.mean.keys()
-    for a, b in zip(x.runs, y.runs):
+    for a, b in zip(x.runs, y.runs, strict=True):
         assert a.keys() == b.keys()
         for k in a:
             np.testing.assert_array_equal(a[k], b[k])
@@ -114,7 +114,7 @@ def test_failing_run_is_reported_and_the_others_returned():
 
 def test_run_r_uses_child_r_of_the_seed():
     res = granular.ensemble(ensemble_tasks.gaussian, 3, seed=5, backend="serial")
-    for run, child in zip(res.runs, np.random.SeedSequence(5).spawn(3)):
+    for run, child in zip(res.runs, np.random.SeedSequence(5).spawn(3), strict=True):
         np.testing.assert_array_equal(run["x"], ensemble_tasks.gaussian(child)["x"])
 
 
@@ -126,7 +126,7 @@ def test_a_sweep_gives_each_point_as_run_alone_with_its_child_seed():
     kw = dict(quantities=("temperature", "pair_collisions"), **RUN)
     sweep = granular.ensemble(points, 3, seed=11, backend="processes", workers=2, **kw)
     assert isinstance(sweep, list) and len(sweep) == 2
-    for point, child, res in zip(points, np.random.SeedSequence(11).spawn(2), sweep):
+    for point, child, res in zip(points, np.random.SeedSequence(11).spawn(2), sweep, strict=True):
         alone = granular.ensemble(point, 3, seed=child, backend="serial", **kw)
         assert res.count == alone.count == 3 and not res.failures
         _assert_identical(alone, res)
@@ -199,7 +199,7 @@ def test_dask_submission_is_windowed(dask_client):
     lean = granular.ensemble(models, 12, seed=4, backend=client, keep_runs=False)
     assert 1 < client.peak <= 4
     serial = granular.ensemble(models, 12, seed=4, backend="serial")
-    for a, b in zip(lean, serial):
+    for a, b in zip(lean, serial, strict=True):
         assert a.runs == [] and a.count == 12
         np.testing.assert_array_equal(a.mean["x"], b.mean["x"])
         np.testing.assert_array_equal(a.error["x"], b.error["x"])
@@ -289,7 +289,8 @@ GUARD_TO_WRITE = 'if __name__ == "__main__":\n        result = granular.ensemble
     [
         ("res = granular.ensemble(model, 4, seed=1, workers=2)\n", 6),
         (
-            "def main():\n    return granular.ensemble(model, 4, seed=1, workers=2)\n\n\nres = main()\n",
+            "def main():\n    return granular.ensemble(model, 4, seed=1, workers=2)\n\n\n"
+            "res = main()\n",
             10,
         ),
     ],

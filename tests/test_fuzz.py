@@ -38,7 +38,8 @@ class Worker:
     def __init__(self):
         self.log = tempfile.TemporaryFile()
         code = (
-            f"import sys; sys.path.insert(0, {str(HERE)!r}); import resource; from helpers import fuzz_cases\n"
+            f"import sys; sys.path.insert(0, {str(HERE)!r}); import resource; "
+            "from helpers import fuzz_cases\n"
             f"if 'asan' not in __import__('os').environ.get('LD_PRELOAD', ''):\n"
             f"    resource.setrlimit(resource.RLIMIT_AS, ({MEMORY_CAP}, {MEMORY_CAP}))\n"
             f"fuzz_cases.worker({SEED}, {COUNT})"
@@ -113,7 +114,7 @@ def test_fuzz_inputs_end_in_a_clear_error_or_a_valid_result():
             worker.proc.stdin.close()
             worker.close()
 
-    tally = Counter((c["kind"], status) for c, (status, _) in zip(cases, outcomes))
+    tally = Counter((c["kind"], status) for c, (status, _) in zip(cases, outcomes, strict=True))
     failures = [
         f"#{i} {describe(cases[i])}\n    -> {detail}"
         for i, (status, detail) in enumerate(outcomes)

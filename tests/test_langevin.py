@@ -398,7 +398,7 @@ def test_core_sde_run_checks_sizes_without_overflow(case, error):
 
 
 def test_refuses_unstable_euler_maruyama():
-    with pytest.raises(granular.UnstableStepError, match="gamma0\\*dt >= 2.*exact") as info:
+    with pytest.raises(granular.UnstableStepError, match=r"gamma0\*dt >= 2.*exact") as info:
         langevin.run(10, gamma0=10.0, D0=0.1, dt=0.2, t_stop=1.0, scheme="em")
     assert info.value.value == pytest.approx(2.0)
     # the exact scheme takes the same step

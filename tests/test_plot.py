@@ -35,7 +35,7 @@ def test_all_plots_render(tmp_path):
             assert "[" in label or "dimensionless" in label, f"plot {k}: no unit in {label!r}"
         ax.figure.savefig(tmp_path / f"f{k}.png")
         assert (tmp_path / f"f{k}.png").stat().st_size > 1000
-    fig, ax = plt.subplots()
+    _, ax = plt.subplots()
     assert plot.energy(t, np.ones(20), ax=ax) is ax
     plt.close("all")
 
@@ -73,7 +73,7 @@ def test_demo_panels_read_well():
             runs=[dict(velocities=[rng.normal(size=(300, 3)) * np.sqrt(T[-1])])],
         )
         results[label] = (res, msd, T, c)
-    fig, axes = plt.subplots(1, 4)
+    _, axes = plt.subplots(1, 4)
     demo._msd(axes[0], t, results)
     demo._temperature(axes[1], t, results)
     demo._speeds(axes[2], "molecular", results)

@@ -114,7 +114,7 @@ def test_collapse_map_chart_reads_well():
     for ax in fig.axes:
         squares = [p.get_window_extent(renderer) for p in ax.patches if isinstance(p, Rectangle)]
         assert len(squares) == 25 and len(ax.texts) == 25
-        for text, square in zip(ax.texts, squares):
+        for text, square in zip(ax.texts, squares, strict=True):
             box = text.get_window_extent(renderer)
             assert (
                 square.x0 <= box.x0

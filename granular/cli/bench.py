@@ -91,9 +91,10 @@ def run(quick=False, large=False, langevin=True, out=print):
         r = edmd_workload(name, dim, n, eta, coll)
         results.append(r)
         out(
-            f"{r['name']:<28} N={r['n']:>8}  {r['pair_collisions_per_second'] / 1e6:6.3f} M pair collisions/s"
-            f"  ({r['ns_per_event']:.0f} ns/event, {r['events'] / r['pair_collisions']:.2f} events/collision"
-            f"{', neighbour lists' if r['shell'] > 0 else ''})"
+            f"{r['name']:<28} N={r['n']:>8}  {r['pair_collisions_per_second'] / 1e6:6.3f} M pair "
+            f"collisions/s  ({r['ns_per_event']:.0f} ns/event, "
+            f"{r['events'] / r['pair_collisions']:.2f} "
+            f"events/collision{', neighbour lists' if r['shell'] > 0 else ''})"
         )
     if langevin:
         try:
@@ -104,8 +105,9 @@ def run(quick=False, large=False, langevin=True, out=print):
             for r in bench_langevin.workloads(quick=quick):
                 results.append(r)
                 out(
-                    f"{r['name']:<28} N={r['n']:>8}  {r['particle_steps_per_second'] / 1e6:8.1f} M particle-steps/s"
-                    f"  (NumPy: {r['numpy_particle_steps_per_second'] / 1e6:.1f} M/s; peak {r['peak_memory_mb']:.1f} MB)"
+                    f"{r['name']:<28} N={r['n']:>8}  {r['particle_steps_per_second'] / 1e6:8.1f} M "
+                    f"particle-steps/s  (NumPy: {r['numpy_particle_steps_per_second'] / 1e6:.1f} "
+                    f"M/s; peak {r['peak_memory_mb']:.1f} MB)"
                 )
     return results
 

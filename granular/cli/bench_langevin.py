@@ -11,6 +11,7 @@ of them) plus the Langevin ones."""
 
 from __future__ import annotations
 
+import functools
 import time
 import tracemalloc
 
@@ -61,7 +62,7 @@ def _measure(fn):
 
 
 def _record(name, r, seconds, peak, numpy_rate):
-    steps = int(round(r.t_stop / r.dt))
+    steps = round(r.t_stop / r.dt)
     return dict(
         name=name,
         engine="langevin",
@@ -90,11 +91,18 @@ def workloads(quick=False):
     for n, steps in cases:
         dt = 0.01
         np_steps = max(10, steps // 20)
-        _, np_seconds, _ = _measure(lambda: numpy_em(n, np_steps, dt))
+        _, np_seconds, _ = _measure(functools.partial(numpy_em, n, np_steps, dt))
         for scheme in ("em", "exact"):
             r, seconds, peak = _measure(
-                lambda: langevin.run(
-                    n, gamma0=G0, D0=D0, dt=dt, t_stop=steps * dt, scheme=scheme, seed=1
+                functools.partial(
+                    langevin.run,
+                    n,
+                    gamma0=G0,
+                    D0=D0,
+                    dt=dt,
+                    t_stop=steps * dt,
+                    scheme=scheme,
+                    seed=1,
                 )
             )
             out.append(

@@ -48,8 +48,8 @@ def main(out="granular-demo", quick=False, runs=None, backend="processes"):
     times = np.concatenate([[0.0], np.logspace(-2, math.log10(t_stop), 40)])
     start = _equilibrated(n, radius, seed=2020)
     print(
-        f"granular demo: N = {n}, r = {radius:.4g}, eta = {start.packing_fraction:.4f}, periodic unit box, "
-        f"T0 = {start.temperature:.4f}, t = 0 .. {t_stop:g}, {runs} runs each"
+        f"granular demo: N = {n}, r = {radius:.4g}, eta = {start.packing_fraction:.4f}, periodic "
+        f"unit box, T0 = {start.temperature:.4f}, t = 0 .. {t_stop:g}, {runs} runs each"
     )
 
     rows, results = [], {}
@@ -96,24 +96,29 @@ def main(out="granular-demo", quick=False, runs=None, backend="processes"):
     names = _figures(out, times, results)
     write_json(os.path.join(out, "summary.json"), rows)
     print(
-        f"{'gas':<10} {'T(t_end)':>22} {'Haff/const':>10} {'MSD(t_end)':>20} {'theory':>9} {'coll/part':>9}"
+        f"{'gas':<10} {'T(t_end)':>22} {'Haff/const':>10} {'MSD(t_end)':>20} {'theory':>9} "
+        f"{'coll/part':>9}"
     )
     for r in rows:
         print(
-            f"{r['gas']:<10} {r['T_end']:>12.4g} +- {r['T_end_error']:<7.2g}{r['T_end_theory']:>10.4g} "
-            f"{r['msd_end']:>10.4g} +- {r['msd_end_error']:<6.2g}{r['msd_end_theory']:>9.4g} "
+            f"{r['gas']:<10} {r['T_end']:>12.4g} +- "
+            f"{r['T_end_error']:<7.2g}{r['T_end_theory']:>10.4g} {r['msd_end']:>10.4g} +- "
+            f"{r['msd_end_error']:<6.2g}{r['msd_end_theory']:>9.4g} "
             f"{r['collisions_per_particle']:>9.0f}"
         )
-    dev = lambda ours, error, th: f"{ours / th - 1:+.1%} +- {error / th:.1%}"  # noqa: E731
+
+    def dev(ours, error, th):
+        return f"{ours / th - 1:+.1%} +- {error / th:.1%}"
+
     mol, gran = rows
     print(
-        f"relative deviation from theory +- standard error: molecular MSD "
+        "relative deviation from theory +- standard error: molecular MSD "
         f"{dev(mol['msd_end'], mol['msd_end_error'], mol['msd_end_theory'])}, granular MSD "
         f"{dev(gran['msd_end'], gran['msd_end_error'], gran['msd_end_theory'])}, granular T "
-        f"{dev(gran['T_end'], gran['T_end_error'], gran['T_end_theory'])}.\n  Why they may differ: the MSD "
-        f"theory uses Enskog's D0, which misses velocity correlations (diffusion a few % faster "
-        f"at eta = {start.packing_fraction:.3f}; the thesis measured +4 %), and Haff's law the "
-        f"Maxwellian cooling rate, which misses them too (the gas cools more slowly)."
+        f"{dev(gran['T_end'], gran['T_end_error'], gran['T_end_theory'])}.\n  Why they may differ: "
+        "the MSD theory uses Enskog's D0, which misses velocity correlations (diffusion a few % "
+        f"faster at eta = {start.packing_fraction:.3f}; the thesis measured +4 %), and Haff's law "
+        "the Maxwellian cooling rate, which misses them too (the gas cools more slowly)."
     )
     print(f"{', '.join(names)} and summary.json in {out}/  ({time.perf_counter() - started:.1f} s)")
     return rows
@@ -173,14 +178,18 @@ def _figures(out, times, results):
         fig, axes = plt.subplots(
             1, len(draws), figsize=(5.5 * len(draws), 4.2), layout="constrained", squeeze=False
         )
-        for ax, draw in zip(axes[0], draws):
+        for ax, draw in zip(axes[0], draws, strict=True):
             draw(ax)
         fig.savefig(os.path.join(out, name), dpi=120)
         plt.close(fig)
         return name
 
-    msd = lambda ax: _msd(ax, times, results)  # noqa: E731
-    temperature = lambda ax: _temperature(ax, times, results)  # noqa: E731
+    def msd(ax):
+        return _msd(ax, times, results)
+
+    def temperature(ax):
+        return _temperature(ax, times, results)
+
     return [
         save("demo.png", msd, temperature),
         save("msd.png", msd),

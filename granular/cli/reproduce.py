@@ -94,7 +94,9 @@ def _checked(res):
 
 
 def _row(id_, quantity, ours, error=None, runs=None, thesis=None, theory_value=None):
-    f = lambda x: None if x is None or (isinstance(x, float) and not math.isfinite(x)) else float(x)  # noqa: E731
+    def f(x):
+        return None if x is None or (isinstance(x, float) and not math.isfinite(x)) else float(x)
+
     return {
         "id": id_,
         "quantity": quantity,
@@ -292,7 +294,7 @@ def _fig_4_8_and_4_10(cfg, out):
 
     eq = equilibrium_scene(cfg)
     fig, axes = _fig(3)
-    for ax, xi in zip(axes, (0.99, 0.5, 0.3)):
+    for ax, xi in zip(axes, (0.99, 0.5, 0.3), strict=True):
         r = _checked_ensemble(
             eq.replace(restitution=xi),
             cfg.runs_few,
@@ -342,7 +344,7 @@ def _fig_4_9(cfg, out):
             axes[k].set_xticks([])
             axes[k].set_yticks([])
             k += 1
-    fig.suptitle(r"Fig. 4.9: 2D granular gas, $\xi$ = 0.8, N = %d" % cfg.n2)
+    fig.suptitle(rf"Fig. 4.9: 2D granular gas, $\xi$ = 0.8, N = {cfg.n2}")
     return [_save(fig, out, "fig4_9_clusters_2d.png")], []
 
 
@@ -384,17 +386,20 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
             label=f"EDMD, {len(r.runs)} runs",
             theory_label=equation,
         )
-        ax.set_title(f"Fig. {fig_msd.replace('_', '.')}: MSD, " + (r"$\xi$ = %g" % xi))
+        ax.set_title(f"Fig. {fig_msd.replace('_', '.')}: MSD, " + rf"$\xi$ = {xi:g}")
         names.append(_save(fig, out, f"fig{fig_msd}_msd_xi{xi}.png"))
         fig, ax = _fig()
         dims = [analysis.diffusivity(t, run["msd"]) for run in r.runs]
-        dm, de = analysis.ensemble_mean(dims)
+        dm, _ = analysis.ensemble_mean(dims)
         plot.diffusivity(t, dm, theory_values=c.D0 / (1 + t / c.tau0), ax=ax, label="EDMD")
-        ax.set_title(f"Fig. {fig_d.replace('_', '.')}: diffusivity, " + (r"$\xi$ = %g" % xi))
+        ax.set_title(f"Fig. {fig_d.replace('_', '.')}: diffusivity, " + rf"$\xi$ = {xi:g}")
         names.append(_save(fig, out, f"fig{fig_d}_diffusivity_xi{xi}.png"))
         if xi in THESIS_SLOPES:
             log = xi < 1
-            slope = lambda msd: analysis.fit_slope(t[window], msd[window], log=log)[0]  # noqa: E731
+
+            def slope(msd, log=log):
+                return analysis.fit_slope(t[window], msd[window], log=log)[0]
+
             measured, thesis_theory = THESIS_SLOPES[xi]
             asymptote = ("6 D0", 6 * c.D0) if xi == 1 else ("6 D0 tau0", 6 * c.D0 * c.tau0)
             quantity = (
@@ -424,7 +429,8 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
             if log:
                 ax.set_xscale("log")
             ax.set_title(
-                f"Fig. F.{1 if xi == 1 else 2}: slope {row['ours']:.3f} vs theory {row['theory']:.3f}"
+                f"Fig. F.{1 if xi == 1 else 2}: slope {row['ours']:.3f} vs theory "
+                f"{row['theory']:.3f}"
             )
     names.append(_save(figF, out, "figF_linear_axes.png"))
     return names, rows
@@ -727,21 +733,21 @@ def _notes(cfg, by_id):
 
     haff = [
         "(2.45) is Enskog's tau0 for a homogeneous cooling state with a Maxwellian velocity "
-        "distribution.  The real cooling state is not quite Maxwellian (Sonine coefficient a2), and "
-        "inelastic collisions build up velocity correlations and, at late times, inhomogeneities: "
-        "corrections of a few percent that grow with 1 - xi."
+        "distribution.  The real cooling state is not quite Maxwellian (Sonine coefficient a2), "
+        "and inelastic collisions build up velocity correlations and, at late times, "
+        "inhomogeneities: corrections of a few percent that grow with 1 - xi."
     ]
     above, below = significant("haff.", 1), significant("haff.", -1)
     if above:
         haff.append(
-            f"Where the fit lies above (2.45) (xi = {', '.join(map(_xi, above))}) the gas cools more "
-            "slowly than that theory says; the thesis too found 'computed values somewhat higher "
-            "than theory' at low xi."
+            f"Where the fit lies above (2.45) (xi = {', '.join(map(_xi, above))}) the gas cools "
+            "more slowly than that theory says; the thesis too found 'computed values somewhat "
+            "higher than theory' at low xi."
         )
     if below:
         haff.append(
-            f"Where the fit lies below (2.45) (xi = {', '.join(map(_xi, below))}) the gas cools faster "
-            "than that theory says."
+            f"Where the fit lies below (2.45) (xi = {', '.join(map(_xi, below))}) the gas cools "
+            "faster than that theory says."
         )
     if not above and not below:
         haff.append(f"Every fitted tau0 agrees with (2.45) within {SIGMA:g} standard errors.")
@@ -760,9 +766,10 @@ def _notes(cfg, by_id):
             "(N = 1000) are quoted, not compared."
         )
     slopes.append(
-        f"The thesis measured its molecular slope {m1:.3f} against 6 D0 = {t1:.3f} ({m1 / t1 - 1:+.0%}); "
-        f"(2.52) for its system gives 6 D0 = {6 * c1.D0:.3f}.  For xi = 0.8 it measured {m8:.3f} and "
-        f"quoted {t8:.3f} as theory, while (2.45) and (2.52) for its system give 6 D0 tau0 = {ours8:.3f}"
+        f"The thesis measured its molecular slope {m1:.3f} against 6 D0 = {t1:.3f} "
+        f"({m1 / t1 - 1:+.0%}); (2.52) for its system gives 6 D0 = {6 * c1.D0:.3f}.  For xi = 0.8 "
+        f"it measured {m8:.3f} and quoted {t8:.3f} as theory, while (2.45) and (2.52) for its "
+        f"system give 6 D0 tau0 = {ours8:.3f}"
         + (
             ": its theory value does not follow from its own equations."
             if abs(ours8 / t8 - 1) > 0.02
@@ -773,8 +780,8 @@ def _notes(cfg, by_id):
     if above:
         slopes.append(
             f"Where our slope lies above theory ({', '.join(r['id'] for r in above)}): Enskog's D0 "
-            "(2.52) neglects velocity correlations and underestimates hard-sphere self-diffusion by "
-            "a few percent at eta = 0.065, and for xi < 1 a tau0 above (2.45) (see Haff's law) "
+            "(2.52) neglects velocity correlations and underestimates hard-sphere self-diffusion "
+            "by a few percent at eta = 0.065, and for xi < 1 a tau0 above (2.45) (see Haff's law) "
             "raises the slope against ln t further."
         )
 
@@ -782,9 +789,9 @@ def _notes(cfg, by_id):
     g_max = max(c.gamma0 for c in cq.values()) * 0.01
     g_dt1, g_thesis = cq[0.8].gamma0, c8.gamma0
     sde = [
-        f"Euler-Maruyama at dt = 0.01 (gamma0 dt up to {g_max:.3f} here) biases the stationary <v^2> by "
-        f"up to 2 / (2 - gamma0 dt) - 1 = {2 / (2 - g_max) - 1:.1%}; the theory includes the transient "
-        "of the thesis' fixed initial speed sqrt(2).",
+        f"Euler-Maruyama at dt = 0.01 (gamma0 dt up to {g_max:.3f} here) biases the stationary "
+        f"<v^2> by up to 2 / (2 - gamma0 dt) - 1 = {2 / (2 - g_max) - 1:.1%}; the theory includes "
+        "the transient of the thesis' fixed initial speed sqrt(2).",
         f"At dt = 1 (Fig. 4.20) gamma0 dt = {g_dt1:.1f} for xi = 0.8 here"
         + (
             ", past Euler-Maruyama's stability limit 2, so the figure shows the exact scheme there."
@@ -792,14 +799,15 @@ def _notes(cfg, by_id):
             else ", within Euler-Maruyama's stability limit 2."
         )
         + (
-            f"  With the thesis' coefficients gamma0 dt = {g_thesis:.1f}: its dt = 1 curve cannot have been "
-            "Euler-Maruyama as printed."
+            f"  With the thesis' coefficients gamma0 dt = {g_thesis:.1f}: its dt = 1 curve cannot "
+            "have been Euler-Maruyama as printed."
             if g_thesis >= 2
             else ""
         ),
-        "UDSBM is a model of the granular gas, not the gas: it tracks the EDMD MSD only up to O(1 - xi), "
-        "because its velocity autocorrelation (2.111) differs from the gas' (2.77) unless gamma0 tau0 >> 1 "
-        f"(thesis 4.2.2); here gamma0 tau0 = {cq[0.8].gamma0 * cq[0.8].tau0:.1f} at xi = 0.8.",
+        "UDSBM is a model of the granular gas, not the gas: it tracks the EDMD MSD only up to "
+        "O(1 - xi), because its velocity autocorrelation (2.111) differs from the gas' (2.77) "
+        "unless gamma0 tau0 >> 1 (thesis 4.2.2); here gamma0 tau0 = "
+        f"{cq[0.8].gamma0 * cq[0.8].tau0:.1f} at xi = 0.8.",
     ]
 
     ud = by_id["ergodicity.udsbm"]
@@ -839,8 +847,8 @@ def _report(rows, cfg, names, seconds):
         f"{cfg.runs_few} runs where the thesis used 4, {cfg.runs_many} where it used 20"
         + (" (quick mode: small sizes, short times)" if cfg.quick else "")
         + f". Took {seconds:.0f} s.",
-        "Errors are standard errors of the mean over the runs (central limit theorem); 'agrees' means "
-        f"within {SIGMA:g} of them.",
+        "Errors are standard errors of the mean over the runs (central limit theorem); 'agrees' "
+        f"means within {SIGMA:g} of them.",
         "",
         "| id | quantity | ours | runs | thesis | theory | ours/theory - 1 |",
         "|---|---|---|---|---|---|---|",
@@ -849,8 +857,8 @@ def _report(rows, cfg, names, seconds):
         rel = f"{r['ours'] / r['theory'] - 1:+.2%}" if r["theory"] else "--"
         quantity = r["quantity"].replace("|", "\\|")
         lines.append(
-            f"| {r['id']} | {quantity} | {_fmt(r['ours'], r['ours_error'])} | {r['runs'] or '--'} | "
-            f"{_num(r['thesis'])} | {_num(r['theory'])} | {rel} |"
+            f"| {r['id']} | {quantity} | {_fmt(r['ours'], r['ours_error'])} | {r['runs'] or '--'} "
+            f"| {_num(r['thesis'])} | {_num(r['theory'])} | {rel} |"
         )
     lines += ["", "## Where we agree, and where not"]
     by_id = {r["id"]: r for r in rows}
@@ -862,9 +870,9 @@ def _report(rows, cfg, names, seconds):
         "",
         "### Slips of the thesis, corrected",
         "",
-        "Isotropic initial directions instead of eq. 3.3 (a uniform polar angle puts too much speed along "
-        "z), the mean collision time of (2.42) instead of (2.70)-(2.71) (which make it proportional to "
-        "sqrt(T)), and the Euler-Maruyama noise term sqrt(2D) gamma dW.",
+        "Isotropic initial directions instead of eq. 3.3 (a uniform polar angle puts too much "
+        "speed along z), the mean collision time of (2.42) instead of (2.70)-(2.71) (which make "
+        "it proportional to sqrt(T)), and the Euler-Maruyama noise term sqrt(2D) gamma dW.",
         "",
         "## Figures",
         "",

@@ -77,7 +77,7 @@ def _errors(times, msd, t_ref, ref, slope_ref, log, t_fit):
     return float(np.max(np.abs(msd[ok] / ref_at - 1))), float(abs(slope / slope_ref - 1))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _equilibrated(n, seed):
     """N particles at the standard density (box scaled), equilibrated at T0, and the CPU
     seconds that took (cached: both gases start from the same state)."""
@@ -133,7 +133,22 @@ def speed_accuracy_points(quick=False):
         )
         slope_th = analysis.fit_slope(times[sel], th[sel], log=log)[0]
 
-        def add(method, label, msd, seconds, at=times, **extra):
+        # this iteration's reference and theory bound as defaults, not looked up at call time
+        def add(
+            method,
+            label,
+            msd,
+            seconds,
+            at=times,
+            *,
+            xi=xi,
+            ref=ref,
+            slope_ref=slope_ref,
+            th=th,
+            slope_th=slope_th,
+            log=log,
+            **extra,
+        ):
             e_ref, s_ref = _errors(at, msd, times, ref, slope_ref, log, t_fit)
             e_th, s_th = _errors(at, msd, times, th, slope_th, log, t_fit)
             points.append(
@@ -429,7 +444,7 @@ def _collapse_map(plt, cells):
     fig, axes = plt.subplots(
         1, len(tcs), figsize=(4.5 * len(tcs) + 1.5, 4.2), layout="constrained", squeeze=False
     )
-    for ax, tc in zip(axes[0], tcs):
+    for ax, tc in zip(axes[0], tcs, strict=True):
         for c in (c for c in cells if c["contact_duration"] == tc):
             x, y = etas.index(c["eta"]), xis.index(c["xi"])
             ax.add_patch(
@@ -571,7 +586,8 @@ def main(out="speed-accuracy", quick=False):
     print(f"{'method':<34} {'CPU s':>8} {'MSD err':>8} {'slope err':>9}")
     for p in points:
         print(
-            f"{p['gas'][:4] + ' ' + p['label']:<34} {p['seconds']:>8.2f} {p['msd_error']:>8.3f} {p['slope_error']:>9.3f}"
+            f"{p['gas'][:4] + ' ' + p['label']:<34} {p['seconds']:>8.2f} {p['msd_error']:>8.3f} "
+            f"{p['slope_error']:>9.3f}"
         )
     print(f"charts and speed_accuracy.json in {out}/ ({time.perf_counter() - started:.0f} s)")
     return dict(

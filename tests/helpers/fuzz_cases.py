@@ -197,7 +197,7 @@ def _shape(key):
             np.concatenate([a, a[:1]]),
             a[None],
             a.reshape(len(a), -1)[:, :1],
-            np.zeros((0,) + a.shape[1:]),
+            np.zeros((0, *a.shape[1:])),
         ][choice]
         return f"{key} reshaped to {np.shape(p[key])}"
 
@@ -267,7 +267,7 @@ def _mass_spread(rng, p):
 SCENE_MUTATIONS = [
     _entry("positions", [NAN, INF, -INF]),
     _shape("positions"),
-    _set("positions", WRONG_TYPES + [[[0.1, 0.1], [0.5]], np.array([["a", "b"]])]),
+    _set("positions", [*WRONG_TYPES, [[0.1, 0.1], [0.5]], np.array([["a", "b"]])]),
     _entry("velocities", [NAN, INF, 1e154, 1e300]),
     _shape("velocities"),
     _set("velocities", WRONG_TYPES),
@@ -288,9 +288,9 @@ SCENE_MUTATIONS = [
     _scale(1e-150),
     _scale(1e150),
     _set("boundary", ["wall", "", None, 3, "PERIODIC"]),
-    _set("wall_restitution", EXTREME + [2.0, 1e3] + WRONG_TYPES),
-    _set("restitution", EXTREME + [-0.1, 1.1, 1 - 1e-16, "0.5", 1j, None]),
-    _set("contact_duration", EXTREME + ["x", None]),
+    _set("wall_restitution", [*EXTREME, 2.0, 1e3, *WRONG_TYPES]),
+    _set("restitution", [*EXTREME, -0.1, 1.1, 1 - 1e-16, "0.5", 1j, None]),
+    _set("contact_duration", [*EXTREME, "x", None]),
     _overlap("same place"),
     _overlap("overlap 1e-9"),
     _overlap("touching"),
@@ -308,12 +308,12 @@ RANDOM_MUTATIONS = [
         + [(1e15, 1e15 + 1), (1e13, 1e13 + 1), (1.0, 0.0), ([0, 0], [1, 1]), 1e-300],
     ),
     _set("boundary", ["wall", None, 0]),
-    _set("restitution", EXTREME + [-0.1, 1.1, "1"]),
+    _set("restitution", [*EXTREME, -0.1, 1.1, "1"]),
     _set("speed", EXTREME + WRONG_TYPES + [1e200]),
     _set("temperature", EXTREME + WRONG_TYPES),
     _set("mass", EXTREME + WRONG_TYPES + [1e308, 5e-324, [1.0, 2.0]]),
-    _set("wall_restitution", EXTREME + [2.0, 1e3]),
-    _set("contact_duration", EXTREME + ["x"]),
+    _set("wall_restitution", [*EXTREME, 2.0, 1e3]),
+    _set("contact_duration", [*EXTREME, "x"]),
     _set("seed", [-1, "abc", 1.5, NAN, [1, 2], 2**200]),
     _set("remove_drift", ["no", None, 2]),
 ]
@@ -547,7 +547,7 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
     if traj.positions is not None and traj.velocities is not None:
         length = scene.upper - scene.lower
         every = max(1, len(traj.times) // 20)  # at most ~20 samples checked for overlaps
-        for x, v in zip(traj.positions[::every], traj.velocities[::every]):
+        for x, v in zip(traj.positions[::every], traj.velocities[::every], strict=True):
             if scene.boundary == "periodic":
                 x = scene.lower + np.mod(x - scene.lower, length)
                 x = np.where(x >= scene.upper, scene.lower, x)  # mod can round up to L
@@ -560,7 +560,7 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
                 box=(scene.lower, scene.upper),
                 boundary=scene.boundary,
             )
-    sim.scene  # the final state, checked the same way
+    _ = sim.scene  # the final state, checked the same way (the property builds a Scene)
     elastic = scene.restitution == 1 and (
         scene.boundary == "periodic" or scene.wall_restitution == 1
     )
