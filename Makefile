@@ -2,12 +2,13 @@
 #   make demo   -- set up .venv and run the main job
 #   make test   -- set up .venv and run the whole test suite (CI)
 #   make test-quick -- the same without the tests marked slow, for daily work
+#   make lint   -- ruff check and ruff format --check (CI runs it before the tests)
 # and for the C core: make test-asan (the suite against an ASan + UBSan build, in its own venv)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: setup demo test test-quick test-asan test-asan-ci bench clean
+.PHONY: setup demo test test-quick lint test-asan test-asan-ci bench clean
 
 $(VENV)/.installed: pyproject.toml setup.py $(wildcard csrc/*.c csrc/*.h)
 	$(PYTHON) -m venv $(VENV)
@@ -26,6 +27,10 @@ test: setup
 # the slowest tests (pytest.mark.slow: the CLI runs, long physics checks) left out
 test-quick: setup
 	$(PY) -m pytest -q -m "not slow"
+
+# lint and formatting; the configuration is pyproject.toml's [tool.ruff*]
+lint: setup
+	$(PY) -m ruff check . && $(PY) -m ruff format --check .
 
 bench: setup
 	$(PY) -m granular bench --json bench.json

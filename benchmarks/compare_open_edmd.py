@@ -33,6 +33,7 @@ them: its setup (8 s at N = 1e6) and final snapshot are not timed.  granular the
 same number of pair collisions in one window after building and equilibrating the gas,
 which is not timed either (bench.edmd_workload with one window).
 """
+
 import argparse
 import math
 import os
@@ -60,7 +61,7 @@ def write_init(path, m, eta):
     other code's init.sph format (N; box lengths; one 'a x y z radius' line each)."""
     if not 0.0 < eta < math.pi / 6.0:
         raise ValueError(f"a simple cubic lattice holds packing fractions below pi/6, not {eta}")
-    n = m ** 3
+    n = m**3
     box = (n * math.pi / 6.0 / eta) ** (1.0 / 3.0)
     a = box / m
     with open(path, "w") as f:
@@ -75,8 +76,9 @@ def run_other(directory, eta):
     """Run ./md in directory, line-buffered; (pair collisions, seconds) between its first
     and its last report ("Simtime: t, Collisions: c, ..."), so that neither its setup (8 s
     at N = 1e6) nor its final snapshot is timed, as granular's setup is not."""
-    proc = subprocess.Popen(["stdbuf", "-oL", "./md"], cwd=directory, stdout=subprocess.PIPE,
-                            text=True)
+    proc = subprocess.Popen(
+        ["stdbuf", "-oL", "./md"], cwd=directory, stdout=subprocess.PIPE, text=True
+    )
     reports, packing = [], None
     for line in proc.stdout:
         now = time.perf_counter()
@@ -101,24 +103,36 @@ def run_granular(name, pairs):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--other", action="append", default=[], metavar="WORKLOAD=DIR",
-                   help="a prepared run directory of the other code; workloads: "
-                        + ", ".join(WORKLOADS))
+    p = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    p.add_argument(
+        "--other",
+        action="append",
+        default=[],
+        metavar="WORKLOAD=DIR",
+        help="a prepared run directory of the other code; workloads: " + ", ".join(WORKLOADS),
+    )
     p.add_argument("--repeats", type=int, default=2)
     p.add_argument("--plot", metavar="FILE", help="also chart the figures into FILE (PNG)")
-    p.add_argument("--write-init", nargs=3, metavar=("M", "ETA", "FILE"),
-                   help="write an M**3 simple cubic lattice at packing fraction ETA and exit")
-    p.add_argument("--tiny", action="store_true",
-                   help="granular's side and --write-init at a tiny size, no other code (CI)")
+    p.add_argument(
+        "--write-init",
+        nargs=3,
+        metavar=("M", "ETA", "FILE"),
+        help="write an M**3 simple cubic lattice at packing fraction ETA and exit",
+    )
+    p.add_argument(
+        "--tiny",
+        action="store_true",
+        help="granular's side and --write-init at a tiny size, no other code (CI)",
+    )
     args = p.parse_args()
     if args.tiny:
         with tempfile.TemporaryDirectory() as folder:
             path = os.path.join(folder, "init.sph")
             write_init(path, 4, 0.065)
             with open(path) as f:
-                if len(f.readlines()) != 2 + 4 ** 3:
+                if len(f.readlines()) != 2 + 4**3:
                     raise RuntimeError(f"{path}: not the N + 2 lines of an init.sph")
         r = edmd_workload("3d-tiny-0.065", 3, 500, 0.065, 2.0, windows=1)
         print(f"{r['name']:14s} {'granular':12s} {r['pair_collisions']:16d} {r['seconds']:8.2f}")
@@ -145,8 +159,10 @@ def main():
 
     def report(name, code, pairs, seconds):
         rows.append((name, code, pairs / seconds))
-        print(f"{name:14s} {code:12s} {pairs:16d} {seconds:8.2f} {pairs / seconds / 1e6:7.3f}",
-              flush=True)
+        print(
+            f"{name:14s} {code:12s} {pairs:16d} {seconds:8.2f} {pairs / seconds / 1e6:7.3f}",
+            flush=True,
+        )
 
     print(f"{'workload':14s} {'code':12s} {'pair collisions':>16s} {'seconds':>8s} {'M/s':>7s}")
     for _ in range(args.repeats):
@@ -171,22 +187,33 @@ def plot(rows, path):
     for code, colour in (("granular", "C0"), ("Smallenburg", "C1")):
         label = "granular" if code == "granular" else "Smallenburg's EDMD"
         for dense in (False, True):
-            mine = [(WORKLOADS[name][0], rate) for name, c, rate in rows
-                    if c == code and (WORKLOADS[name][1] > 0.1) == dense]
+            mine = [
+                (WORKLOADS[name][0], rate)
+                for name, c, rate in rows
+                if c == code and (WORKLOADS[name][1] > 0.1) == dense
+            ]
             if not mine:
                 continue
             n, rate = np.array(mine).T
-            ax.plot(n, rate / 1e6, "s" if dense else "o", color=colour,
-                    mfc="none" if dense else colour,
-                    label=f"{label}, packing 0.45" if dense else f"{label}, packing 0.065")
+            ax.plot(
+                n,
+                rate / 1e6,
+                "s" if dense else "o",
+                color=colour,
+                mfc="none" if dense else colour,
+                label=f"{label}, packing 0.45" if dense else f"{label}, packing 0.065",
+            )
             if not dense:
                 ns = np.unique(n)
                 ax.plot(ns, [rate[n == v].mean() / 1e6 for v in ns], "-", color=colour)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-    ax.yaxis.set_minor_formatter(matplotlib.ticker.FuncFormatter(
-        lambda v, _: f"{v:g}" if round(v / 10 ** math.floor(math.log10(v))) in (2, 3, 5) else ""))
+    ax.yaxis.set_minor_formatter(
+        matplotlib.ticker.FuncFormatter(
+            lambda v, _: f"{v:g}" if round(v / 10 ** math.floor(math.log10(v))) in (2, 3, 5) else ""
+        )
+    )
     ax.set_xlabel("particles N (3D, periodic, monodisperse)")
     ax.set_ylabel("pair collisions per second (millions)")
     ax.set_title("one thread, same machine, interleaved runs")

@@ -7,15 +7,24 @@ that checks them against theory.
 >>> scene = granular.Scene.random(1000, 0.025, restitution=0.8, seed=1)
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
-from . import errors
-from .errors import (FrozenGasError, GranularError, HeatedWallsError, InelasticCollapseError,
-                     NoProgressError, NonFiniteError, OutsideBoxError, OverlapError,
-                     ProcessBackendError, UnstableStepError)
+
+from . import analysis, errors, langevin, theory
+from .ensemble import EnsembleResult, ensemble
+from .errors import (
+    FrozenGasError,
+    GranularError,
+    HeatedWallsError,
+    InelasticCollapseError,
+    NonFiniteError,
+    NoProgressError,
+    OutsideBoxError,
+    OverlapError,
+    ProcessBackendError,
+    UnstableStepError,
+)
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
-from .ensemble import EnsembleResult, ensemble
-from . import analysis, langevin, theory
 
 __version__ = "0.1.0"
 
@@ -37,8 +46,11 @@ def __getattr__(name):
     if name in _MOVED:
         import warnings
 
-        warnings.warn(f"granular.{name} moved to granular.cli.{name}; the old name goes in the "
-                      f"next release", DeprecationWarning, stacklevel=2)
+        warnings.warn(
+            f"granular.{name} moved to granular.cli.{name}; the old name goes in the next release",
+            DeprecationWarning,
+            stacklevel=2,
+        )
         return importlib.import_module(f".cli.{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
@@ -46,7 +58,25 @@ def __getattr__(name):
 def __dir__():
     return sorted(list(globals()) + list(_LAZY))
 
-__all__ = ["Scene", "Simulation", "Trajectory", "ensemble", "EnsembleResult", "analysis",
-           "langevin", "theory", "errors", "GranularError", "OverlapError",
-           "OutsideBoxError", "InelasticCollapseError", "HeatedWallsError", "NoProgressError",
-           "FrozenGasError", "NonFiniteError", "ProcessBackendError", "UnstableStepError"]
+
+__all__ = [
+    "EnsembleResult",
+    "FrozenGasError",
+    "GranularError",
+    "HeatedWallsError",
+    "InelasticCollapseError",
+    "NoProgressError",
+    "NonFiniteError",
+    "OutsideBoxError",
+    "OverlapError",
+    "ProcessBackendError",
+    "Scene",
+    "Simulation",
+    "Trajectory",
+    "UnstableStepError",
+    "analysis",
+    "ensemble",
+    "errors",
+    "langevin",
+    "theory",
+]

@@ -3,6 +3,7 @@
 Thin on purpose: it parses the arguments, checks the optional modules the command needs and
 only then imports the application from granular.cli (applications built on the library,
 which the library never imports)."""
+
 from __future__ import annotations
 
 import argparse
@@ -11,8 +12,11 @@ import sys
 
 # Optional modules a command imports only when it draws, and the extra that installs each:
 # checked before the command starts, so that a missing one never loses minutes of work.
-_NEEDS = {"demo": ("matplotlib",), "reproduce": ("matplotlib",),
-          "bench --speed-accuracy": ("matplotlib",)}
+_NEEDS = {
+    "demo": ("matplotlib",),
+    "reproduce": ("matplotlib",),
+    "bench --speed-accuracy": ("matplotlib",),
+}
 _EXTRA = {"matplotlib": "plot"}
 
 
@@ -22,8 +26,9 @@ def _missing(modules):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m granular",
-                                     description="Molecular and granular gases of hard spheres.")
+    parser = argparse.ArgumentParser(
+        prog="python -m granular", description="Molecular and granular gases of hard spheres."
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="a granular and a molecular gas against theory")
     demo.add_argument("--out", default="granular-demo", help="output folder for figures")
@@ -36,8 +41,11 @@ def main(argv=None):
     bench.add_argument("--json", metavar="FILE", help="write the figures as JSON")
     bench.add_argument("--quick", action="store_true", help="tiny workloads (seconds)")
     bench.add_argument("--large", action="store_true", help="add N = 1e6")
-    bench.add_argument("--speed-accuracy", action="store_true",
-                       help="chart error against cost and map where methods fail")
+    bench.add_argument(
+        "--speed-accuracy",
+        action="store_true",
+        help="chart error against cost and map where methods fail",
+    )
     bench.add_argument("--out", default="speed-accuracy", help="output folder (--speed-accuracy)")
     args = parser.parse_args(argv)
 
@@ -45,8 +53,11 @@ def main(argv=None):
     missing = _missing(_NEEDS.get(command, ()))
     if missing:
         extras = ",".join(sorted({_EXTRA[m] for m in missing}))
-        print(f"python -m granular {command} needs {', '.join(missing)}, which is not "
-              f"installed: pip install 'granular[{extras}]'", file=sys.stderr)
+        print(
+            f"python -m granular {command} needs {', '.join(missing)}, which is not "
+            f"installed: pip install 'granular[{extras}]'",
+            file=sys.stderr,
+        )
         return 2
 
     if args.command == "demo":

@@ -4,6 +4,7 @@ Shapes: ``times (T,)``, ``positions (T, N, d)`` unwrapped, ``velocities (T, N, d
 ``(N, d)`` for one snapshot.  MSDs are totals over the d dimensions unless asked per
 dimension, as in ``granular.theory``.
 """
+
 from __future__ import annotations
 
 import math
@@ -32,6 +33,7 @@ def _times(times, count=None):
 
 # -- mean squared displacements -------------------------------------------------------------
 
+
 def _select(x, particles):
     """Positions (T, N, d) of the chosen particles: indices, or a boolean mask over all N."""
     if particles is None:
@@ -40,8 +42,10 @@ def _select(x, particles):
     n = x.shape[1]
     if p.dtype == bool:
         if p.shape != (n,):
-            raise ValueError(f"a boolean particles mask must have one entry per particle "
-                             f"({n}), got shape {p.shape}")
+            raise ValueError(
+                f"a boolean particles mask must have one entry per particle "
+                f"({n}), got shape {p.shape}"
+            )
         p = np.nonzero(p)[0]
     elif p.size and not np.issubdtype(p.dtype, np.integer):
         raise TypeError(f"particles must be indices (integers) or a boolean mask, got {p.dtype}")
@@ -53,8 +57,9 @@ def _select(x, particles):
     return x[:, p, :]
 
 
-def msd(positions: ArrayLike, per_dimension: bool = False,
-        particles: ArrayLike | None = None) -> NDArray[np.float64]:
+def msd(
+    positions: ArrayLike, per_dimension: bool = False, particles: ArrayLike | None = None
+) -> NDArray[np.float64]:
     """Ensemble MSD ``<|x(t) - x(0)|^2>`` over particles at every sample (any spacing).
 
     Returns (T,) summed over dimensions, or (T, d) with ``per_dimension=True``.
@@ -72,9 +77,16 @@ def _uniform(times):
     return len(dt) > 0 and np.allclose(dt, dt[0], rtol=1e-9, atol=0)
 
 
-def tamsd(positions: ArrayLike, lags: ArrayLike | None = None, times: ArrayLike | None = None,
-          *, lag_samples: ArrayLike | None = None, method: str = "auto",
-          per_particle: bool = False, particles: ArrayLike | None = None) -> NDArray[np.float64]:
+def tamsd(
+    positions: ArrayLike,
+    lags: ArrayLike | None = None,
+    times: ArrayLike | None = None,
+    *,
+    lag_samples: ArrayLike | None = None,
+    method: str = "auto",
+    per_particle: bool = False,
+    particles: ArrayLike | None = None,
+) -> NDArray[np.float64]:
     """Time-averaged MSD (thesis 2.114-2.115) at the given lags, averaged over particles.
 
     For each particle, ``delta^2(lag) = mean_k |x(t_k + lag) - x(t_k)|^2`` over all sample
@@ -114,15 +126,19 @@ def tamsd(positions: ArrayLike, lags: ArrayLike | None = None, times: ArrayLike 
                 raise ValueError(f"lag_samples must be whole numbers of samples, got {k}")
         k = k.astype(np.int64)
         if np.any(k < 1) or np.any(k > T - 1):
-            raise ValueError(f"lag_samples must be between 1 and {T - 1} (the trajectory "
-                             f"has {T} samples), got {k}")
+            raise ValueError(
+                f"lag_samples must be between 1 and {T - 1} (the trajectory "
+                f"has {T} samples), got {k}"
+            )
         if times is not None and not uniform:
             raise ValueError("lag_samples needs uniformly spaced samples; give lags in time")
         lags = k * (t[1] - t[0])
     lags = np.atleast_1d(np.asarray(lags, dtype=np.float64))
     if not np.all(np.isfinite(lags)) or np.any(lags <= 0) or np.any(lags > t[-1] - t[0]):
-        raise ValueError(f"lags must be positive and no longer than the trajectory "
-                         f"({t[-1] - t[0]:g}), got {lags}")
+        raise ValueError(
+            f"lags must be positive and no longer than the trajectory "
+            f"({t[-1] - t[0]:g}), got {lags}"
+        )
     if method == "auto":
         method = "fft" if uniform else "direct"
     if method == "fft":
@@ -138,7 +154,8 @@ def tamsd(positions: ArrayLike, lags: ArrayLike | None = None, times: ArrayLike 
             raise ValueError(
                 f"lag {lag:g} is not a multiple of the sample spacing {spacing:g}; the "
                 f"nearest lags that are: {below:g} and {below + spacing:g} (or give "
-                "lag_samples= in samples)")
+                "lag_samples= in samples)"
+            )
         out = _tamsd_fft(x, k)
     elif method == "direct":
         out = _tamsd_direct(x, t, lags)
@@ -150,12 +167,12 @@ def tamsd(positions: ArrayLike, lags: ArrayLike | None = None, times: ArrayLike 
 def _tamsd_fft(x, k, chunk_bytes=2**27):
     """(N, L) TAMSD at integer lags k by the FFT algorithm, in chunks of particles."""
     T, N, d = x.shape
-    nfft = 1 << int(math.ceil(math.log2(2 * T)))
+    nfft = 1 << math.ceil(math.log2(2 * T))
     out = np.empty((N, len(k)))
     per_particle = 16 * (nfft // 2 + 1) * d + 8 * T * d
     step = max(1, int(chunk_bytes // per_particle))
     for lo in range(0, N, step):
-        y = x[:, lo:lo + step, :] - x[0, lo:lo + step, :]  # relative to the start
+        y = x[:, lo : lo + step, :] - x[0, lo : lo + step, :]  # relative to the start
         f = np.fft.rfft(y, n=nfft, axis=0)
         auto = np.fft.irfft(f * f.conj(), n=nfft, axis=0)[:T]  # sum_j y_j y_{j+m}
         sq = np.cumsum(y * y, axis=0)  # Q[m] = sum_{j<=m} y_j^2
@@ -163,7 +180,7 @@ def _tamsd_fft(x, k, chunk_bytes=2**27):
         head = sq[T - 1 - k]  # sum_{j=0}^{T-1-m} y_j^2
         tail = total - np.where((k >= 1)[:, None, None], sq[np.maximum(k - 1, 0)], 0.0)
         s = (head + tail - 2.0 * auto[k]) / (T - k)[:, None, None]
-        out[lo:lo + step] = s.sum(axis=2).T
+        out[lo : lo + step] = s.sum(axis=2).T
     return out
 
 
@@ -201,8 +218,13 @@ def diffusivity(times: ArrayLike, msd_values: ArrayLike, dim: int = 3) -> NDArra
     return deriv / (2.0 * dim)
 
 
-def fit_slope(times: ArrayLike, values: ArrayLike, t_min: float | None = None,
-              t_max: float | None = None, log: bool = False) -> tuple[float, float, float]:
+def fit_slope(
+    times: ArrayLike,
+    values: ArrayLike,
+    t_min: float | None = None,
+    t_max: float | None = None,
+    log: bool = False,
+) -> tuple[float, float, float]:
     """Least-squares straight line through ``values`` against ``times`` (or against
     ``ln(times)`` with ``log=True``: the long-time MSD of a granular gas grows like
     ln t) between t_min and t_max, as in the thesis' App. F.
@@ -221,7 +243,7 @@ def fit_slope(times: ArrayLike, values: ArrayLike, t_min: float | None = None,
         raise ValueError("fit_slope needs at least three points in [t_min, t_max]")
     xs = np.log(t[sel]) if log else t[sel]
     A = np.vstack([xs, np.ones_like(xs)]).T
-    coef, res, *_ = np.linalg.lstsq(A, v[sel], rcond=None)
+    coef, *_ = np.linalg.lstsq(A, v[sel], rcond=None)
     dof = len(xs) - 2
     resid = v[sel] - A @ coef
     s2 = float(resid @ resid) / dof if dof > 0 else np.nan
@@ -230,6 +252,7 @@ def fit_slope(times: ArrayLike, values: ArrayLike, t_min: float | None = None,
 
 
 # -- velocities ------------------------------------------------------------------------------
+
 
 def temperature(velocities: ArrayLike, masses: ArrayLike = 1.0) -> float | NDArray[np.float64]:
     """Granular temperature ``T = 2 E_kin / (d N)`` of each snapshot ((N, d) -> scalar,
@@ -250,9 +273,11 @@ def _speeds(velocities):
     return np.linalg.norm(v, axis=-1).ravel(), v.shape[-1]
 
 
-def speed_histogram(velocities: ArrayLike, bins: int | ArrayLike = 50,
-                    range: tuple[float, float] | None = None,
-                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def speed_histogram(
+    velocities: ArrayLike,
+    bins: int | ArrayLike = 50,
+    range: tuple[float, float] | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Normalised histogram of the speeds in one or more snapshots.
 
     Returns (bin centres, density, standard error of the density) -- the error from the
@@ -262,11 +287,16 @@ def speed_histogram(velocities: ArrayLike, bins: int | ArrayLike = 50,
     counts, edges = np.histogram(speed, bins=bins, range=range)
     width = np.diff(edges)
     total = counts.sum()
-    return 0.5 * (edges[1:] + edges[:-1]), counts / (total * width), np.sqrt(counts) / (total * width)
+    return (
+        0.5 * (edges[1:] + edges[:-1]),
+        counts / (total * width),
+        np.sqrt(counts) / (total * width),
+    )
 
 
-def speed_statistics(velocities: ArrayLike, temperature: float | None = None,
-                     masses: ArrayLike = 1.0) -> dict[str, dict[str, float]]:
+def speed_statistics(
+    velocities: ArrayLike, temperature: float | None = None, masses: ArrayLike = 1.0
+) -> dict[str, dict[str, float]]:
     """Mean speed, mean squared speed and standard deviation of the speed (Table 4.1),
     with the Maxwell-Boltzmann values at ``temperature`` (default: the snapshots' own
     temperature) and the relative errors ``ours / theory - 1``.  As in the thesis, the
@@ -279,12 +309,15 @@ def speed_statistics(velocities: ArrayLike, temperature: float | None = None,
     T = float(np.mean(_snapshot_temperature(v, masses))) if temperature is None else temperature
     mb = theory.maxwell_boltzmann_moments(T, mass, dim)
     ours = {"mean": speed.mean(), "mean_sq": np.mean(speed**2), "std": speed.std()}
-    return {k: {"ours": float(ours[k]), "theory": mb[k], "relative_error": float(ours[k] / mb[k] - 1)}
-            for k in ours}
+    return {
+        k: {"ours": float(ours[k]), "theory": mb[k], "relative_error": float(ours[k] / mb[k] - 1)}
+        for k in ours
+    }
 
 
-def fit_haff_tau0(times: ArrayLike, temperature_values: ArrayLike,
-                  t_max: float | None = None) -> tuple[float, float]:
+def fit_haff_tau0(
+    times: ArrayLike, temperature_values: ArrayLike, t_max: float | None = None
+) -> tuple[float, float]:
     """Fit Haff's tau0 to a cooling curve: Haff's law makes ``sqrt(T0 / T(t)) - 1 = t/tau0``
     a straight line through the origin; least squares with T0 the first sample.
 
@@ -303,8 +336,9 @@ def fit_haff_tau0(times: ArrayLike, temperature_values: ArrayLike,
     return 1.0 / k, err_k / k**2
 
 
-def ensemble_mean(values: ArrayLike,
-                  axis: int = 0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def ensemble_mean(
+    values: ArrayLike, axis: int = 0
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Mean over runs and its central-limit standard error ``std(ddof=1) / sqrt(M)``
     (thesis 2.120-2.122)."""
     # C order: NumPy's pairwise sums follow the memory layout, so a Fortran-order input

@@ -7,6 +7,7 @@ of a sweep over P models: ``SeedSequence(seed).spawn(P)[p].spawn(K)[r]``), and r
 reduced in run order, so the same seed gives bit-identical results whichever backend and
 however many workers ran them.
 """
+
 from __future__ import annotations
 
 import ast
@@ -24,9 +25,17 @@ from .errors import ProcessBackendError
 from .scene import Scene
 from .simulation import Simulation
 
-EDMD_QUANTITIES = ("msd", "msd_per_dimension", "temperature", "kinetic_energy",
-                   "collisions_per_particle", "pair_collisions", "pressure", "positions",
-                   "velocities")
+EDMD_QUANTITIES = (
+    "msd",
+    "msd_per_dimension",
+    "temperature",
+    "kinetic_energy",
+    "collisions_per_particle",
+    "pair_collisions",
+    "pressure",
+    "positions",
+    "velocities",
+)
 
 
 @dataclass(frozen=True)
@@ -62,9 +71,10 @@ _GUARD_ADVICE = (
     "Worker processes start by importing the main script, so its top-level code, this "
     "ensemble call included, runs again in each of them. Put the script's work under a "
     "main guard (the functions the runs call stay at top level, where workers find them):\n\n"
-    "    if __name__ == \"__main__\":\n"
+    '    if __name__ == "__main__":\n'
     "        result = granular.ensemble(...)\n\n"
-    "or pass backend=\"serial\" or backend=\"threads\".")
+    'or pass backend="serial" or backend="threads".'
+)
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -100,12 +110,14 @@ class EnsembleResult:
 
     def _quantity(self, name: str, hint: str) -> NDArray[np.float64]:
         if name not in self.mean:
-            raise ValueError(f"this ensemble collected no {name!r} ({hint}); it has "
-                             f"{sorted(self.mean)}")
+            raise ValueError(
+                f"this ensemble collected no {name!r} ({hint}); it has {sorted(self.mean)}"
+            )
         return self.mean[name]
 
-    def msd(self, per_dimension: bool = False,
-            particles: ArrayLike | None = None) -> NDArray[np.float64]:
+    def msd(
+        self, per_dimension: bool = False, particles: ArrayLike | None = None
+    ) -> NDArray[np.float64]:
         """The ensemble mean of the runs' MSDs at the sample times: (T,) summed over
         dimensions, or (T, d) with ``per_dimension=True`` (for EDMD, collect
         ``"msd_per_dimension"`` among ``quantities``).  Its standard error is
@@ -117,12 +129,15 @@ class EnsembleResult:
         ``quantities=("positions",)`` and ``analysis.msd(run["positions"], particles=...)``
         over ``runs``)."""
         if particles is not None:
-            raise TypeError("an ensemble holds each run's MSD averaged over its particles; "
-                            "particles= cannot apply here (choose particles in the runs: "
-                            "see EnsembleResult.msd)")
+            raise TypeError(
+                "an ensemble holds each run's MSD averaged over its particles; "
+                "particles= cannot apply here (choose particles in the runs: "
+                "see EnsembleResult.msd)"
+            )
         if per_dimension:
-            return self._quantity("msd_per_dimension", 'ensemble(quantities=(..., '
-                                  '"msd_per_dimension"))')
+            return self._quantity(
+                "msd_per_dimension", 'ensemble(quantities=(..., "msd_per_dimension"))'
+            )
         return self._quantity("msd", 'ensemble(quantities=(..., "msd"))')
 
     @property
@@ -130,9 +145,14 @@ class EnsembleResult:
         """(L,) lags in time of ``tamsd()``: those of the runs (Langevin ensembles)."""
         return self._quantity("tamsd_lags", "a TAMSD comes from Langevin runs with tamsd_lags")
 
-    def tamsd(self, lags: ArrayLike | None = None, *, lag_samples: ArrayLike | None = None,
-              particles: ArrayLike | None = None,
-              per_particle: bool = False) -> NDArray[np.float64]:
+    def tamsd(
+        self,
+        lags: ArrayLike | None = None,
+        *,
+        lag_samples: ArrayLike | None = None,
+        particles: ArrayLike | None = None,
+        per_particle: bool = False,
+    ) -> NDArray[np.float64]:
         """The ensemble mean of the runs' time-averaged MSDs, (L,), at the lags the runs
         accumulated (``tamsd_lags``: Langevin runs with ``tamsd_lags``), or at those of
         them chosen by ``lags`` (in time) or ``lag_samples`` (in steps), as
@@ -143,11 +163,16 @@ class EnsembleResult:
         EDMD ensembles collect no TAMSD: collect ``"positions"`` and apply
         ``granular.analysis.tamsd`` to each run."""
         if particles is not None or per_particle:
-            raise TypeError("an ensemble holds each run's TAMSD averaged over its particles; "
-                            "particles= and per_particle= cannot apply here (each run's rows "
-                            "are in runs[r]['tamsd_per_particle'])")
-        values = self._quantity("tamsd", "a TAMSD comes from Langevin runs with tamsd_lags; "
-                                "for EDMD collect positions and use analysis.tamsd")
+            raise TypeError(
+                "an ensemble holds each run's TAMSD averaged over its particles; "
+                "particles= and per_particle= cannot apply here (each run's rows "
+                "are in runs[r]['tamsd_per_particle'])"
+            )
+        values = self._quantity(
+            "tamsd",
+            "a TAMSD comes from Langevin runs with tamsd_lags; "
+            "for EDMD collect positions and use analysis.tamsd",
+        )
         from .langevin import _lag_indices
 
         dt = float(self._quantity("dt", "the runs' step"))
@@ -198,8 +223,11 @@ class _Accumulator:
     def result(self):
         error = {}
         for k, m2 in self.m2.items():
-            error[k] = (np.sqrt(m2 / (self.count - 1) / self.count) if self.count > 1
-                        else np.full_like(m2, np.nan))
+            error[k] = (
+                np.sqrt(m2 / (self.count - 1) / self.count)
+                if self.count > 1
+                else np.full_like(m2, np.nan)
+            )
         return self.mean, error
 
 
@@ -207,15 +235,20 @@ def _shuffle_velocities(scene, rng):
     """The thesis' way (3.8) to make independent runs from one equilibrated scene: give the
     velocity vectors to the particles in a random order."""
     if not np.all(scene.masses == scene.masses[0]):
-        raise ValueError("shuffling velocities among particles of different masses would "
-                         "change the energy; pass a function seed -> Scene instead")
+        raise ValueError(
+            "shuffling velocities among particles of different masses would "
+            "change the energy; pass a function seed -> Scene instead"
+        )
     return scene.replace(velocities=scene.velocities[rng.permutation(scene.n)])
 
 
 def _edmd_quantities(scene, run_kwargs, quantities):
     """Run EDMD on one scene and collect the requested quantities."""
-    store = tuple(s for s in ("positions", "velocities")
-                  if s in quantities or (s == "positions" and any(q.startswith("msd") for q in quantities)))
+    store = tuple(
+        s
+        for s in ("positions", "velocities")
+        if s in quantities or (s == "positions" and any(q.startswith("msd") for q in quantities))
+    )
     traj = Simulation(scene).run(store=store, **run_kwargs)
     out = {"times": traj.times}
     for q in quantities:
@@ -236,8 +269,11 @@ def _arrays_of(result):
     if callable(getattr(result, "arrays", None)):
         return dict(result.arrays())
     items = result.items() if isinstance(result, dict) else vars(result).items()
-    return {k: np.asarray(v) for k, v in items
-            if isinstance(v, (np.ndarray, float, np.floating, np.integer))}
+    return {
+        k: np.asarray(v)
+        for k, v in items
+        if isinstance(v, (np.ndarray, float, np.floating, np.integer))
+    }
 
 
 class _Task:
@@ -256,8 +292,10 @@ class _Task:
         if isinstance(made, Scene):
             return _edmd_quantities(made, self.run_kwargs, self.quantities)
         if self.run_kwargs:
-            raise TypeError(f"run options {sorted(self.run_kwargs)} apply to EDMD scenes only; "
-                            "put the model's own options into the function (functools.partial)")
+            raise TypeError(
+                f"run options {sorted(self.run_kwargs)} apply to EDMD scenes only; "
+                "put the model's own options into the function (functools.partial)"
+            )
         return _arrays_of(made)
 
 
@@ -266,7 +304,8 @@ def _call_task(task, index, seed):
     so that one failing run never loses the others."""
     try:
         return index, "ok", task(seed)
-    except Exception as exc:  # reported with its seed, the other runs go on
+    # any error of the task (user code) is caught: reported with its seed, the other runs go on
+    except Exception as exc:  # noqa: BLE001
         return index, "error", (repr(exc), exc.__class__.__name__, traceback.format_exc())
 
 
@@ -298,6 +337,7 @@ def _executor(backend, workers):
 def _main_guard_lines(tree):
     """Line ranges of the blocks that run only when a script is run, not imported:
     ``if __name__ == "__main__":`` (either operand order) and the ``else`` of ``!=``."""
+
     def is_name(node):
         return isinstance(node, ast.Name) and node.id == "__name__"
 
@@ -327,14 +367,18 @@ def _unguarded_main_call(start_method):
     main = sys.modules.get("__main__")
     path = getattr(main, "__file__", None)
     spec = getattr(main, "__spec__", None)
-    if (start_method == "fork" or not isinstance(path, str)
-            or (spec is not None and spec.name.rpartition(".")[2] == "__main__")):
+    if (
+        start_method == "fork"
+        or not isinstance(path, str)
+        or (spec is not None and spec.name.rpartition(".")[2] == "__main__")
+    ):
         return None
     frame = sys._getframe(1)
-    while frame is not None and not (frame.f_globals is vars(main)
-                                     and frame.f_code.co_name == "<module>"
-                                     and os.path.abspath(frame.f_code.co_filename)
-                                     == os.path.abspath(path)):
+    while frame is not None and not (
+        frame.f_globals is vars(main)
+        and frame.f_code.co_name == "<module>"
+        and os.path.abspath(frame.f_code.co_filename) == os.path.abspath(path)
+    ):
         frame = frame.f_back
     if frame is None:
         return None  # not called from the script's top level (e.g. from another thread)
@@ -386,16 +430,19 @@ def _pool_results(calls, backend, workers):
     with _executor(backend, workers) as pool:
         try:
             yield from _windowed(
-                calls, lambda call: pool.submit(_call_task, *call),
+                calls,
+                lambda call: pool.submit(_call_task, *call),
                 lambda futures: cf.wait(futures, return_when=cf.FIRST_COMPLETED).done,
-                window=2 * workers)  # a run queued behind each running one: no worker waits
+                window=2 * workers,
+            )  # a run queued behind each running one: no worker waits
         except BrokenProcessPool as exc:
             raise ProcessBackendError(
-                "A worker process of ensemble(backend=\"processes\") died (BrokenProcessPool). "
+                'A worker process of ensemble(backend="processes") died (BrokenProcessPool). '
                 "The usual cause: the script calls ensemble outside an "
-                "`if __name__ == \"__main__\":` block. " + _GUARD_ADVICE + "\nIf the script "
+                '`if __name__ == "__main__":` block. ' + _GUARD_ADVICE + "\nIf the script "
                 "has that guard, a run crashed its worker or ran out of memory: "
-                "backend=\"serial\" shows the run's own error.") from exc
+                'backend="serial" shows the run\'s own error.'
+            ) from exc
 
 
 def _dask_results(calls, client):
@@ -403,9 +450,11 @@ def _dask_results(calls, client):
 
     threads = max(1, sum(client.nthreads().values()))
     yield from _windowed(
-        calls, lambda call: client.submit(_call_task, *call, pure=False),
+        calls,
+        lambda call: client.submit(_call_task, *call, pure=False),
         lambda futures: wait(futures, return_when="FIRST_COMPLETED").done,
-        window=2 * threads)  # as for local pools, per thread of the cluster as it is now
+        window=2 * threads,
+    )  # as for local pools, per thread of the cluster as it is now
 
 
 def _results(calls, backend, workers):
@@ -418,7 +467,9 @@ def _results(calls, backend, workers):
     elif backend in ("processes", "threads"):
         yield from _pool_results(calls, backend, workers)
     else:
-        raise ValueError(f"backend must be 'serial', 'processes', 'threads' or a dask Client, got {backend!r}")
+        raise ValueError(
+            f"backend must be 'serial', 'processes', 'threads' or a dask Client, got {backend!r}"
+        )
 
 
 def _seeds(seed, runs, points=None):
@@ -447,15 +498,28 @@ class _PointReducer:
                 self.kept.append(payload)
         else:
             s = self.seeds[run]
-            self.failures.append(RunFailure(run, {"entropy": s.entropy, "spawn_key": s.spawn_key},
-                                            payload[0], payload[2], payload[1]))
+            self.failures.append(
+                RunFailure(
+                    run,
+                    {"entropy": s.entropy, "spawn_key": s.spawn_key},
+                    payload[0],
+                    payload[2],
+                    payload[1],
+                )
+            )
 
     def result(self):
         mean, error = self.acc.result()
         times = mean.pop("times", None)
         error.pop("times", None)
-        return EnsembleResult(self.kept if self.kept is not None else [], mean, error,
-                              self.acc.count, self.failures, times)
+        return EnsembleResult(
+            self.kept if self.kept is not None else [],
+            mean,
+            error,
+            self.acc.count,
+            self.failures,
+            times,
+        )
 
 
 def _reduce_in_order(results, reducers, runs, bar):
@@ -473,12 +537,18 @@ def _reduce_in_order(results, reducers, runs, bar):
         bar.update(1)
 
 
-def ensemble(model: Scene | Callable[..., Any] | Sequence[Scene | Callable[..., Any]],
-             runs: int, *, seed: int | np.random.SeedSequence | None = None,
-             backend: Any = "processes", workers: int | None = None,
-             progress: bool | None = None, keep_runs: bool = True,
-             quantities: Sequence[str] = ("msd", "temperature"),
-             **run_kwargs: Any) -> EnsembleResult | list[EnsembleResult]:
+def ensemble(
+    model: Scene | Callable[..., Any] | Sequence[Scene | Callable[..., Any]],
+    runs: int,
+    *,
+    seed: int | np.random.SeedSequence | None = None,
+    backend: Any = "processes",
+    workers: int | None = None,
+    progress: bool | None = None,
+    keep_runs: bool = True,
+    quantities: Sequence[str] = ("msd", "temperature"),
+    **run_kwargs: Any,
+) -> EnsembleResult | list[EnsembleResult]:
     """Run ``runs`` independent realizations of a model, or of every model of a sweep, and
     return their results with ensemble means and standard errors.
 
@@ -538,8 +608,10 @@ def ensemble(model: Scene | Callable[..., Any] | Sequence[Scene | Callable[..., 
         raise ValueError("a sweep needs at least one model")
     for m in models:
         if not (isinstance(m, Scene) or callable(m)):
-            raise TypeError("model must be a Scene, a function of seed or a list of these, "
-                            f"got {type(m).__name__}")
+            raise TypeError(
+                "model must be a Scene, a function of seed or a list of these, "
+                f"got {type(m).__name__}"
+            )
     bad = set(quantities) - set(EDMD_QUANTITIES)
     if bad:
         raise ValueError(f"unknown quantities {sorted(bad)}; choose from {EDMD_QUANTITIES}")
@@ -547,13 +619,15 @@ def ensemble(model: Scene | Callable[..., Any] | Sequence[Scene | Callable[..., 
         where = _unguarded_main_call(_process_context().get_start_method())
         if where is not None:
             raise ProcessBackendError(
-                f"ensemble(backend=\"processes\") is called from {where[0]}, line {where[1]}, "
-                "outside an `if __name__ == \"__main__\":` block. " + _GUARD_ADVICE)
+                f'ensemble(backend="processes") is called from {where[0]}, line {where[1]}, '
+                'outside an `if __name__ == "__main__":` block. ' + _GUARD_ADVICE
+            )
     seeds = _seeds(seed, runs, len(models) if sweep else None)
     tasks = [_Task(m, run_kwargs, tuple(quantities)) for m in models]
     # call index p * runs + r: run r of point p, the order in which runs are reduced
-    calls = [(task, p * runs + r, s)
-             for p, task in enumerate(tasks) for r, s in enumerate(seeds[p])]
+    calls = [
+        (task, p * runs + r, s) for p, task in enumerate(tasks) for r, s in enumerate(seeds[p])
+    ]
     reducers = [_PointReducer(point_seeds, keep_runs) for point_seeds in seeds]
     pool_size = workers if workers is not None else os.cpu_count() or 1
     with _progress_bar(len(calls), progress) as bar:

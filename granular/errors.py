@@ -4,6 +4,7 @@ The C core returns status codes; the binding (``granular._core``) turns each int
 these classes, with the particles and the time involved as attributes so that a script can
 react to, say, an inelastic collapse without parsing the message.
 """
+
 from __future__ import annotations
 
 from collections.abc import Iterable
@@ -12,8 +13,14 @@ from collections.abc import Iterable
 class GranularError(Exception):
     """Base class of every error granular raises on its own account."""
 
-    def __init__(self, message: str, *, particles: Iterable[int] = (), time: float | None = None,
-                 value: float | None = None) -> None:
+    def __init__(
+        self,
+        message: str,
+        *,
+        particles: Iterable[int] = (),
+        time: float | None = None,
+        value: float | None = None,
+    ) -> None:
         super().__init__(message)
         self.particles: tuple[int, ...] = tuple(int(p) for p in particles)
         self.time = time

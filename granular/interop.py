@@ -6,6 +6,7 @@ coordinates in float32 (about 7 significant digits) and gives frames evenly spac
 (``dt``), so log-spaced samples lose their real times in a Universe -- the file written by
 ``write_trajectory`` keeps them.
 """
+
 from __future__ import annotations
 
 import os
@@ -19,8 +20,9 @@ def _mda():
     try:
         import MDAnalysis
     except ImportError as exc:  # pragma: no cover - exercised only without MDAnalysis
-        raise ImportError("this needs MDAnalysis: pip install MDAnalysis "
-                          "(or pip install 'granular[interop]')") from exc
+        raise ImportError(
+            "this needs MDAnalysis: pip install MDAnalysis (or pip install 'granular[interop]')"
+        ) from exc
     return MDAnalysis
 
 
@@ -29,7 +31,7 @@ def _as_3d(positions):
     if x.ndim != 3 or x.shape[2] not in (2, 3):
         raise ValueError(f"positions must have shape (T, N, d) with d = 2 or 3, got {x.shape}")
     if x.shape[2] == 2:  # MDAnalysis is three-dimensional: disks lie in the plane z = 0
-        x = np.concatenate([x, np.zeros(x.shape[:2] + (1,))], axis=2)
+        x = np.concatenate([x, np.zeros((*x.shape[:2], 1))], axis=2)
     return x
 
 
@@ -41,8 +43,12 @@ def _dimensions(box, dim):
     return np.concatenate([lengths, [90.0, 90.0, 90.0]]).astype(np.float32)
 
 
-def to_universe(times: ArrayLike, positions: ArrayLike, box: ArrayLike | None = None,
-                radii: ArrayLike | None = None) -> Any:
+def to_universe(
+    times: ArrayLike,
+    positions: ArrayLike,
+    box: ArrayLike | None = None,
+    radii: ArrayLike | None = None,
+) -> Any:
     """An in-memory ``MDAnalysis.Universe`` with one atom per particle and one frame per
     sample (unwrapped positions).
 
@@ -61,14 +67,17 @@ def to_universe(times: ArrayLike, positions: ArrayLike, box: ArrayLike | None = 
         u.add_TopologyAttr("radii", np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)))
     dims = _dimensions(box, np.asarray(positions).shape[2])
     dt = float((t[-1] - t[0]) / (len(t) - 1)) if len(t) > 1 else 1.0
-    u.load_new(x.astype(np.float32), format=MemoryReader, order="fac", dt=dt,
-               dimensions=dims)
+    u.load_new(x.astype(np.float32), format=MemoryReader, order="fac", dt=dt, dimensions=dims)
     return u
 
 
-def write_trajectory(path: str | os.PathLike[str], times: ArrayLike, positions: ArrayLike,
-                     velocities: ArrayLike | None = None,
-                     box: ArrayLike | None = None) -> str:
+def write_trajectory(
+    path: str | os.PathLike[str],
+    times: ArrayLike,
+    positions: ArrayLike,
+    velocities: ArrayLike | None = None,
+    box: ArrayLike | None = None,
+) -> str:
     """Write a GROMACS TRR file (through MDAnalysis' TRRWriter): per frame its real time,
     unwrapped positions and optionally velocities, in float32.  MDAnalysis, OVITO, VMD and
     GROMACS read it; 2D scenes are written in the plane z = 0.

@@ -32,6 +32,7 @@ chunking.  Nothing of size N x steps is stored: the ensemble MSD at the sample t
 the time-averaged MSD at the requested lags are accumulated on the fly (window starts every
 max(1, lag/16) steps, so each particle needs at most 32 past positions per lag).
 """
+
 from __future__ import annotations
 
 import math
@@ -68,8 +69,9 @@ class _ArrayAndMethod(np.ndarray):
     _method: Any  # the bound method (None only on views made by NumPy itself)
     _name: str
 
-    def __new__(cls, values: NDArray[np.float64], method: Callable[..., NDArray[np.float64]],
-                name: str) -> _ArrayAndMethod:
+    def __new__(
+        cls, values: NDArray[np.float64], method: Callable[..., NDArray[np.float64]], name: str
+    ) -> _ArrayAndMethod:
         obj = np.asarray(values).view(cls)
         obj._method, obj._name = method, name
         return obj
@@ -82,9 +84,12 @@ class _ArrayAndMethod(np.ndarray):
         return self._method(*args, **kwargs)
 
     def _deprecated(self) -> None:
-        warnings.warn(f"using result.{self._name} as an array is deprecated; call "
-                      f"result.{self._name}() (the same numbers)", DeprecationWarning,
-                      stacklevel=3)
+        warnings.warn(
+            f"using result.{self._name} as an array is deprecated; call "
+            f"result.{self._name}() (the same numbers)",
+            DeprecationWarning,
+            stacklevel=3,
+        )
 
     def __getitem__(self, index: Any) -> Any:
         self._deprecated()
@@ -94,18 +99,21 @@ class _ArrayAndMethod(np.ndarray):
         self._deprecated()
         plain = tuple(x.view(np.ndarray) if isinstance(x, _ArrayAndMethod) else x for x in inputs)
         if "out" in kwargs:
-            kwargs["out"] = tuple(x.view(np.ndarray) if isinstance(x, _ArrayAndMethod) else x
-                                  for x in kwargs["out"])
+            kwargs["out"] = tuple(
+                x.view(np.ndarray) if isinstance(x, _ArrayAndMethod) else x for x in kwargs["out"]
+            )
         return getattr(ufunc, method)(*plain, **kwargs)
 
     def __array_function__(self, func: Any, types: Any, args: Any, kwargs: Any) -> Any:
         self._deprecated()
+
         def plain(x: Any) -> Any:
             if isinstance(x, _ArrayAndMethod):
                 return x.view(np.ndarray)
             if isinstance(x, (list, tuple)):
                 return type(x)(plain(y) for y in x)
             return x
+
         return func(*plain(args), **{k: plain(v) for k, v in kwargs.items()})
 
     def __repr__(self) -> str:
@@ -115,8 +123,9 @@ class _ArrayAndMethod(np.ndarray):
         return self.view(np.ndarray).__reduce__()
 
 
-def _lag_indices(available: NDArray[np.float64], dt: float, lags: ArrayLike | None,
-                 lag_samples: ArrayLike | None) -> NDArray[np.intp]:
+def _lag_indices(
+    available: NDArray[np.float64], dt: float, lags: ArrayLike | None, lag_samples: ArrayLike | None
+) -> NDArray[np.intp]:
     """Indices into ``available`` (lags in time, whole multiples of ``dt``) of the lags
     asked for: all of them when neither ``lags`` (in time) nor ``lag_samples`` (in steps)
     is given.  An engine that accumulates the TAMSD on the fly has it at those lags
@@ -138,14 +147,18 @@ def _lag_indices(available: NDArray[np.float64], dt: float, lags: ArrayLike | No
         off = ~np.isclose(t, k * dt, rtol=1e-9, atol=0.0)
         k[off] = -1  # not a whole number of steps: never accumulated
     pos = np.searchsorted(have, k)
-    found = (pos < len(have)) & (have[np.minimum(pos, len(have) - 1)] == k) if len(have) else \
-        np.zeros(k.shape, dtype=bool)
+    found = (
+        (pos < len(have)) & (have[np.minimum(pos, len(have) - 1)] == k)
+        if len(have)
+        else np.zeros(k.shape, dtype=bool)
+    )
     if not np.all(found):
         asked = (np.asarray(lag_samples) if lags is None else np.asarray(lags)).reshape(-1)
         raise ValueError(
             f"lag {asked[~found][0]!r} was not accumulated: the engine keeps the TAMSD only at "
             f"the lags given to run(tamsd_lags=...), here {list(np.asarray(available))} in time "
-            f"({list(have)} in steps)")
+            f"({list(have)} in steps)"
+        )
     return pos
 
 
@@ -210,14 +223,17 @@ class LangevinResult:
         (Used as an array, ``result.msd`` is still the (T,) MSD, deprecated.)"""
         return _ArrayAndMethod(self.msd_total, self._msd, "msd")
 
-    def _msd(self, per_dimension: bool = False,
-             particles: ArrayLike | None = None) -> NDArray[np.float64]:
+    def _msd(
+        self, per_dimension: bool = False, particles: ArrayLike | None = None
+    ) -> NDArray[np.float64]:
         if particles is None:
             return self.msd_per_dimension if per_dimension else self.msd_total
         if self.positions is None:
-            raise ValueError("msd(particles=...) needs the positions: run with "
-                             "store_positions=True (the engine accumulates the MSD of all "
-                             "particles only)")
+            raise ValueError(
+                "msd(particles=...) needs the positions: run with "
+                "store_positions=True (the engine accumulates the MSD of all "
+                "particles only)"
+            )
         from .analysis import _select
 
         # every particle starts at the origin, so |x|^2 is the squared displacement
@@ -242,9 +258,14 @@ class LangevinResult:
         (Used as an array, ``result.tamsd`` is still the (L,) TAMSD, deprecated.)"""
         return _ArrayAndMethod(self.tamsd_mean, self._tamsd, "tamsd")
 
-    def _tamsd(self, lags: ArrayLike | None = None, *, lag_samples: ArrayLike | None = None,
-               particles: ArrayLike | None = None,
-               per_particle: bool = False) -> NDArray[np.float64]:
+    def _tamsd(
+        self,
+        lags: ArrayLike | None = None,
+        *,
+        lag_samples: ArrayLike | None = None,
+        particles: ArrayLike | None = None,
+        per_particle: bool = False,
+    ) -> NDArray[np.float64]:
         pick = _lag_indices(self.tamsd_lags, self.dt, lags, lag_samples)
         if particles is None and not per_particle:
             return self.tamsd_mean[pick]
@@ -264,20 +285,28 @@ class LangevinResult:
     def arrays(self) -> dict[str, NDArray[Any]]:
         """The NumPy arrays and numbers of this result by name, as ``granular.ensemble``
         collects them from each run (``msd`` and ``tamsd`` under those names)."""
-        out = {"times": self.times, "steps": self.steps, "msd": self.msd_total,
-               "msd_per_dimension": self.msd_per_dimension, "v2": self.v2,
-               "tamsd_lags": self.tamsd_lags, "tamsd": self.tamsd_mean,
-               "tamsd_per_particle": self.tamsd_per_particle,
-               "final_positions": self.final_positions,
-               "final_velocities": self.final_velocities}
+        out = {
+            "times": self.times,
+            "steps": self.steps,
+            "msd": self.msd_total,
+            "msd_per_dimension": self.msd_per_dimension,
+            "v2": self.v2,
+            "tamsd_lags": self.tamsd_lags,
+            "tamsd": self.tamsd_mean,
+            "tamsd_per_particle": self.tamsd_per_particle,
+            "final_positions": self.final_positions,
+            "final_velocities": self.final_velocities,
+        }
         if self.positions is not None:
             out["positions"] = self.positions
         for name in ("gamma0", "D0", "tau0", "dt", "t_stop", "v0_sq"):
             out[name] = np.asarray(getattr(self, name))
         return out
 
-    def theory_msd(self, t: float | NDArray[np.float64] | None = None,
-                   ) -> float | NDArray[np.float64]:
+    def theory_msd(
+        self,
+        t: float | NDArray[np.float64] | None = None,
+    ) -> float | NDArray[np.float64]:
         """The analytic ensemble MSD of this model from ``granular.theory`` (with this
         run's initial speed) at the sample times or at t."""
         from . import theory
@@ -290,19 +319,36 @@ class LangevinResult:
     def theory_tamsd(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected time-averaged MSD of this run at its lags (or at ``lags``), as the
         engine measures it: see ``theory_tamsd``."""
-        return theory_tamsd(self.tamsd_lags if lags is None else lags, gamma0=self.gamma0,
-                            D0=self.D0, tau0=self.tau0, dt=self.dt, t_stop=self.t_stop,
-                            dim=self.dim, v0_sq=self.v0_sq)
+        return theory_tamsd(
+            self.tamsd_lags if lags is None else lags,
+            gamma0=self.gamma0,
+            D0=self.D0,
+            tau0=self.tau0,
+            dt=self.dt,
+            t_stop=self.t_stop,
+            dim=self.dim,
+            v0_sq=self.v0_sq,
+        )
 
     def __repr__(self) -> str:
-        return (f"LangevinResult(model={self.model!r}, scheme={self.scheme!r}, n={self.n}, "
-                f"dim={self.dim}, dt={self.dt}, t_stop={self.t_stop}, samples={len(self.times)}, "
-                f"lags={len(self.tamsd_lags)})")
+        return (
+            f"LangevinResult(model={self.model!r}, scheme={self.scheme!r}, n={self.n}, "
+            f"dim={self.dim}, dt={self.dt}, t_stop={self.t_stop}, samples={len(self.times)}, "
+            f"lags={len(self.tamsd_lags)})"
+        )
 
 
-def theory_tamsd(lags: ArrayLike, *, gamma0: float, D0: float, dt: float, t_stop: float,
-                 tau0: float = math.inf, dim: int = 3,
-                 v0_sq: float | None = None) -> NDArray[np.float64]:
+def theory_tamsd(
+    lags: ArrayLike,
+    *,
+    gamma0: float,
+    D0: float,
+    dt: float,
+    t_stop: float,
+    tau0: float = math.inf,
+    dim: int = 3,
+    v0_sq: float | None = None,
+) -> NDArray[np.float64]:
     """The expected time-averaged MSD of a run, total over ``dim``: for each lag the mean,
     over the windows the engine averages (starting every ``sde_lag_stride`` steps from 0
     while they end by ``t_stop``), of the mean squared displacement over the window --
@@ -312,14 +358,18 @@ def theory_tamsd(lags: ArrayLike, *, gamma0: float, D0: float, dt: float, t_stop
     C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD."""
     from . import theory
 
-    n_steps = int(round(t_stop / dt))
+    n_steps = round(t_stop / dt)
     out = []
     for lag in np.atleast_1d(np.asarray(lags, dtype=np.float64)):
-        k = int(round(lag / dt))
+        k = round(lag / dt)
         starts = np.arange(0, n_steps - k + 1, _core.sde_lag_stride(k)) * dt
         if math.isinf(tau0):
             thermal = D0 * gamma0
-            v_sq = thermal if v0_sq is None else thermal + (v0_sq - thermal) * np.exp(-2 * gamma0 * starts)
+            v_sq = (
+                thermal
+                if v0_sq is None
+                else thermal + (v0_sq - thermal) * np.exp(-2 * gamma0 * starts)
+            )
             incr = theory.msd_langevin(lag, D0, gamma0, dim, v0_sq=v_sq)
         else:
             incr = theory.udsbm_increment_msd(lag, starts, D0, gamma0, tau0, dim, v0_sq=v0_sq)
@@ -334,11 +384,25 @@ def _positive(name: str, value: float) -> float:
     return value
 
 
-def run(n: int, *, gamma0: float, D0: float, dt: float, t_stop: float, tau0: float = math.inf,
-        model: str | None = None, scheme: str = "exact", dim: int = 3,
-        sample_times: ArrayLike | None = None, tamsd_lags: ArrayLike | None = None,
-        initial: str = "thermal", speed: float | None = None, store_positions: bool = False,
-        seed: Any = None, progress: bool = False) -> LangevinResult:
+def run(
+    n: int,
+    *,
+    gamma0: float,
+    D0: float,
+    dt: float,
+    t_stop: float,
+    tau0: float = math.inf,
+    model: str | None = None,
+    scheme: str = "exact",
+    dim: int = 3,
+    sample_times: ArrayLike | None = None,
+    tamsd_lags: ArrayLike | None = None,
+    initial: str = "thermal",
+    speed: float | None = None,
+    store_positions: bool = False,
+    seed: Any = None,
+    progress: bool = False,
+) -> LangevinResult:
     """Integrate N independent particles from a common start at the origin.
 
     Parameters
@@ -371,8 +435,9 @@ def run(n: int, *, gamma0: float, D0: float, dt: float, t_stop: float, tau0: flo
         raise ValueError(f"n must be >= 1, got {n}")
     if dim not in (1, 2, 3):
         raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
-    gamma0, D0, dt, t_stop = (_positive(k, v) for k, v in
-                              (("gamma0", gamma0), ("D0", D0), ("dt", dt), ("t_stop", t_stop)))
+    gamma0, D0, dt, t_stop = (
+        _positive(k, v) for k, v in (("gamma0", gamma0), ("D0", D0), ("dt", dt), ("t_stop", t_stop))
+    )
     tau0 = float(tau0)
     if not tau0 > 0:
         raise ValueError(f"tau0 must be positive (inf for the Langevin model), got {tau0}")
@@ -392,12 +457,15 @@ def run(n: int, *, gamma0: float, D0: float, dt: float, t_stop: float, tau0: flo
         raise UnstableStepError(
             f"Euler-Maruyama diverges for gamma0*dt >= 2 (here {gamma0 * dt:.4g}); take "
             f"dt < {2 / gamma0:.4g} or scheme='exact', which is stable at any step",
-            value=gamma0 * dt)
+            value=gamma0 * dt,
+        )
     n_steps_f = t_stop / dt  # in float first: it may be past any int64, or infinite
     if not n_steps_f <= _core.SDE_MAX_STEPS:
-        raise ValueError(f"t_stop / dt = {t_stop!r} / {dt!r} = {n_steps_f:.4g} steps; a run "
-                         f"takes at most 2**62 = {_core.SDE_MAX_STEPS:.4g}")
-    n_steps = int(round(n_steps_f))
+        raise ValueError(
+            f"t_stop / dt = {t_stop!r} / {dt!r} = {n_steps_f:.4g} steps; a run "
+            f"takes at most 2**62 = {_core.SDE_MAX_STEPS:.4g}"
+        )
+    n_steps = round(n_steps_f)
     if n_steps < 1:
         raise ValueError("t_stop must be at least one step")
 
@@ -454,8 +522,10 @@ def run(n: int, *, gamma0: float, D0: float, dt: float, t_stop: float, tau0: flo
     if store_positions:
         need = 8.0 * T * n * dim
         if need > 8e9:
-            raise MemoryError(f"storing positions needs {need / 2**30:.1f} GiB; sample fewer "
-                              "times or leave store_positions off (the MSD is accumulated anyway)")
+            raise MemoryError(
+                f"storing positions needs {need / 2**30:.1f} GiB; sample fewer "
+                "times or leave store_positions off (the MSD is accumulated anyway)"
+            )
     x = np.zeros((n, dim))
     x2 = np.zeros((T, dim))
     v2 = np.zeros((T, dim))
@@ -478,17 +548,38 @@ def run(n: int, *, gamma0: float, D0: float, dt: float, t_stop: float, tau0: flo
         bar = tqdm(total=n * n_steps, unit="particle-step", unit_scale=True, leave=False)
     try:
         for first in range(0, n, per_call):
-            xs = np.ascontiguousarray(x[first:first + per_call])
-            vs = np.ascontiguousarray(v[first:first + per_call])
+            xs = np.ascontiguousarray(x[first : first + per_call])
+            vs = np.ascontiguousarray(v[first : first + per_call])
             for step_from in range(0, n_steps, steps_per_call):
                 step_to = min(step_from + steps_per_call, n_steps)
-                _core.sde_run(dim, model_code, scheme_code, gamma0, D0, tau0, dt, key, n, first,
-                              step_from, step_to, n_steps, xs, vs, steps, x2, v2, positions,
-                              lags, tamsd_sum, ring)
+                _core.sde_run(
+                    dim,
+                    model_code,
+                    scheme_code,
+                    gamma0,
+                    D0,
+                    tau0,
+                    dt,
+                    key,
+                    n,
+                    first,
+                    step_from,
+                    step_to,
+                    n_steps,
+                    xs,
+                    vs,
+                    steps,
+                    x2,
+                    v2,
+                    positions,
+                    lags,
+                    tamsd_sum,
+                    ring,
+                )
                 if bar is not None:
                     bar.update(len(xs) * (step_to - step_from))
-            x[first:first + len(xs)] = xs
-            v[first:first + len(vs)] = vs
+            x[first : first + len(xs)] = xs
+            v[first : first + len(vs)] = vs
     finally:
         if bar is not None:
             bar.close()
@@ -497,12 +588,28 @@ def run(n: int, *, gamma0: float, D0: float, dt: float, t_stop: float, tau0: flo
     windows = (n_steps - lags) // np.maximum(strides, 1) + 1
     per_particle = tamsd_sum / windows if L else tamsd_sum
     return LangevinResult(
-        times=(steps * dt).astype(np.float64, copy=False), steps=steps, msd_total=x2.sum(1) / n, msd_per_dimension=x2 / n,
-        v2=v2.sum(1) / n, tamsd_lags=(lags * dt).astype(np.float64, copy=False),
+        times=(steps * dt).astype(np.float64, copy=False),
+        steps=steps,
+        msd_total=x2.sum(1) / n,
+        msd_per_dimension=x2 / n,
+        v2=v2.sum(1) / n,
+        tamsd_lags=(lags * dt).astype(np.float64, copy=False),
         tamsd_mean=per_particle.mean(0) if L else np.zeros(0),
-        tamsd_per_particle=per_particle, positions=positions, final_positions=x,
-        final_velocities=v, model=model, scheme=scheme, gamma0=gamma0, D0=D0, tau0=tau0, dt=dt,
-        n=n, dim=dim, t_stop=n_steps * dt, v0_sq=v0_sq)
+        tamsd_per_particle=per_particle,
+        positions=positions,
+        final_positions=x,
+        final_velocities=v,
+        model=model,
+        scheme=scheme,
+        gamma0=gamma0,
+        D0=D0,
+        tau0=tau0,
+        dt=dt,
+        n=n,
+        dim=dim,
+        t_stop=n_steps * dt,
+        v0_sq=v0_sq,
+    )
 
 
 def coefficients_from_scene(scene: Scene) -> LangevinCoefficients:
@@ -512,16 +619,34 @@ def coefficients_from_scene(scene: Scene) -> LangevinCoefficients:
 
     radius = float(np.mean(scene.radii))
     mass = float(np.mean(scene.masses))
-    return theory.langevin_coefficients(scene.n, radius, scene.volume, scene.restitution,
-                                        scene.temperature, mass, scene.dim)
+    return theory.langevin_coefficients(
+        scene.n, radius, scene.volume, scene.restitution, scene.temperature, mass, scene.dim
+    )
 
 
-def from_scene(scene: Scene, *, dt: float, t_stop: float, scheme: str = "exact",
-               n: int | None = None, **kwargs: Any) -> LangevinResult:
+def from_scene(
+    scene: Scene,
+    *,
+    dt: float,
+    t_stop: float,
+    scheme: str = "exact",
+    n: int | None = None,
+    **kwargs: Any,
+) -> LangevinResult:
     """A Langevin run (xi = 1) or UDSBM run (xi < 1) with the scene's coefficients, so it
     can be set beside an EDMD run of the same scene.  ``n`` defaults to the scene's N;
     other arguments as in ``run``."""
     c = coefficients_from_scene(scene)
     model = "langevin" if math.isinf(c.tau0) else "udsbm"
-    return run(scene.n if n is None else n, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, model=model,
-               scheme=scheme, dt=dt, t_stop=t_stop, dim=scene.dim, **kwargs)
+    return run(
+        scene.n if n is None else n,
+        gamma0=c.gamma0,
+        D0=c.D0,
+        tau0=c.tau0,
+        model=model,
+        scheme=scheme,
+        dt=dt,
+        t_stop=t_stop,
+        dim=scene.dim,
+        **kwargs,
+    )

@@ -14,6 +14,7 @@ Units follow the package (DESIGN.md) and every axis says which it shows:
 
 Ratios and counts are marked dimensionless.
 """
+
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
@@ -48,8 +49,13 @@ def _axes(ax: Axes | None) -> Axes:
     return ax
 
 
-def energy(times: ArrayLike, kinetic_energy: ArrayLike, ax: Axes | None = None,
-           label: str | None = None, relative: bool = True) -> Axes:
+def energy(
+    times: ArrayLike,
+    kinetic_energy: ArrayLike,
+    ax: Axes | None = None,
+    label: str | None = None,
+    relative: bool = True,
+) -> Axes:
     """Kinetic energy against time; with ``relative`` the deviation E(t)/E(0) - 1 (thesis
     Fig. 4.2: rounding-level for a molecular gas)."""
     ax = _axes(ax)
@@ -63,8 +69,9 @@ def energy(times: ArrayLike, kinetic_energy: ArrayLike, ax: Axes | None = None,
     return ax
 
 
-def collisions_per_particle(times: ArrayLike, collisions: ArrayLike, ax: Axes | None = None,
-                            label: str | None = None) -> Axes:
+def collisions_per_particle(
+    times: ArrayLike, collisions: ArrayLike, ax: Axes | None = None, label: str | None = None
+) -> Axes:
     """Mean collisions per particle against time (thesis Figs 4.3-4.4)."""
     ax = _axes(ax)
     ax.plot(times, collisions, label=label)
@@ -75,9 +82,14 @@ def collisions_per_particle(times: ArrayLike, collisions: ArrayLike, ax: Axes | 
     return ax
 
 
-def speed_distribution(velocities: ArrayLike, temperature: float | None = None,
-                       mass: float = 1.0, bins: int = 40, ax: Axes | None = None,
-                       label: str = "simulation") -> Axes:
+def speed_distribution(
+    velocities: ArrayLike,
+    temperature: float | None = None,
+    mass: float = 1.0,
+    bins: int = 40,
+    ax: Axes | None = None,
+    label: str = "simulation",
+) -> Axes:
     """Histogram of speeds with Poisson error bars against Maxwell-Boltzmann (Figs 4.5-4.6)."""
     from . import analysis, theory
 
@@ -91,16 +103,24 @@ def speed_distribution(velocities: ArrayLike, temperature: float | None = None,
     width = centres[1] - centres[0]
     ax.bar(centres, dens, width=width, alpha=0.5, label=label, yerr=err, ecolor="0.4")
     s = np.linspace(0.0, top, 300)
-    ax.plot(s, theory.maxwell_boltzmann_pdf(s, T, mass, dim), "k--", label=f"Maxwell-Boltzmann ({dim}D)")
+    ax.plot(
+        s, theory.maxwell_boltzmann_pdf(s, T, mass, dim), "k--", label=f"Maxwell-Boltzmann ({dim}D)"
+    )
     ax.set_xlabel(SPEED)
     ax.set_ylabel(SPEED_DENSITY)
     ax.legend()
     return ax
 
 
-def haff(times: ArrayLike, temperature: ArrayLike, tau0: float,
-         temperature0: float | None = None, ax: Axes | None = None, label: str = "simulation",
-         error: ArrayLike | None = None) -> Axes:
+def haff(
+    times: ArrayLike,
+    temperature: ArrayLike,
+    tau0: float,
+    temperature0: float | None = None,
+    ax: Axes | None = None,
+    label: str = "simulation",
+    error: ArrayLike | None = None,
+) -> Axes:
     """Granular temperature against Haff's law T0 / (1 + t/tau0)^2 on log-log axes
     (Figs 4.8, 4.10)."""
     from . import theory
@@ -114,8 +134,12 @@ def haff(times: ArrayLike, temperature: ArrayLike, tau0: float,
         ax.errorbar(t[keep], T[keep], yerr=np.asarray(error)[keep], fmt=".", label=label)
     else:
         ax.plot(t[keep], T[keep], ".", label=label)
-    ax.plot(t[keep], theory.haff_temperature(t[keep], T0, tau0), "k--",
-            label=rf"Haff, $\tau_0$ = {tau0:.3g}")
+    ax.plot(
+        t[keep],
+        theory.haff_temperature(t[keep], T0, tau0),
+        "k--",
+        label=rf"Haff, $\tau_0$ = {tau0:.3g}",
+    )
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(TIME)
@@ -124,10 +148,17 @@ def haff(times: ArrayLike, temperature: ArrayLike, tau0: float,
     return ax
 
 
-def msd(times: ArrayLike, values: ArrayLike, error: ArrayLike | None = None,
-        theory_values: ArrayLike | None = None, ax: Axes | None = None,
-        label: str = "simulation", theory_label: str = "theory", loglog: bool = True,
-        theory_style: str = "k--") -> Axes:
+def msd(
+    times: ArrayLike,
+    values: ArrayLike,
+    error: ArrayLike | None = None,
+    theory_values: ArrayLike | None = None,
+    ax: Axes | None = None,
+    label: str = "simulation",
+    theory_label: str = "theory",
+    loglog: bool = True,
+    theory_style: str = "k--",
+) -> Axes:
     """MSD against time with error bars and a theory curve (Figs 4.11-4.13, 4.17-4.20);
     ``theory_style`` is its matplotlib format string, to tell several theories apart."""
     ax = _axes(ax)
@@ -149,8 +180,13 @@ def msd(times: ArrayLike, values: ArrayLike, error: ArrayLike | None = None,
     return ax
 
 
-def diffusivity(times: ArrayLike, values: ArrayLike, theory_values: ArrayLike | None = None,
-                ax: Axes | None = None, label: str = "simulation") -> Axes:
+def diffusivity(
+    times: ArrayLike,
+    values: ArrayLike,
+    theory_values: ArrayLike | None = None,
+    ax: Axes | None = None,
+    label: str = "simulation",
+) -> Axes:
     """Time-dependent diffusivity (Figs 4.14-4.16)."""
     ax = _axes(ax)
     t = np.asarray(times, dtype=np.float64)
@@ -166,8 +202,14 @@ def diffusivity(times: ArrayLike, values: ArrayLike, theory_values: ArrayLike | 
     return ax
 
 
-def msd_vs_tamsd(times: ArrayLike, msd_values: ArrayLike, lags: ArrayLike,
-                 tamsd_values: ArrayLike, ax: Axes | None = None, label: str = "") -> Axes:
+def msd_vs_tamsd(
+    times: ArrayLike,
+    msd_values: ArrayLike,
+    lags: ArrayLike,
+    tamsd_values: ArrayLike,
+    ax: Axes | None = None,
+    label: str = "",
+) -> Axes:
     """Ensemble MSD and time-averaged MSD on one log-log plot (Figs 4.21-4.23): equal for an
     ergodic process, apart for a non-ergodic one."""
     ax = _axes(ax)
@@ -183,8 +225,14 @@ def msd_vs_tamsd(times: ArrayLike, msd_values: ArrayLike, lags: ArrayLike,
     return ax
 
 
-def snapshot(positions: ArrayLike, radii: ArrayLike, lower: ArrayLike, upper: ArrayLike,
-             ax: Axes | None = None, color: str = "C0") -> Axes:
+def snapshot(
+    positions: ArrayLike,
+    radii: ArrayLike,
+    lower: ArrayLike,
+    upper: ArrayLike,
+    ax: Axes | None = None,
+    color: str = "C0",
+) -> Axes:
     """Disks of a 2D configuration drawn to scale (Fig. 4.9)."""
     from matplotlib.collections import EllipseCollection
 
@@ -193,8 +241,17 @@ def snapshot(positions: ArrayLike, radii: ArrayLike, lower: ArrayLike, upper: Ar
     if x.shape[1] != 2:
         raise ValueError("snapshot draws 2D scenes")
     d = 2 * np.broadcast_to(radii, (len(x),))
-    ax.add_collection(EllipseCollection(d, d, np.zeros(len(x)), units="xy", offsets=x,
-                                        offset_transform=ax.transData, facecolors=color))
+    ax.add_collection(
+        EllipseCollection(
+            d,
+            d,
+            np.zeros(len(x)),
+            units="xy",
+            offsets=x,
+            offset_transform=ax.transData,
+            facecolors=color,
+        )
+    )
     lo, hi = np.asarray(lower, dtype=np.float64), np.asarray(upper, dtype=np.float64)
     ax.set_xlim(float(lo[0]), float(hi[0]))
     ax.set_ylim(float(lo[1]), float(hi[1]))

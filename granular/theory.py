@@ -13,21 +13,25 @@ granular gas, a percent-level effect for xi >= 0.5 that grows towards small xi -
 approximate contact values g2 (Carnahan-Starling in 3D, Henderson's in 2D), good to
 about 1% up to eta = 0.4 (3D) and 0.5 (2D).
 """
+
 from __future__ import annotations
 
 import math
-from typing import NamedTuple, Union
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 # what the formulas return: a float for scalar arguments, else an array of their shape
-FloatOrArray = Union[float, NDArray[np.float64]]
+FloatOrArray = float | NDArray[np.float64]
 
 
 # -- geometry and equilibrium structure ---------------------------------------------------
 
-def packing_fraction(n: FloatOrArray, radius: FloatOrArray, volume: FloatOrArray, dim: int = 3) -> FloatOrArray:
+
+def packing_fraction(
+    n: FloatOrArray, radius: FloatOrArray, volume: FloatOrArray, dim: int = 3
+) -> FloatOrArray:
     """Fraction of the volume (area in 2D) covered by n particles of the given radius
     (2.44): ``eta = n (4/3) pi r^3 / V`` in 3D, ``n pi r^2 / A`` in 2D."""
     _check_dim(dim)
@@ -58,13 +62,19 @@ def compressibility_factor(eta: FloatOrArray, dim: int = 3) -> FloatOrArray:
 
 # -- collisions, Haff's law, transport coefficients ----------------------------------------
 
+
 def _eta(density, radius, dim, eta):
     return packing_fraction(density, radius, 1.0, dim) if eta is None else eta
 
 
-def collision_frequency(density: FloatOrArray, radius: FloatOrArray, temperature: FloatOrArray,
-                        mass: FloatOrArray = 1.0, dim: int = 3,
-                        eta: FloatOrArray | None = None) -> FloatOrArray:
+def collision_frequency(
+    density: FloatOrArray,
+    radius: FloatOrArray,
+    temperature: FloatOrArray,
+    mass: FloatOrArray = 1.0,
+    dim: int = 3,
+    eta: FloatOrArray | None = None,
+) -> FloatOrArray:
     """Enskog collision frequency per particle, the inverse mean collision time (2.42).
 
     3D: ``4 sqrt(pi) g2 sigma^2 n sqrt(T/m)``; 2D: ``2 sqrt(pi) g2 sigma n sqrt(T/m)``,
@@ -78,15 +88,27 @@ def collision_frequency(density: FloatOrArray, radius: FloatOrArray, temperature
     return geometry * math.sqrt(math.pi) * g2 * density * np.sqrt(np.asarray(temperature) / mass)
 
 
-def collision_time(density: FloatOrArray, radius: FloatOrArray, temperature: FloatOrArray,
-                   mass: FloatOrArray = 1.0, dim: int = 3,
-                   eta: FloatOrArray | None = None) -> FloatOrArray:
+def collision_time(
+    density: FloatOrArray,
+    radius: FloatOrArray,
+    temperature: FloatOrArray,
+    mass: FloatOrArray = 1.0,
+    dim: int = 3,
+    eta: FloatOrArray | None = None,
+) -> FloatOrArray:
     """Mean time between collisions of one particle, ``1 / collision_frequency`` (2.42)."""
     return 1.0 / collision_frequency(density, radius, temperature, mass, dim, eta)
 
 
-def haff_tau0(density: FloatOrArray, radius: FloatOrArray, xi: FloatOrArray, temperature0: FloatOrArray,
-              mass: FloatOrArray = 1.0, dim: int = 3, eta: FloatOrArray | None = None) -> FloatOrArray:
+def haff_tau0(
+    density: FloatOrArray,
+    radius: FloatOrArray,
+    xi: FloatOrArray,
+    temperature0: FloatOrArray,
+    mass: FloatOrArray = 1.0,
+    dim: int = 3,
+    eta: FloatOrArray | None = None,
+) -> FloatOrArray:
     """Haff's time scale tau0 (2.41, 2.45): ``1/tau0 = (1 - xi^2) omega(T0) / (2 d)``.
 
     In 3D this is (2.45), ``(2/3)(1 - xi^2) sqrt(pi) g2 n sigma^2 sqrt(T0/m)``.  The
@@ -102,15 +124,23 @@ def haff_tau0(density: FloatOrArray, radius: FloatOrArray, xi: FloatOrArray, tem
     return 2 * dim / ((1.0 - xi**2) * omega)
 
 
-def haff_temperature(t: FloatOrArray, temperature0: FloatOrArray, tau0: FloatOrArray) -> FloatOrArray:
+def haff_temperature(
+    t: FloatOrArray, temperature0: FloatOrArray, tau0: FloatOrArray
+) -> FloatOrArray:
     """Haff's law ``T(t) = T0 / (1 + t/tau0)^2`` (2.40), homogeneous cooling state."""
     t = np.asarray(t, dtype=np.float64)
     return temperature0 / (1.0 + t / tau0) ** 2
 
 
-def diffusion_d0(density: FloatOrArray, radius: FloatOrArray, xi: FloatOrArray, temperature0: FloatOrArray,
-                 mass: FloatOrArray = 1.0, dim: int = 3,
-                 eta: FloatOrArray | None = None) -> FloatOrArray:
+def diffusion_d0(
+    density: FloatOrArray,
+    radius: FloatOrArray,
+    xi: FloatOrArray,
+    temperature0: FloatOrArray,
+    mass: FloatOrArray = 1.0,
+    dim: int = 3,
+    eta: FloatOrArray | None = None,
+) -> FloatOrArray:
     """Self-diffusion coefficient at t = 0 (2.49-2.52): ``D0 = 4 D_E / (1 + xi)^2`` with
     Enskog's D_E = ``3 / (8 n g2 sigma^2) sqrt(T0 / (pi m))`` in 3D (2.50), and its 2D
     counterpart ``1 / (2 n g2 sigma) sqrt(T0 / (pi m))`` (velocity relaxation rate
@@ -134,9 +164,15 @@ class LangevinCoefficients(NamedTuple):
     tau0: float
 
 
-def langevin_coefficients(n: float, radius: float, volume: float, xi: float,
-                          temperature0: float, mass: float = 1.0,
-                          dim: int = 3) -> LangevinCoefficients:
+def langevin_coefficients(
+    n: float,
+    radius: float,
+    volume: float,
+    xi: float,
+    temperature0: float,
+    mass: float = 1.0,
+    dim: int = 3,
+) -> LangevinCoefficients:
     """gamma0, D0, tau0 of a gas of n particles in a box of the given volume, as the thesis
     derives them for its Langevin and UDSBM models: D0 (2.52), ``gamma0 = T0 / (m D0)``
     (2.55), tau0 (2.45; infinite for xi = 1)."""
@@ -148,6 +184,7 @@ def langevin_coefficients(n: float, radius: float, volume: float, xi: float,
 
 
 # -- mean squared displacements -------------------------------------------------------------
+
 
 def _x_plus_expm1(x):
     """``x + expm1(-x)`` without cancellation for small x (a series there)."""
@@ -165,8 +202,9 @@ def _one_minus_exp_over(x):
     return np.where(x == 0, 1.0, -np.expm1(-safe) / safe)
 
 
-def msd_langevin(t: FloatOrArray, D0: float, gamma0: float, dim: int = 3,
-                 v0_sq: FloatOrArray | None = None) -> FloatOrArray:
+def msd_langevin(
+    t: FloatOrArray, D0: float, gamma0: float, dim: int = 3, v0_sq: FloatOrArray | None = None
+) -> FloatOrArray:
     """MSD of a molecular gas and of the underdamped Langevin equation (2.68), total over
     ``dim`` dimensions: ``d [2 D0 t + (2 D0/gamma0)(exp(-gamma0 t) - 1)]``.
 
@@ -185,8 +223,9 @@ def msd_langevin(t: FloatOrArray, D0: float, gamma0: float, dim: int = 3,
     return dim * out
 
 
-def msd_granular(t: FloatOrArray, D0: float, gamma0: float, tau0: float,
-                 dim: int = 3) -> FloatOrArray:
+def msd_granular(
+    t: FloatOrArray, D0: float, gamma0: float, tau0: float, dim: int = 3
+) -> FloatOrArray:
     """MSD of a granular gas in the homogeneous cooling state (2.79), total over ``dim``:
     ``d 2 D0 tau0 [ln(1 + t/tau0) + ((1 + t/tau0)^(-gamma0 tau0) - 1) / (gamma0 tau0)]``.
 
@@ -211,8 +250,9 @@ def udsbm_v0_sq(D0: float, gamma0: float, tau0: float) -> float:
     return D0 * gamma0 * a / (a - 1)
 
 
-def msd_udsbm(t: FloatOrArray, D0: float, gamma0: float, tau0: float, dim: int = 3,
-              v0_sq: float | None = None) -> FloatOrArray:
+def msd_udsbm(
+    t: FloatOrArray, D0: float, gamma0: float, tau0: float, dim: int = 3, v0_sq: float | None = None
+) -> FloatOrArray:
     """MSD of underdamped scaled Brownian motion, total over ``dim`` dimensions.
 
     With ``v0_sq = None`` (default) the particles start with App. C's initial speed
@@ -235,8 +275,15 @@ def msd_udsbm(t: FloatOrArray, D0: float, gamma0: float, tau0: float, dim: int =
     return dim * out
 
 
-def udsbm_increment_msd(lag: FloatOrArray, start: FloatOrArray, D0: float, gamma0: float, tau0: float,
-                        dim: int = 3, v0_sq: float | None = None) -> FloatOrArray:
+def udsbm_increment_msd(
+    lag: FloatOrArray,
+    start: FloatOrArray,
+    D0: float,
+    gamma0: float,
+    tau0: float,
+    dim: int = 3,
+    v0_sq: float | None = None,
+) -> FloatOrArray:
     """Mean squared displacement of UDSBM over [start, start + lag], total over ``dim``
     dimensions -- the quantity a time average over windows starting at ``start`` collects
     (thesis 2.114-2.119).  At start = 0 it is ``msd_udsbm``.
@@ -261,22 +308,25 @@ def udsbm_increment_msd(lag: FloatOrArray, start: FloatOrArray, D0: float, gamma
     return dim * (stationary + transient)
 
 
-def msd_ballistic(t: FloatOrArray, temperature: float, mass: float = 1.0,
-                  dim: int = 3) -> FloatOrArray:
+def msd_ballistic(
+    t: FloatOrArray, temperature: float, mass: float = 1.0, dim: int = 3
+) -> FloatOrArray:
     """Short-time limit of every MSD here: free flight, ``d (T/m) t^2``."""
     return dim * temperature / mass * np.asarray(t, dtype=np.float64) ** 2
 
 
-def msd_diffusive(t: FloatOrArray, D0: float, dim: int = 3,
-                  gamma0: float | None = None) -> FloatOrArray:
+def msd_diffusive(
+    t: FloatOrArray, D0: float, dim: int = 3, gamma0: float | None = None
+) -> FloatOrArray:
     """Einstein's long-time limit of a molecular gas, ``2 d D0 t`` (2.46); with gamma0 the
     exact asymptote of (2.68), ``2 d D0 (t - 1/gamma0)``."""
     shift = 0.0 if gamma0 is None else 1.0 / gamma0
     return 2.0 * dim * D0 * (np.asarray(t, dtype=np.float64) - shift)
 
 
-def msd_logarithmic(t: FloatOrArray, D0: float, tau0: float, dim: int = 3,
-                    gamma0: float | None = None) -> FloatOrArray:
+def msd_logarithmic(
+    t: FloatOrArray, D0: float, tau0: float, dim: int = 3, gamma0: float | None = None
+) -> FloatOrArray:
     """Long-time limit of a granular gas, ``2 d D0 tau0 ln(1 + t/tau0)`` (2.80); with gamma0
     the exact asymptote of (2.79), ``2 d D0 tau0 (ln(1 + t/tau0) - 1/(gamma0 tau0))``."""
     shift = 0.0 if gamma0 is None else 1.0 / (gamma0 * tau0)
@@ -285,8 +335,10 @@ def msd_logarithmic(t: FloatOrArray, D0: float, tau0: float, dim: int = 3,
 
 # -- Maxwell-Boltzmann ----------------------------------------------------------------------
 
-def maxwell_boltzmann_pdf(speed: FloatOrArray, temperature: float, mass: float = 1.0,
-                          dim: int = 3) -> FloatOrArray:
+
+def maxwell_boltzmann_pdf(
+    speed: FloatOrArray, temperature: float, mass: float = 1.0, dim: int = 3
+) -> FloatOrArray:
     """Speed density of a gas in equilibrium (2.30 in 2D, 2.32 in 3D):
     2D ``(m v / T) exp(-m v^2 / 2T)``; 3D ``4 pi v^2 (m / 2 pi T)^(3/2) exp(-m v^2 / 2T)``."""
     _check_dim(dim)
@@ -297,16 +349,21 @@ def maxwell_boltzmann_pdf(speed: FloatOrArray, temperature: float, mass: float =
     return 4 * math.pi * v * v * (b / (2 * math.pi)) ** 1.5 * np.exp(-0.5 * b * v * v)
 
 
-def maxwell_boltzmann_moments(temperature: float, mass: float = 1.0,
-                              dim: int = 3) -> dict[str, float]:
+def maxwell_boltzmann_moments(
+    temperature: float, mass: float = 1.0, dim: int = 3
+) -> dict[str, float]:
     """Expectation values of Table 2.2: mean speed, mean squared speed, standard deviation
     of the speed and most probable speed."""
     _check_dim(dim)
     s = temperature / mass
     mean = math.sqrt(math.pi * s / 2) if dim == 2 else math.sqrt(8 * s / math.pi)
     mean_sq = dim * s
-    return {"mean": mean, "mean_sq": mean_sq, "std": math.sqrt(mean_sq - mean**2),
-            "most_probable": math.sqrt(s) if dim == 2 else math.sqrt(2 * s)}
+    return {
+        "mean": mean,
+        "mean_sq": mean_sq,
+        "std": math.sqrt(mean_sq - mean**2),
+        "most_probable": math.sqrt(s) if dim == 2 else math.sqrt(2 * s),
+    }
 
 
 def _check_dim(dim):

@@ -4,6 +4,7 @@ import ...``), not here and not in test modules.
 ``slow`` marks the slowest tests: ``make test`` (CI) runs everything, ``make test-quick``
 (``-m "not slow"``) leaves them out for daily work.  A new test may carry
 ``@pytest.mark.slow`` itself; the existing ones are listed in SLOW, in one place."""
+
 import matplotlib
 import pytest
 

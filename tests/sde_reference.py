@@ -19,6 +19,7 @@ Step k (1-based) goes from (k-1) dt to k dt and draws from the stream of (key, k
 particle): for each axis in turn one normal (EM) or two (exact: the first drives v).
 O(N x steps) Python-level work: tests only.
 """
+
 import math
 
 import numpy as np
@@ -107,8 +108,12 @@ def ou_step(gamma, D, dt):
     (v, x), so that (noise_v, noise_x) = L @ (z1, z2)."""
     h = gamma * dt
     c = math.exp(-h)
-    cov = np.array([[D * gamma * (1 - c * c), D * (1 - c) ** 2],
-                    [D * (1 - c) ** 2, D / gamma * (2 * h - 3 + 4 * c - c * c)]])
+    cov = np.array(
+        [
+            [D * gamma * (1 - c * c), D * (1 - c) ** 2],
+            [D * (1 - c) ** 2, D / gamma * (2 * h - 3 + 4 * c - c * c)],
+        ]
+    )
     return c, (1 - c) / gamma, np.linalg.cholesky(cov)
 
 
@@ -148,8 +153,22 @@ def tamsd_per_particle(xs, lag, stride):
     return (d * d).sum(axis=2).mean(axis=0)
 
 
-def engine(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, lags=(), first=0,
-           n=None, sample_steps=None):
+def engine(
+    v0,
+    key,
+    *,
+    model,
+    scheme,
+    gamma0,
+    D0,
+    tau0,
+    dt,
+    n_steps,
+    lags=(),
+    first=0,
+    n=None,
+    sample_steps=None,
+):
     """The C engine's raw entry point (``_core.sde_run``) over a whole run, with fresh
     buffers, for comparison with ``run``: samples at every step unless ``sample_steps``.
     Returns positions (T, N, d), final velocities (N, d), x2 (T, d) summed over the
@@ -159,15 +178,39 @@ def engine(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, lags=(), fi
     v = np.array(v0, dtype=np.float64)
     count, d = v.shape
     n = count if n is None else n
-    steps = (np.arange(n_steps + 1, dtype=np.int64) if sample_steps is None
-             else np.asarray(sample_steps, dtype=np.int64))
+    steps = (
+        np.arange(n_steps + 1, dtype=np.int64)
+        if sample_steps is None
+        else np.asarray(sample_steps, dtype=np.int64)
+    )
     lags = np.asarray(lags, dtype=np.int64).reshape(-1)
     x = np.zeros((count, d))
     x2, v2 = np.zeros((len(steps), d)), np.zeros((len(steps), d))
     positions = np.zeros((len(steps), n, d))
     tamsd = np.zeros((n, len(lags)))
     ring = np.zeros(_core.sde_ring_size(d, lags))
-    _core.sde_run(d, ("langevin", "udsbm").index(model), ("em", "exact").index(scheme),
-                  gamma0, D0, tau0 if model == "udsbm" else math.inf, dt, key, n, first, 0,
-                  n_steps, n_steps, x, v, steps, x2, v2, positions, lags, tamsd, ring)
-    return positions[:, first:first + count], v, x2, tamsd[first:first + count]
+    _core.sde_run(
+        d,
+        ("langevin", "udsbm").index(model),
+        ("em", "exact").index(scheme),
+        gamma0,
+        D0,
+        tau0 if model == "udsbm" else math.inf,
+        dt,
+        key,
+        n,
+        first,
+        0,
+        n_steps,
+        n_steps,
+        x,
+        v,
+        steps,
+        x2,
+        v2,
+        positions,
+        lags,
+        tamsd,
+        ring,
+    )
+    return positions[:, first : first + count], v, x2, tamsd[first : first + count]

@@ -1,6 +1,7 @@
 """The scripts in benchmarks/ keep working: each runs at a tiny size (--tiny, seconds) in a
 fresh interpreter, and uses only granular's public API, as a user's script would, so that a
 change inside the library cannot silently break them."""
+
 import ast
 import subprocess
 import sys
@@ -17,8 +18,13 @@ def test_there_are_benchmarks():
 
 @pytest.mark.parametrize("script", BENCHMARKS, ids=lambda p: p.name)
 def test_runs_at_a_tiny_size(script, tmp_path):
-    done = subprocess.run([sys.executable, str(script), "--tiny"], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, str(script), "--tiny"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip()
 
@@ -31,10 +37,17 @@ def test_uses_only_the_public_api(script):
         if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("granular"):
             names = [*node.module.split("."), *(a.name for a in node.names)]
         elif isinstance(node, ast.Import):
-            names = [part for a in node.names if a.name.startswith("granular")
-                     for part in a.name.split(".")]
-        elif isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) \
-                and node.value.id == "granular":
+            names = [
+                part
+                for a in node.names
+                if a.name.startswith("granular")
+                for part in a.name.split(".")
+            ]
+        elif (
+            isinstance(node, ast.Attribute)
+            and isinstance(node.value, ast.Name)
+            and node.value.id == "granular"
+        ):
             names = [node.attr]
         else:
             continue

@@ -5,6 +5,7 @@ view with negative strides, read-only, Fortran order, big-endian, an integer dty
 gives the same results as the plain C-contiguous float64 array, and never modifies its
 inputs.  A layout the raw binding cannot take must be refused with an error, never read
 wrongly."""
+
 import math
 
 import numpy as np
@@ -18,7 +19,7 @@ import sde_reference
 
 def _strided(a):
     """A non-contiguous view of a's values (every other row of a larger array)."""
-    big = np.zeros((2 * a.shape[0],) + a.shape[1:], dtype=a.dtype) if a.ndim else a
+    big = np.zeros((2 * a.shape[0], *a.shape[1:]), dtype=a.dtype) if a.ndim else a
     if a.ndim:
         big[::2] = a
         return big[::2]
@@ -40,15 +41,23 @@ def variants(a, integer=False):
     """(name, value) pairs holding a's numbers in every layout; ``integer``: a's values
     are whole numbers, so integer dtypes hold them too."""
     a = np.asarray(a, dtype=np.float64)
-    out = [("list", a.tolist()), ("strided", _strided(a)), ("negative strides", _reversed(a)),
-           ("read-only", _read_only(a)), ("fortran", np.asfortranarray(a)),
-           ("big-endian", a.astype(">f8")), ("fortran big-endian read-only",
-                                             _read_only(np.asfortranarray(a.astype(">f8"))))]
+    out = [
+        ("list", a.tolist()),
+        ("strided", _strided(a)),
+        ("negative strides", _reversed(a)),
+        ("read-only", _read_only(a)),
+        ("fortran", np.asfortranarray(a)),
+        ("big-endian", a.astype(">f8")),
+        ("fortran big-endian read-only", _read_only(np.asfortranarray(a.astype(">f8")))),
+    ]
     if integer:
-        out += [("int64", a.astype(np.int64)), ("int64 big-endian", a.astype(">i8")),
-                ("int32 big-endian", a.astype(">i4")),
-                ("uint8", a.astype(np.uint8)) if np.all(a >= 0) else ("int16", a.astype(np.int16)),
-                ("int64 list", a.astype(np.int64).tolist())]
+        out += [
+            ("int64", a.astype(np.int64)),
+            ("int64 big-endian", a.astype(">i8")),
+            ("int32 big-endian", a.astype(">i4")),
+            ("uint8", a.astype(np.uint8)) if np.all(a >= 0) else ("int16", a.astype(np.int16)),
+            ("int64 list", a.astype(np.int64).tolist()),
+        ]
     return out
 
 
@@ -81,15 +90,17 @@ MASSES = np.array([1.0, 2.0, 1.0, 3.0])
 def _scene(**arrays):
     kw = dict(positions=POS, velocities=VEL, radii=RADII, masses=MASSES)
     kw.update(arrays)
-    return granular.Scene(kw["positions"], kw["velocities"], kw["radii"], kw["masses"],
-                          box=12.0, restitution=0.9)
+    return granular.Scene(
+        kw["positions"], kw["velocities"], kw["radii"], kw["masses"], box=12.0, restitution=0.9
+    )
 
 
 @pytest.fixture(scope="module")
 def plain_scene_run():
     s = _scene()
-    tr = granular.Simulation(s).run(t_stop=3.0, sample_times=[0.0, 1.5, 3.0],
-                                    store=("positions", "velocities"))
+    tr = granular.Simulation(s).run(
+        t_stop=3.0, sample_times=[0.0, 1.5, 3.0], store=("positions", "velocities")
+    )
     return s, tr
 
 
@@ -105,8 +116,9 @@ def test_scene_takes_every_layout(name, plain_scene_run):
             got = getattr(s, attr)
             assert got.dtype == np.float64 and got.flags.c_contiguous, (label, attr)
             np.testing.assert_array_equal(got, getattr(plain, attr), err_msg=label)
-        tr = granular.Simulation(s).run(t_stop=3.0, sample_times=[0.0, 1.5, 3.0],
-                                        store=("positions", "velocities"))
+        tr = granular.Simulation(s).run(
+            t_stop=3.0, sample_times=[0.0, 1.5, 3.0], store=("positions", "velocities")
+        )
         np.testing.assert_array_equal(tr.positions, plain_tr.positions, err_msg=label)
         np.testing.assert_array_equal(tr.velocities, plain_tr.velocities, err_msg=label)
         _unchanged(value, before)
@@ -121,8 +133,16 @@ def test_a_scene_does_not_share_memory_with_its_inputs():
 
 # -- langevin.run and the raw sde_run --------------------------------------------------------
 
-RUN = dict(gamma0=9.26, D0=0.072, dt=0.01, t_stop=1.0, tau0=0.972, scheme="exact",
-           store_positions=True, seed=3)
+RUN = dict(
+    gamma0=9.26,
+    D0=0.072,
+    dt=0.01,
+    t_stop=1.0,
+    tau0=0.972,
+    scheme="exact",
+    store_positions=True,
+    seed=3,
+)
 SAMPLES = np.array([0.0, 0.1, 0.25, 0.5, 1.0])
 LAGS = np.array([0.01, 0.2, 0.5])
 
@@ -133,10 +153,19 @@ def plain_langevin():
 
 
 def _same_langevin(r, plain, label):
-    for name in ("times", "msd_total", "msd_per_dimension", "v2", "tamsd_lags",
-                 "tamsd_per_particle", "positions", "final_velocities"):
-        np.testing.assert_array_equal(getattr(r, name), getattr(plain, name),
-                                      err_msg=f"{label}: {name}")
+    for name in (
+        "times",
+        "msd_total",
+        "msd_per_dimension",
+        "v2",
+        "tamsd_lags",
+        "tamsd_per_particle",
+        "positions",
+        "final_velocities",
+    ):
+        np.testing.assert_array_equal(
+            getattr(r, name), getattr(plain, name), err_msg=f"{label}: {name}"
+        )
 
 
 @pytest.mark.parametrize("which", ["sample_times", "tamsd_lags"])
@@ -159,8 +188,7 @@ def test_langevin_run_takes_integer_times():
         _same_langevin(r, plain, label)
 
 
-SDE = dict(model="udsbm", scheme="exact", gamma0=9.26, D0=0.072, tau0=0.972, dt=0.05,
-           n_steps=40)
+SDE = dict(model="udsbm", scheme="exact", gamma0=9.26, D0=0.072, tau0=0.972, dt=0.05, n_steps=40)
 
 
 def _raw(x=None, v=None, steps=None, lags=None, v0=None):
@@ -174,14 +202,36 @@ def _raw(x=None, v=None, steps=None, lags=None, v0=None):
     x2, v2 = np.zeros((4, 2)), np.zeros((4, 2))
     pos, tamsd = np.zeros((4, 3, 2)), np.zeros((3, 3))
     ring = np.zeros(_core.sde_ring_size(2, np.array([1, 17, 40], dtype=np.int64)))
-    _core.sde_run(2, 1, 1, SDE["gamma0"], SDE["D0"], SDE["tau0"], SDE["dt"], 77, 3, 0, 0, 40,
-                  40, x, v, steps, x2, v2, pos, lags, tamsd, ring)
+    _core.sde_run(
+        2,
+        1,
+        1,
+        SDE["gamma0"],
+        SDE["D0"],
+        SDE["tau0"],
+        SDE["dt"],
+        77,
+        3,
+        0,
+        0,
+        40,
+        40,
+        x,
+        v,
+        steps,
+        x2,
+        v2,
+        pos,
+        lags,
+        tamsd,
+        ring,
+    )
     return x, v, x2, pos, tamsd
 
 
 def test_the_raw_sde_run_is_the_reference():
     v0 = np.array([[0.5, -0.2], [0.1, 0.3], [-0.4, 0.0]])
-    x, v, _, pos, _ = _raw()
+    _, v, _, pos, _ = _raw()
     xs, vs = sde_reference.run(v0, 77, **SDE)
     np.testing.assert_allclose(pos, xs[[0, 5, 20, 40]], rtol=0, atol=1e-13)
     np.testing.assert_allclose(v, vs[-1], rtol=0, atol=1e-13)
@@ -197,8 +247,9 @@ BYTE_ORDER_BUG = pytest.mark.xfail(strict=True, reason="csrc/_core.c does not ch
 
 def _labels(integer, misread):
     labels = [label for label, _ in variants(np.zeros(2), integer=integer)]
-    return [pytest.param(label, marks=BYTE_ORDER_BUG) if label == misread else label
-            for label in labels]
+    return [
+        pytest.param(label, marks=BYTE_ORDER_BUG) if label == misread else label for label in labels
+    ]
 
 
 @pytest.mark.parametrize("label", _labels(integer=True, misread="int64 big-endian"))
@@ -216,7 +267,7 @@ def test_the_raw_sde_run_reads_its_inputs_right_or_refuses_them(which, label):
     except ValueError as exc:
         assert "C-contiguous int64" in str(exc), exc
     else:
-        for a, b in zip(got, plain):
+        for a, b in zip(got, plain, strict=True):
             np.testing.assert_array_equal(a, b)
     _unchanged(value, before)
 
@@ -235,6 +286,7 @@ def test_the_raw_sde_run_writes_its_state_in_place_or_refuses(which, label):
 
 # -- analysis --------------------------------------------------------------------------------
 
+
 def _positions():
     """(T, N, d) whole-number positions: every dtype holds them."""
     return np.cumsum(np.random.default_rng(5).integers(-3, 4, size=(9, 4, 3)), axis=0)
@@ -243,16 +295,24 @@ def _positions():
 CASES = {
     "msd": (lambda a: analysis.msd(a), _positions),
     "msd per dimension, particles": (
-        lambda a: analysis.msd(a, per_dimension=True, particles=[0, 2]), _positions),
+        lambda a: analysis.msd(a, per_dimension=True, particles=[0, 2]),
+        _positions,
+    ),
     "tamsd fft": (lambda a: analysis.tamsd(a, lag_samples=[1, 3, 8]), _positions),
-    "tamsd direct": (lambda a: analysis.tamsd(a, [1.0, 3.0], times=np.arange(9.0),
-                                              method="direct", per_particle=True), _positions),
+    "tamsd direct": (
+        lambda a: analysis.tamsd(
+            a, [1.0, 3.0], times=np.arange(9.0), method="direct", per_particle=True
+        ),
+        _positions,
+    ),
     "temperature": (lambda a: analysis.temperature(a, masses=2.0), _positions),
     "speed_histogram": (lambda a: analysis.speed_histogram(a, bins=5), _positions),
     "speed_statistics": (lambda a: analysis.speed_statistics(a[-1]), _positions),
     "ensemble_mean": (lambda a: analysis.ensemble_mean(a), _positions),
-    "diffusivity": (lambda a: analysis.diffusivity(np.arange(1.0, 10.0), a[:, 0, 0] ** 2),
-                    _positions),
+    "diffusivity": (
+        lambda a: analysis.diffusivity(np.arange(1.0, 10.0), a[:, 0, 0] ** 2),
+        _positions,
+    ),
     "fit_slope": (lambda a: analysis.fit_slope(np.arange(1.0, 10.0), a[:, 1, 2]), _positions),
 }
 
@@ -263,7 +323,7 @@ def _same(got, want, label):
         for k in want:
             _same(got[k], want[k], label)
     elif isinstance(want, tuple):
-        for g, w in zip(got, want):
+        for g, w in zip(got, want, strict=True):
             _same(g, w, label)
     else:
         np.testing.assert_array_equal(got, want, err_msg=label)
@@ -289,12 +349,14 @@ def test_analysis_takes_times_and_series_in_every_layout():
     t = np.arange(1.0, 10.0)
     y = 2.0 * t + np.array([0.0, 1, -1, 0, 2, -2, 0, 1, -1])
     temps = 100.0 / (1.0 + t / 4.0) ** 2
-    want = (analysis.fit_slope(t, y), analysis.diffusivity(t, y),
-            analysis.fit_haff_tau0(t, temps))
+    want = (analysis.fit_slope(t, y), analysis.diffusivity(t, y), analysis.fit_haff_tau0(t, temps))
     for label, value in variants(t, integer=True):
         before = _snapshot(value)
-        got = (analysis.fit_slope(value, y), analysis.diffusivity(value, y),
-               analysis.fit_haff_tau0(value, temps))
+        got = (
+            analysis.fit_slope(value, y),
+            analysis.diffusivity(value, y),
+            analysis.fit_haff_tau0(value, temps),
+        )
         _same(got, want, label)
         _unchanged(value, before)
     for label, value in variants(y, integer=True):

@@ -6,6 +6,7 @@ error is the standard error of a mean over K independent runs, t the Student-t q
 with K - 1 degrees of freedom for a two-sided false-alarm rate of 1e-4 per check (K = 20:
 t = 4.9), and the margin the theory's own known systematic accuracy, cited where it is set.
 """
+
 import json
 import math
 import re
@@ -21,13 +22,20 @@ FALSE_ALARM = 1e-4  # per check, two-sided
 
 
 def run(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "granular", *args], cwd=cwd, capture_output=True,
-                          text=True, timeout=600, check=True)
+    return subprocess.run(
+        [sys.executable, "-m", "granular", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=True,
+    )
 
 
 def strict_json(path):
     """The file parsed by a strict JSON parser: Infinity and NaN, which Python's json writes
     by default but other parsers reject, raise."""
+
     def refuse(constant):
         raise ValueError(f"{path.name} holds {constant}, which is not JSON")
 
@@ -41,7 +49,10 @@ def test_json_files_are_strict(tmp_path):
 
     from granular.cli.output import write_json
 
-    write_json(tmp_path / "s.json", [dict(tau0=float("inf"), x=np.float64("nan"), ok=1.5, row=(2, -math.inf))])
+    write_json(
+        tmp_path / "s.json",
+        [dict(tau0=float("inf"), x=np.float64("nan"), ok=1.5, row=(2, -math.inf))],
+    )
     assert strict_json(tmp_path / "s.json") == [dict(tau0=None, x=None, ok=1.5, row=[2, None])]
 
 
@@ -50,7 +61,8 @@ def assert_agrees(what, ours, error, runs, theory, margin):
     tolerance = t * error + margin * abs(theory)
     assert abs(ours - theory) <= tolerance, (
         f"{what}: {ours:.6g} +- {error:.2g} ({runs} runs) vs theory {theory:.6g}; tolerance "
-        f"{tolerance:.3g} = {t:.2f} standard errors + {margin:.0%} of theory")
+        f"{tolerance:.3g} = {t:.2f} standard errors + {margin:.0%} of theory"
+    )
 
 
 def _euler_maruyama_margin():
@@ -61,8 +73,10 @@ def _euler_maruyama_margin():
     from granular.cli import reproduce
 
     cfg = reproduce.Config(quick=True)
-    g = max(theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, reproduce.THESIS_T0).gamma0
-            for xi in (1.0, 0.8, 0.5))
+    g = max(
+        theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, reproduce.THESIS_T0).gamma0
+        for xi in (1.0, 0.8, 0.5)
+    )
     return 2 / (2 - g * 0.01) - 1
 
 
@@ -72,10 +86,12 @@ REPRODUCE_MARGINS = {
     # over N particles (ddof = 0), shift <v> and std(v) by less than 0.4% for the quick sizes
     # (N = 250 in 3D, 400 in 2D: the Beta distribution of one particle's share of the energy)
     "table4.1.": 0.004,
-    "haff.tau0.xi0.99": haff_margin(0.99), "haff.tau0.xi0.5": haff_margin(0.5),
+    "haff.tau0.xi0.99": haff_margin(0.99),
+    "haff.tau0.xi0.5": haff_margin(0.5),
     "haff.tau0.xi0.3": haff_margin(0.3),
     # slopes over t (xi = 1) or ln t (xi = 0.8): sensitivities to D0 and tau0 at most 1
-    "msd.slope.xi1": msd_margin_bound(1.0), "msd.slope.xi0.8": msd_margin_bound(0.8),
+    "msd.slope.xi1": msd_margin_bound(1.0),
+    "msd.slope.xi0.8": msd_margin_bound(0.8),
     "sde.": _euler_maruyama_margin(),
     "ergodicity.": _euler_maruyama_margin(),
 }
@@ -99,16 +115,32 @@ def test_demo_quick(tmp_path):
     # the deviations from theory are printed with their standard errors, and explained
     line = re.search(r"molecular MSD ([-+][\d.]+)% \+- ([\d.]+)%", out.stdout)
     assert line, out.stdout
-    assert float(line[1]) == pytest.approx(100 * (mol["msd_end"] / mol["msd_end_theory"] - 1), abs=0.05)
-    assert float(line[2]) == pytest.approx(100 * mol["msd_end_error"] / mol["msd_end_theory"], abs=0.05)
+    assert float(line[1]) == pytest.approx(
+        100 * (mol["msd_end"] / mol["msd_end_theory"] - 1), abs=0.05
+    )
+    assert float(line[2]) == pytest.approx(
+        100 * mol["msd_end_error"] / mol["msd_end_theory"], abs=0.05
+    )
     assert "Enskog's D0" in out.stdout and "Maxwellian cooling rate" in out.stdout
     assert mol["runs"] >= 10 and gran["runs"] >= 10
     assert mol["T_end"] == pytest.approx(mol["T_end_theory"], rel=1e-12)
-    assert_agrees("granular T(t_end)", gran["T_end"], gran["T_end_error"], gran["runs"], gran["T_end_theory"],
-                  2 * haff_margin(0.8))
+    assert_agrees(
+        "granular T(t_end)",
+        gran["T_end"],
+        gran["T_end_error"],
+        gran["runs"],
+        gran["T_end_theory"],
+        2 * haff_margin(0.8),
+    )
     for r in (mol, gran):
-        assert_agrees(f"{r['gas']} MSD(t_end)", r["msd_end"], r["msd_end_error"], r["runs"],
-                      r["msd_end_theory"], msd_margin_bound(r["xi"]))
+        assert_agrees(
+            f"{r['gas']} MSD(t_end)",
+            r["msd_end"],
+            r["msd_end_error"],
+            r["runs"],
+            r["msd_end_theory"],
+            msd_margin_bound(r["xi"]),
+        )
 
 
 def test_bench_quick_json(tmp_path):
@@ -117,8 +149,18 @@ def test_bench_quick_json(tmp_path):
     edmd = [r for r in rows if r["engine"] == "edmd"]
     assert len(edmd) == 5 and {r["dim"] for r in edmd} == {2, 3}
     for r in edmd:
-        for key in ("name", "dim", "n", "packing_fraction", "boundary", "restitution",
-                    "pair_collisions", "seconds", "pair_collisions_per_second", "shell"):
+        for key in (
+            "name",
+            "dim",
+            "n",
+            "packing_fraction",
+            "boundary",
+            "restitution",
+            "pair_collisions",
+            "seconds",
+            "pair_collisions_per_second",
+            "shell",
+        ):
             assert key in r
         assert r["pair_collisions"] > 0 and r["pair_collisions_per_second"] > 0
         assert (r["shell"] > 0) == (r["packing_fraction"] > 0.4)  # lists for the dense one
@@ -135,9 +177,17 @@ def test_reproduce_quick(tmp_path):
 
     run("reproduce", "--quick", "--out", "rep", cwd=tmp_path)
     rows = {r["id"]: r for r in strict_json(tmp_path / "rep" / "summary.json")}
-    required = ["energy.drift.xi1", "msd.slope.xi1", "msd.slope.xi0.8", "ergodicity.langevin",
-                "ergodicity.udsbm"] + [f"table4.1.{d}.{k}" for d in ("2d", "3d") for k in ("mean", "mean_sq", "std")] \
+    required = (
+        [
+            "energy.drift.xi1",
+            "msd.slope.xi1",
+            "msd.slope.xi0.8",
+            "ergodicity.langevin",
+            "ergodicity.udsbm",
+        ]
+        + [f"table4.1.{d}.{k}" for d in ("2d", "3d") for k in ("mean", "mean_sq", "std")]
         + [f"haff.tau0.xi{x}" for x in ("0.99", "0.5", "0.3")]
+    )
     assert set(required) <= set(rows)
     for r in rows.values():
         assert set(r) == {"id", "quantity", "ours", "ours_error", "runs", "thesis", "theory"}
@@ -147,7 +197,9 @@ def test_reproduce_quick(tmp_path):
     assert rows["energy.drift.xi1"]["ours"] < 1e-13
     for key in BY_CONSTRUCTION:
         assert rows[key]["ours"] == pytest.approx(rows[key]["theory"], rel=1e-12)
-    statistical = [r for r in rows.values() if r["id"] not in ("energy.drift.xi1", *BY_CONSTRUCTION)]
+    statistical = [
+        r for r in rows.values() if r["id"] not in ("energy.drift.xi1", *BY_CONSTRUCTION)
+    ]
     for r in statistical:
         assert r["runs"] >= 10, r["id"]
         margin = next(m for prefix, m in REPRODUCE_MARGINS.items() if r["id"].startswith(prefix))
@@ -162,4 +214,6 @@ def test_reproduce_quick(tmp_path):
         assert f"theory {r['theory']:.4g}: {verdict}" in sentence, sentence
     pngs = {p.name for p in (tmp_path / "rep").glob("*.png")}
     assert len(pngs) >= 24 and "fig4_23_ergodicity_udsbm_tstop.png" in pngs
-    assert math.isfinite(rows["ergodicity.udsbm"]["theory"]) and rows["ergodicity.udsbm"]["theory"] < 1
+    assert (
+        math.isfinite(rows["ergodicity.udsbm"]["theory"]) and rows["ergodicity.udsbm"]["theory"] < 1
+    )

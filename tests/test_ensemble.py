@@ -1,5 +1,6 @@
 """Ensembles: identical results on every backend, independent runs, 1/sqrt(K) errors,
 failures reported without losing the other runs, sweeps in one call, bounded memory."""
+
 import functools
 import math
 import weakref
@@ -19,9 +20,12 @@ RUN = dict(t_stop=1.0, sample_times=np.linspace(0.0, 1.0, 6))
 def dask_client():
     """Worker processes, so that tasks and results really travel pickled through Dask."""
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
         yield client
 
 
@@ -47,7 +51,7 @@ class CountingClient:
 def _assert_identical(x, y):
     """Two EnsembleResults agree bit for bit: every run's arrays, the means and errors."""
     assert len(x.runs) == len(y.runs) and x.mean.keys() == y.mean.keys()
-    for a, b in zip(x.runs, y.runs):
+    for a, b in zip(x.runs, y.runs, strict=True):
         assert a.keys() == b.keys()
         for k in a:
             np.testing.assert_array_equal(a[k], b[k])
@@ -68,15 +72,22 @@ def test_same_seed_same_results_on_every_backend(dask_client):
 
 def test_runs_are_distinct_and_scene_runs_shuffle_velocities():
     scene = Scene.random(200, 0.03, restitution=0.8, seed=1)
-    res = granular.ensemble(scene, 3, seed=2, backend="serial",
-                            quantities=("temperature", "pair_collisions"), **RUN)
+    res = granular.ensemble(
+        scene, 3, seed=2, backend="serial", quantities=("temperature", "pair_collisions"), **RUN
+    )
     counts = [r["pair_collisions"][-1] for r in res.runs]
     assert len(set(counts)) == 3
     # velocity shuffling keeps the energy: T(0) equal in every run
     t0 = [r["temperature"][0] for r in res.runs]
     assert np.ptp(t0) < 1e-14 * t0[0]
-    res = granular.ensemble(functools.partial(Scene.random, 200, 0.03), 3, seed=2,
-                            backend="serial", quantities=("temperature",), **RUN)
+    res = granular.ensemble(
+        functools.partial(Scene.random, 200, 0.03),
+        3,
+        seed=2,
+        backend="serial",
+        quantities=("temperature",),
+        **RUN,
+    )
     assert len({r["temperature"][0] for r in res.runs}) == 3
 
 
@@ -92,8 +103,9 @@ def test_error_shrinks_like_one_over_sqrt_k():
 
 
 def test_failing_run_is_reported_and_the_others_returned():
-    res = granular.ensemble(ensemble_tasks.fails_for_run_2, 5, seed=3, backend="processes",
-                            workers=2)
+    res = granular.ensemble(
+        ensemble_tasks.fails_for_run_2, 5, seed=3, backend="processes", workers=2
+    )
     assert res.count == 4 and len(res.runs) == 4
     (fail,) = res.failures
     assert fail.index == 2 and fail.seed["spawn_key"] == (2,)
@@ -102,17 +114,19 @@ def test_failing_run_is_reported_and_the_others_returned():
 
 def test_run_r_uses_child_r_of_the_seed():
     res = granular.ensemble(ensemble_tasks.gaussian, 3, seed=5, backend="serial")
-    for run, child in zip(res.runs, np.random.SeedSequence(5).spawn(3)):
+    for run, child in zip(res.runs, np.random.SeedSequence(5).spawn(3), strict=True):
         np.testing.assert_array_equal(run["x"], ensemble_tasks.gaussian(child)["x"])
 
 
 def test_a_sweep_gives_each_point_as_run_alone_with_its_child_seed():
-    points = [Scene.random(100, 0.03, restitution=1.0, seed=1),
-              functools.partial(Scene.random, 100, 0.03, restitution=0.8)]
+    points = [
+        Scene.random(100, 0.03, restitution=1.0, seed=1),
+        functools.partial(Scene.random, 100, 0.03, restitution=0.8),
+    ]
     kw = dict(quantities=("temperature", "pair_collisions"), **RUN)
     sweep = granular.ensemble(points, 3, seed=11, backend="processes", workers=2, **kw)
     assert isinstance(sweep, list) and len(sweep) == 2
-    for point, child, res in zip(points, np.random.SeedSequence(11).spawn(2), sweep):
+    for point, child, res in zip(points, np.random.SeedSequence(11).spawn(2), sweep, strict=True):
         alone = granular.ensemble(point, 3, seed=child, backend="serial", **kw)
         assert res.count == alone.count == 3 and not res.failures
         _assert_identical(alone, res)
@@ -122,8 +136,13 @@ def test_a_sweep_gives_each_point_as_run_alone_with_its_child_seed():
 
 
 def test_a_sweep_reports_failures_per_point_with_their_seeds():
-    ok, failing = granular.ensemble([ensemble_tasks.gaussian, ensemble_tasks.fails_for_run_2],
-                                    4, seed=3, backend="threads", workers=2)
+    ok, failing = granular.ensemble(
+        [ensemble_tasks.gaussian, ensemble_tasks.fails_for_run_2],
+        4,
+        seed=3,
+        backend="threads",
+        workers=2,
+    )
     assert ok.count == 4 and not ok.failures
     (fail,) = failing.failures
     assert failing.count == 3 and fail.index == 2 and fail.seed["spawn_key"] == (1, 2)
@@ -163,8 +182,9 @@ def test_finished_runs_are_not_kept_when_only_means_are_asked_for():
     worker, lets at most 4 runs be submitted and not yet reduced; the last one reduced is
     referenced until the next result arrives: 5 at most."""
     ensemble_tasks.reset_tracking()
-    lean = granular.ensemble(ensemble_tasks.tracked_result, 40, seed=9, backend="threads",
-                             workers=2, keep_runs=False)
+    lean = granular.ensemble(
+        ensemble_tasks.tracked_result, 40, seed=9, backend="threads", workers=2, keep_runs=False
+    )
     assert lean.runs == [] and lean.count == 40
     assert ensemble_tasks.peak_live_results <= 4 + 1
     serial = granular.ensemble(ensemble_tasks.tracked_result, 40, seed=9, backend="serial")
@@ -179,7 +199,7 @@ def test_dask_submission_is_windowed(dask_client):
     lean = granular.ensemble(models, 12, seed=4, backend=client, keep_runs=False)
     assert 1 < client.peak <= 4
     serial = granular.ensemble(models, 12, seed=4, backend="serial")
-    for a, b in zip(lean, serial):
+    for a, b in zip(lean, serial, strict=True):
         assert a.runs == [] and a.count == 12
         np.testing.assert_array_equal(a.mean["x"], b.mean["x"])
         np.testing.assert_array_equal(a.error["x"], b.error["x"])
@@ -187,11 +207,13 @@ def test_dask_submission_is_windowed(dask_client):
 
 # Runs constant across the ensemble keep their value, inf included (issue 13, item 16).
 
+
 def test_langevin_ensemble_keeps_infinite_tau0():
     """The Langevin model has tau0 = inf in every run: the mean is inf with error 0, like any
     parameter equal in every run, while the MSD is the plain mean over runs."""
-    model = functools.partial(granular.langevin.run, 20, gamma0=2.0, D0=0.5, dt=0.05,
-                              t_stop=2.0, model="langevin")
+    model = functools.partial(
+        granular.langevin.run, 20, gamma0=2.0, D0=0.5, dt=0.05, t_stop=2.0, model="langevin"
+    )
     res = granular.ensemble(model, 4, seed=3, backend="serial")
     assert res.mean["tau0"] == math.inf and res.error["tau0"] == 0
     assert res.mean["gamma0"] == 2.0 and res.error["gamma0"] == 0
@@ -209,8 +231,14 @@ def test_reducer_with_infinite_and_varying_entries():
 
     rng = np.random.default_rng(0)
     k = 7
-    runs = [{"v": rng.normal(size=5) * 1e3 + 1e6,
-             "c": np.array([math.inf, -math.inf, 1.5, 0.0]), "tau0": math.inf} for _ in range(k)]
+    runs = [
+        {
+            "v": rng.normal(size=5) * 1e3 + 1e6,
+            "c": np.array([math.inf, -math.inf, 1.5, 0.0]),
+            "tau0": math.inf,
+        }
+        for _ in range(k)
+    ]
     acc = _Accumulator()
     for r in runs:
         acc.add(r)
@@ -247,41 +275,56 @@ def run_script(tmp_path, text, *args):
     if not args:
         (tmp_path / "script.py").write_text(text)
         args = ("script.py",)
-    done = subprocess.run([sys.executable, *args], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, *args], cwd=tmp_path, capture_output=True, text=True, timeout=120
+    )
     return done.returncode, done.stdout, done.stderr
 
 
 GUARD_TO_WRITE = 'if __name__ == "__main__":\n        result = granular.ensemble(...)'
 
 
-@pytest.mark.parametrize("call, line", [
-    ("res = granular.ensemble(model, 4, seed=1, workers=2)\n", 6),
-    ("def main():\n    return granular.ensemble(model, 4, seed=1, workers=2)\n\n\nres = main()\n", 10),
-])
+@pytest.mark.parametrize(
+    "call, line",
+    [
+        ("res = granular.ensemble(model, 4, seed=1, workers=2)\n", 6),
+        (
+            "def main():\n    return granular.ensemble(model, 4, seed=1, workers=2)\n\n\n"
+            "res = main()\n",
+            10,
+        ),
+    ],
+)
 def test_unguarded_script_gets_told_to_add_the_guard(tmp_path, call, line):
     """Called at top level, directly or through a function: the error names the script's
     line and shows the guard to write, before any worker starts."""
     code, out, err = run_script(tmp_path, MODEL + "\n" + call + 'print("count", res.count)\n')
     assert code == 1 and "count" not in out
     assert "ProcessBackendError" in err and "BrokenProcessPool" not in err
-    assert f"script.py, line {line}, outside an `if __name__ == \"__main__\":` block" in err
+    assert f'script.py, line {line}, outside an `if __name__ == "__main__":` block' in err
     assert GUARD_TO_WRITE in err
 
 
 def test_guarded_scripts_and_scripts_without_a_file_run(tmp_path):
     """No false alarm: under the guard (directly or in a function), the reversed test,
     and ``python -c`` (no script to re-run, as in a notebook) all run."""
-    for body in ('if __name__ == "__main__":\n    res = granular.ensemble(model, 4, seed=1, workers=2)\n'
-                 '    print("count", res.count)\n',
-                 'def main():\n    res = granular.ensemble(model, 4, seed=1, workers=2)\n'
-                 '    print("count", res.count)\n\n\nif "__main__" == __name__:\n    main()\n',
-                 'if __name__ != "__main__":\n    pass\nelse:\n'
-                 '    print("count", granular.ensemble(model, 4, seed=1, workers=2).count)\n'):
+    for body in (
+        'if __name__ == "__main__":\n    res = granular.ensemble(model, 4, seed=1, workers=2)\n'
+        '    print("count", res.count)\n',
+        "def main():\n    res = granular.ensemble(model, 4, seed=1, workers=2)\n"
+        '    print("count", res.count)\n\n\nif "__main__" == __name__:\n    main()\n',
+        'if __name__ != "__main__":\n    pass\nelse:\n'
+        '    print("count", granular.ensemble(model, 4, seed=1, workers=2).count)\n',
+    ):
         code, out, err = run_script(tmp_path, MODEL + "\n" + body)
         assert (code, out) == (0, "count 4\n"), err
-    code, out, err = run_script(tmp_path, None, "-c", MODEL + "\nres = granular.ensemble("
-                                "model, 4, seed=1, workers=2)\nprint('count', res.count)\n")
+    code, out, err = run_script(
+        tmp_path,
+        None,
+        "-c",
+        MODEL + "\nres = granular.ensemble("
+        "model, 4, seed=1, workers=2)\nprint('count', res.count)\n",
+    )
     assert (code, out) == (0, "count 4\n"), err
 
 

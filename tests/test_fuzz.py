@@ -7,6 +7,7 @@ takes longer than TIMEOUT, or kills the worker (a segfault, an abort under ASan)
 and a new worker goes on with the next case. About 3 s on the 2-core development machine, plus
 TIMEOUT for each case that hangs (under ASan about 8 s plus that).
 """
+
 import json
 import os
 import select
@@ -36,15 +37,24 @@ class Worker:
 
     def __init__(self):
         self.log = tempfile.TemporaryFile()
-        code = (f"import sys; sys.path.insert(0, {str(HERE)!r}); import resource; from helpers import fuzz_cases\n"
-                f"if 'asan' not in __import__('os').environ.get('LD_PRELOAD', ''):\n"
-                f"    resource.setrlimit(resource.RLIMIT_AS, ({MEMORY_CAP}, {MEMORY_CAP}))\n"
-                f"fuzz_cases.worker({SEED}, {COUNT})")
+        code = (
+            f"import sys; sys.path.insert(0, {str(HERE)!r}); import resource; "
+            "from helpers import fuzz_cases\n"
+            f"if 'asan' not in __import__('os').environ.get('LD_PRELOAD', ''):\n"
+            f"    resource.setrlimit(resource.RLIMIT_AS, ({MEMORY_CAP}, {MEMORY_CAP}))\n"
+            f"fuzz_cases.worker({SEED}, {COUNT})"
+        )
         env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
         # cwd: the tests directory, so `import granular` finds the installed package the
         # parent uses (under make test-asan, the sanitized one), as a user's script would
-        self.proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=self.log, cwd=HERE, env=env)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", code],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.log,
+            cwd=HERE,
+            env=env,
+        )
         self.buffer, self.eof = b"", False
         assert self._line(60.0) == "ready", f"the fuzz worker did not start: {self._log()}"
 
@@ -104,11 +114,16 @@ def test_fuzz_inputs_end_in_a_clear_error_or_a_valid_result():
             worker.proc.stdin.close()
             worker.close()
 
-    tally = Counter((c["kind"], status) for c, (status, _) in zip(cases, outcomes))
-    failures = [f"#{i} {describe(cases[i])}\n    -> {detail}"
-                for i, (status, detail) in enumerate(outcomes) if status == "FAIL"]
-    assert not failures, (f"{len(failures)} of {COUNT} fuzz cases failed "
-                          f"(tally {dict(tally)}):\n" + "\n".join(failures))
+    tally = Counter((c["kind"], status) for c, (status, _) in zip(cases, outcomes, strict=True))
+    failures = [
+        f"#{i} {describe(cases[i])}\n    -> {detail}"
+        for i, (status, detail) in enumerate(outcomes)
+        if status == "FAIL"
+    ]
+    assert not failures, (
+        f"{len(failures)} of {COUNT} fuzz cases failed "
+        f"(tally {dict(tally)}):\n" + "\n".join(failures)
+    )
     # not a vacuous run: every entry point both accepted inputs and refused some
     for kind in ("scene", "random", "run", "langevin"):
         assert tally[kind, "ok"] >= 10 and tally[kind, "error"] >= 10, dict(tally)

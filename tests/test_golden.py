@@ -12,6 +12,7 @@ rewrites the file in its own commit, saying why:
 The build uses portable flags only (setup.py: no -march=native, no -ffast-math), so the
 bits do not depend on the x86-64 machine.
 """
+
 import hashlib
 import json
 import os
@@ -40,12 +41,16 @@ def _edmd(scene, t_stop, n_samples=6, **sim_kwargs):
     times = np.linspace(0.0, t_stop, n_samples)
     traj = sim.run(t_stop, sample_times=times)
     # the physical counts only: how the engine names its bookkeeping may change
-    counters = {k: int(sim.stats[k]) for k in
-                ("events", "pair_collisions", "wall_collisions", "tc_elastic_collisions")}
-    return {"state": _digest(traj.positions, traj.velocities),
-            "energy": _digest(traj.kinetic_energy, traj.momentum),
-            "msd": _digest(traj.msd()),
-            "counters": counters}
+    counters = {
+        k: int(sim.stats[k])
+        for k in ("events", "pair_collisions", "wall_collisions", "tc_elastic_collisions")
+    }
+    return {
+        "state": _digest(traj.positions, traj.velocities),
+        "energy": _digest(traj.kinetic_energy, traj.momentum),
+        "msd": _digest(traj.msd()),
+        "counters": counters,
+    }
 
 
 def _mixture_with_tracer():
@@ -67,27 +72,47 @@ def _mixture_with_tracer():
 
 CASES = {
     "3d-periodic-inelastic-cells": lambda: _edmd(
-        granular.Scene.random(500, 0.03, restitution=0.8, seed=1), 2.0),
+        granular.Scene.random(500, 0.03, restitution=0.8, seed=1), 2.0
+    ),
     "2d-walls-inelastic": lambda: _edmd(
-        granular.Scene.random(300, 0.01, dim=2, boundary="walls", restitution=0.9,
-                              wall_restitution=0.95, seed=2), 2.0),
+        granular.Scene.random(
+            300, 0.01, dim=2, boundary="walls", restitution=0.9, wall_restitution=0.95, seed=2
+        ),
+        2.0,
+    ),
     "3d-dense-lists": lambda: _edmd(
-        granular.Scene.random(500, 0.0608, seed=3), 0.3),  # packing 0.47: lists
+        granular.Scene.random(500, 0.0608, seed=3), 0.3
+    ),  # packing 0.47: lists
     "2d-mixture-big-tracer": lambda: _edmd(_mixture_with_tracer(), 1.0),
     "3d-tc-model": lambda: _edmd(
-        granular.Scene.random(300, 0.04, restitution=0.3, contact_duration=1e-2, seed=5),
-        2.0),  # 254 of 1787 collisions elastic under the TC model
+        granular.Scene.random(300, 0.04, restitution=0.3, contact_duration=1e-2, seed=5), 2.0
+    ),  # 254 of 1787 collisions elastic under the TC model
 }
 
 for _model, _tau0 in (("langevin", np.inf), ("udsbm", 0.972)):
     for _scheme in ("em", "exact"):
+
         def _case(model=_model, tau0=_tau0, scheme=_scheme):
-            r = langevin.run(50, gamma0=9.26, D0=0.072, tau0=tau0, model=model, dt=0.01,
-                             t_stop=5.0, scheme=scheme, dim=3, tamsd_lags=[0.1, 0.5, 2.0],
-                             store_positions=True, seed=6)
-            return {"msd": _digest(r.times, r.msd(), r.msd(per_dimension=True), r.v2),
-                    "tamsd": _digest(r.tamsd_per_particle),
-                    "positions": _digest(r.positions)}
+            r = langevin.run(
+                50,
+                gamma0=9.26,
+                D0=0.072,
+                tau0=tau0,
+                model=model,
+                dt=0.01,
+                t_stop=5.0,
+                scheme=scheme,
+                dim=3,
+                tamsd_lags=[0.1, 0.5, 2.0],
+                store_positions=True,
+                seed=6,
+            )
+            return {
+                "msd": _digest(r.times, r.msd(), r.msd(per_dimension=True), r.v2),
+                "tamsd": _digest(r.tamsd_per_particle),
+                "positions": _digest(r.positions),
+            }
+
         CASES[f"langevin-{_model}-{_scheme}"] = _case
 
 
@@ -104,8 +129,10 @@ def test_fixed_seed_runs_give_the_recorded_bits(name):
         GOLDEN.write_text(json.dumps(data, indent=1, sort_keys=True) + "\n")
         return
     recorded = _recorded()
-    assert name in recorded, (f"no golden record for {name!r}; write it with "
-                              "GRANULAR_UPDATE_GOLDEN=1 python -m pytest tests/test_golden.py")
+    assert name in recorded, (
+        f"no golden record for {name!r}; write it with "
+        "GRANULAR_UPDATE_GOLDEN=1 python -m pytest tests/test_golden.py"
+    )
     assert got == recorded[name]
 
 

@@ -1,5 +1,6 @@
 """MDAnalysis export: EinsteinMSD of an exported simulation agrees with granular's TAMSD;
 written files read back."""
+
 import math
 
 import numpy as np
@@ -64,8 +65,9 @@ def test_universe_of_a_simulation_and_a_written_trr(tmp_path):
     # log-spaced times survive in the file
     logt = np.concatenate([[0.0], np.logspace(-2, 0, 6)])
     tr2 = Simulation(s).run(t_stop=1.0, sample_times=logt)
-    path = interop.write_trajectory(tmp_path / "gas.trr", tr2.times, tr2.positions, tr2.velocities,
-                                    box=[1, 1, 1])
+    path = interop.write_trajectory(
+        tmp_path / "gas.trr", tr2.times, tr2.positions, tr2.velocities, box=[1, 1, 1]
+    )
     back = mda.Universe.empty(50, trajectory=False)
     back.load_new(path)
     assert back.trajectory.n_frames == 7

@@ -3,6 +3,7 @@ of the estimate, from the ensemble size (stated at each assertion): a false-alar
 probability of 5.7e-7 per comparison (two-sided Gaussian tail at 5 sigma), so by the union
 bound even a test comparing at all its ~60 sample times fails by chance less than once in
 10^4 runs."""
+
 import math
 import os
 import re
@@ -20,10 +21,10 @@ from granular import langevin, theory
 
 import sde_reference  # tests/ is on sys.path (conftest.py)
 
-G0, D0 = 9.26, 0.072          # the thesis' standard gas, xi = 0.8 (theory.langevin_coefficients)
+G0, D0 = 9.26, 0.072  # the thesis' standard gas, xi = 0.8 (theory.langevin_coefficients)
 TAU0 = 0.972
-VT = G0 * D0                  # T0 / m
-A = G0 * TAU0                 # a = gamma0 tau0 of UDSBM
+VT = G0 * D0  # T0 / m
+A = G0 * TAU0  # a = gamma0 tau0 of UDSBM
 
 
 def rel_se_msd(n, dim=3):
@@ -46,18 +47,31 @@ def logarithmic_limit(t):
     return theory.msd_logarithmic(t, D0 * A**2 / (A - 1) ** 2, TAU0, gamma0=G0 - 1 / TAU0)
 
 
-@pytest.mark.parametrize("model,tau0,initial,limit", [
-    ("langevin", math.inf, "thermal", diffusive_limit),
-    ("udsbm", TAU0, "udsbm", logarithmic_limit),
-    ("udsbm", TAU0, "thermal", None)])  # the thermal start's transient shifts the limit
+@pytest.mark.parametrize(
+    "model,tau0,initial,limit",
+    [
+        ("langevin", math.inf, "thermal", diffusive_limit),
+        ("udsbm", TAU0, "udsbm", logarithmic_limit),
+        ("udsbm", TAU0, "thermal", None),
+    ],
+)  # the thermal start's transient shifts the limit
 def test_exact_scheme_msd_matches_theory(model, tau0, initial, limit):
     """Ensemble MSD vs (2.68) for Langevin and (2.113) for UDSBM with App. C's initial
     speed (and the transient term for a thermal start), from the ballistic to the
     diffusive / logarithmic regime; then the long-time samples vs the limit.  Tolerance:
     5 relative standard errors, sqrt(2 / (3 * 20000)) = 0.58% each, at every sample."""
     n = 20000
-    r = langevin.run(n, gamma0=G0, D0=D0, tau0=tau0, dt=0.01, t_stop=50.0, scheme="exact",
-                     initial=initial, seed=1)
+    r = langevin.run(
+        n,
+        gamma0=G0,
+        D0=D0,
+        tau0=tau0,
+        dt=0.01,
+        t_stop=50.0,
+        scheme="exact",
+        initial=initial,
+        seed=1,
+    )
     th = r.theory_msd()
     ok = r.times > 0
     tol = 5 * rel_se_msd(n)
@@ -78,18 +92,32 @@ def test_euler_maruyama_msd_matches_theory_at_small_steps():
     the statistical tolerance."""
     n = 20000
     for tau0 in (math.inf, TAU0):
-        r = langevin.run(n, gamma0=G0, D0=D0, tau0=tau0, dt=0.001, t_stop=5.0, scheme="em",
-                         initial="udsbm" if tau0 < math.inf else "thermal", seed=2)
+        r = langevin.run(
+            n,
+            gamma0=G0,
+            D0=D0,
+            tau0=tau0,
+            dt=0.001,
+            t_stop=5.0,
+            scheme="em",
+            initial="udsbm" if tau0 < math.inf else "thermal",
+            seed=2,
+        )
         ok = r.times > 0
         bias = 2 / (2 - G0 * 0.001) - 1
-        np.testing.assert_array_less(np.abs(r.msd()[ok] / r.theory_msd()[ok] - 1),
-                                     5 * rel_se_msd(n) + bias)
+        np.testing.assert_array_less(
+            np.abs(r.msd()[ok] / r.theory_msd()[ok] - 1), 5 * rel_se_msd(n) + bias
+        )
 
 
-@pytest.mark.parametrize("tau0,initial,v0_sq", [
-    (math.inf, "thermal", VT),
-    (math.inf, "fixed", 1.5**2 / 3),
-    (TAU0, "udsbm", theory.udsbm_v0_sq(D0, G0, TAU0))])
+@pytest.mark.parametrize(
+    "tau0,initial,v0_sq",
+    [
+        (math.inf, "thermal", VT),
+        (math.inf, "fixed", 1.5**2 / 3),
+        (TAU0, "udsbm", theory.udsbm_v0_sq(D0, G0, TAU0)),
+    ],
+)
 def test_ballistic_limit(tau0, initial, v0_sq):
     """Short times, t << 1/gamma0: the MSD is free flight, d <v0^2> t^2
     (theory.msd_ballistic with T/m = the initial <v_a^2>), over a decade of t.
@@ -99,9 +127,19 @@ def test_ballistic_limit(tau0, initial, v0_sq):
     theory (at most 0.4%, at t = 1e-3: gamma0 t / 3 for Langevin)."""
     n = 200_000
     t = np.array([1e-4, 3e-4, 1e-3])
-    r = langevin.run(n, gamma0=G0, D0=D0, tau0=tau0, dt=1e-4, t_stop=1e-3, scheme="exact",
-                     initial=initial, speed=1.5 if initial == "fixed" else None,
-                     sample_times=t, seed=3)
+    r = langevin.run(
+        n,
+        gamma0=G0,
+        D0=D0,
+        tau0=tau0,
+        dt=1e-4,
+        t_stop=1e-3,
+        scheme="exact",
+        initial=initial,
+        speed=1.5 if initial == "fixed" else None,
+        sample_times=t,
+        seed=3,
+    )
     assert r.v0_sq == pytest.approx(v0_sq)
     ballistic = theory.msd_ballistic(t, v0_sq)
     off_limit = np.abs(r.theory_msd(t) / ballistic - 1)
@@ -111,8 +149,18 @@ def test_ballistic_limit(tau0, initial, v0_sq):
 def test_euler_maruyama_first_step_is_exact_free_flight():
     """Fixed speed, first Euler-Maruyama step: x = v0 dt exactly (the noise enters the
     velocity only), so MSD(dt) = speed^2 dt^2 to rounding."""
-    r = langevin.run(100, gamma0=G0, D0=D0, dt=1e-4, t_stop=1e-3, speed=1.5, initial="fixed",
-                     scheme="em", sample_times=[0, 1e-4], seed=3)
+    r = langevin.run(
+        100,
+        gamma0=G0,
+        D0=D0,
+        dt=1e-4,
+        t_stop=1e-3,
+        speed=1.5,
+        initial="fixed",
+        scheme="em",
+        sample_times=[0, 1e-4],
+        seed=3,
+    )
     assert r.msd()[1] == pytest.approx(1.5**2 * 1e-8, rel=1e-13)
     assert r.v0_sq == pytest.approx(0.75)
 
@@ -122,11 +170,27 @@ def test_euler_maruyama_velocity_bias(gdt):
     """Stationary <v^2> of EM is (T/m) 2 / (2 - gamma0 dt) (2.92 iterated); relative standard
     error of the mean over 3N Gaussian components, sqrt(2 / (3 N))."""
     n = 100_000
-    r = langevin.run(n, gamma0=G0, D0=D0, dt=gdt / G0, t_stop=60 / G0, scheme="em", seed=4,
-                     sample_times=[60 / G0])
+    r = langevin.run(
+        n,
+        gamma0=G0,
+        D0=D0,
+        dt=gdt / G0,
+        t_stop=60 / G0,
+        scheme="em",
+        seed=4,
+        sample_times=[60 / G0],
+    )
     assert r.v2[-1] / (3 * VT) == pytest.approx(2 / (2 - gdt), rel=5 * rel_se_msd(n))
-    exact = langevin.run(n, gamma0=G0, D0=D0, dt=gdt / G0, t_stop=60 / G0, scheme="exact",
-                         seed=4, sample_times=[60 / G0])
+    exact = langevin.run(
+        n,
+        gamma0=G0,
+        D0=D0,
+        dt=gdt / G0,
+        t_stop=60 / G0,
+        scheme="exact",
+        seed=4,
+        sample_times=[60 / G0],
+    )
     assert exact.v2[-1] / (3 * VT) == pytest.approx(1.0, rel=5 * rel_se_msd(n))
 
 
@@ -137,8 +201,20 @@ def test_exact_step_moments():
     to 5 (1 - rho^2)/sqrt(N), kurtosis 3 to 5 sqrt(24/N) (which also tests the Gaussian
     generator)."""
     n, g, D, dt = 1_000_000, 2.0, 0.5, 0.3
-    r = langevin.run(n, gamma0=g, D0=D, dt=dt, t_stop=dt, scheme="exact", dim=1,
-                     initial="fixed", speed=1e-300, sample_times=[dt], store_positions=True, seed=5)
+    r = langevin.run(
+        n,
+        gamma0=g,
+        D0=D,
+        dt=dt,
+        t_stop=dt,
+        scheme="exact",
+        dim=1,
+        initial="fixed",
+        speed=1e-300,
+        sample_times=[dt],
+        store_positions=True,
+        seed=5,
+    )
     x = r.positions[0, :, 0]
     v = r.final_velocities[:, 0]
     h, c = g * dt, math.exp(-g * dt)
@@ -166,12 +242,24 @@ def test_tamsd_equals_msd_for_langevin_but_not_for_udsbm():
     O(dt^2 / tau0^2) = 1e-4 relative, far below that."""
     n = 4000
     lags = np.array([0.05, 0.5, 5.0])
-    r = langevin.run(n, gamma0=G0, D0=D0, dt=0.01, t_stop=100.0, scheme="exact", tamsd_lags=lags, seed=6)
+    r = langevin.run(
+        n, gamma0=G0, D0=D0, dt=0.01, t_stop=100.0, scheme="exact", tamsd_lags=lags, seed=6
+    )
     se = r.tamsd_per_particle.std(0, ddof=1) / math.sqrt(n)
     expected = theory.msd_langevin(lags, D0, G0)
     np.testing.assert_array_less(np.abs(r.tamsd() - expected), 5 * se)
-    u = langevin.run(n, gamma0=G0, D0=D0, tau0=TAU0, dt=0.01, t_stop=100.0, scheme="exact",
-                     initial="udsbm", tamsd_lags=lags, seed=6)
+    u = langevin.run(
+        n,
+        gamma0=G0,
+        D0=D0,
+        tau0=TAU0,
+        dt=0.01,
+        t_stop=100.0,
+        scheme="exact",
+        initial="udsbm",
+        tamsd_lags=lags,
+        seed=6,
+    )
     se = u.tamsd_per_particle.std(0, ddof=1) / math.sqrt(n)
     np.testing.assert_array_less(np.abs(u.tamsd() - u.theory_tamsd()), 5 * se)
     # non-ergodic: the ensemble MSD lies many standard errors above the time average
@@ -185,13 +273,35 @@ def test_same_seed_same_result_whatever_the_chunking(monkeypatch, model, tau0, s
     blocks of particles, or one particle at a time in segments of a few steps -- 1, 7 or 13,
     so that segment ends fall before, on and after sample steps and TAMSD window starts and
     ends (samples at every step; lags of 1, 7, 30, 100 and all 200 steps)."""
-    kw = dict(gamma0=G0, D0=D0, tau0=tau0, model=model, scheme=scheme, dt=0.01, t_stop=2.0,
-              sample_times=np.arange(201) * 0.01, tamsd_lags=[0.01, 0.07, 0.3, 1.0, 2.0],
-              store_positions=True, seed=7)
-    names = ("msd_total", "msd_per_dimension", "v2", "tamsd_per_particle", "positions",
-             "final_positions", "final_velocities")
+    kw = dict(
+        gamma0=G0,
+        D0=D0,
+        tau0=tau0,
+        model=model,
+        scheme=scheme,
+        dt=0.01,
+        t_stop=2.0,
+        sample_times=np.arange(201) * 0.01,
+        tamsd_lags=[0.01, 0.07, 0.3, 1.0, 2.0],
+        store_positions=True,
+        seed=7,
+    )
+    names = (
+        "msd_total",
+        "msd_per_dimension",
+        "v2",
+        "tamsd_per_particle",
+        "positions",
+        "final_positions",
+        "final_velocities",
+    )
     a = langevin.run(30, **kw)  # one call: 30 x 200 particle-steps
-    for chunk in (200 * 7, 13, 7, 1):  # 7 particles a call; then one particle, 13, 7, 1 steps a call
+    for chunk in (
+        200 * 7,
+        13,
+        7,
+        1,
+    ):  # 7 particles a call; then one particle, 13, 7, 1 steps a call
         monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", chunk)
         b = langevin.run(30, **kw)
         for name in names:
@@ -219,8 +329,12 @@ def test_ctrl_c_stops_a_long_run_of_one_particle():
             sys.exit(0)
         print("finished", flush=True)
         """)
-    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
-                            cwd=os.path.dirname(__file__))
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=os.path.dirname(__file__),
+    )
     try:
         assert proc.stdout.readline() == "start\n"
         time.sleep(1.0)  # well inside the run
@@ -236,15 +350,21 @@ def test_ctrl_c_stops_a_long_run_of_one_particle():
     assert waited < 3.0, f"the run took {waited:.1f} s to stop after SIGINT"
 
 
-@pytest.mark.parametrize("case,error", [
-    # positions: T x n x dim = 4 x 2**62 x 1 wraps to 0 in int64
-    ("dict(n=2**62, sample_steps=np.arange(4), positions=np.zeros(0))", "OverflowError: .*positions"),
-    # tamsd: n x L = 2**62 x 4 wraps to 0
-    ("dict(n=2**62, lags=np.arange(1, 5), tamsd=np.zeros(0))", "OverflowError: .*tamsd"),
-    # first + len(x) past int64
-    ("dict(n=2**63 - 1, first=2**63 - 1)", "ValueError: first \\+ len\\(x\\) exceeds n"),
-    ("dict(n_steps=2**62 + 1, step_to=2**62 + 1)", "ValueError: n_steps must lie in"),
-])
+@pytest.mark.parametrize(
+    "case,error",
+    [
+        # positions: T x n x dim = 4 x 2**62 x 1 wraps to 0 in int64
+        (
+            "dict(n=2**62, sample_steps=np.arange(4), positions=np.zeros(0))",
+            "OverflowError: .*positions",
+        ),
+        # tamsd: n x L = 2**62 x 4 wraps to 0
+        ("dict(n=2**62, lags=np.arange(1, 5), tamsd=np.zeros(0))", "OverflowError: .*tamsd"),
+        # first + len(x) past int64
+        ("dict(n=2**63 - 1, first=2**63 - 1)", "ValueError: first \\+ len\\(x\\) exceeds n"),
+        ("dict(n_steps=2**62 + 1, step_to=2**62 + 1)", "ValueError: n_steps must lie in"),
+    ],
+)
 def test_core_sde_run_checks_sizes_without_overflow(case, error):
     """_core.sde_run called directly with sizes whose products overflow int64 raises a
     clean exception instead of accepting a short buffer and writing past it (a child
@@ -266,19 +386,32 @@ def test_core_sde_run_checks_sizes_without_overflow(case, error):
         except Exception as exc:
             print(f"{{type(exc).__name__}}: {{exc}}")
         """)
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          cwd=os.path.dirname(__file__), timeout=120)
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        cwd=os.path.dirname(__file__),
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr[-2000:]
     assert re.match(error, done.stdout), done.stdout
 
 
 def test_refuses_unstable_euler_maruyama():
-    with pytest.raises(granular.UnstableStepError, match="gamma0\\*dt >= 2.*exact") as info:
+    with pytest.raises(granular.UnstableStepError, match=r"gamma0\*dt >= 2.*exact") as info:
         langevin.run(10, gamma0=10.0, D0=0.1, dt=0.2, t_stop=1.0, scheme="em")
     assert info.value.value == pytest.approx(2.0)
     # the exact scheme takes the same step
-    r = langevin.run(1000, gamma0=10.0, D0=0.1, dt=0.2, t_stop=100.0, scheme="exact", seed=1,
-                     sample_times=[100.0])
+    r = langevin.run(
+        1000,
+        gamma0=10.0,
+        D0=0.1,
+        dt=0.2,
+        t_stop=100.0,
+        scheme="exact",
+        seed=1,
+        sample_times=[100.0],
+    )
     assert r.v2[-1] / 3 == pytest.approx(1.0, rel=5 * rel_se_msd(1000))
 
 
@@ -312,26 +445,32 @@ def test_from_scene_uses_the_thesis_coefficients():
     assert m.model == "langevin"
 
 
-@pytest.mark.parametrize("kwargs,match", [
-    (dict(gamma0=-1.0), "gamma0 must be positive"),
-    (dict(dt=0.0), "dt must be positive"),
-    (dict(t_stop=float("nan")), "t_stop must be positive"),
-    (dict(model="brownian"), "model must be one of"),
-    (dict(scheme="rk4"), "scheme must be one of"),
-    (dict(dim=4), "dim must be"),
-    (dict(sample_times=[0.5, 0.2]), "increasing"),
-    (dict(sample_times=[0.5, 5.0]), "past t_stop"),
-    (dict(tamsd_lags=[0.0]), "tamsd_lags"),
-    (dict(initial="hot"), "initial must be one of"),
-    (dict(model="udsbm"), "finite tau0"),
-    (dict(initial="udsbm"), "App. C"),
-    # step counts past int64 (or infinite) are refused with the numbers, before any cast
-    (dict(t_stop=1e300), "t_stop / dt = 1e\\+300 / 0.01 = 1e\\+302 steps; a run takes at most 2\\*\\*62"),
-    (dict(dt=5e-324), "t_stop / dt = 1.0 / 5e-324 = inf steps"),
-    (dict(sample_times=[0.0, 1e300]), "past t_stop"),
-    (dict(tamsd_lags=[1e300]), "tamsd_lags must be at least dt and at most t_stop"),
-    (dict(tamsd_lags=[float("nan")]), "tamsd_lags must be at least dt and at most t_stop"),
-])
+@pytest.mark.parametrize(
+    "kwargs,match",
+    [
+        (dict(gamma0=-1.0), "gamma0 must be positive"),
+        (dict(dt=0.0), "dt must be positive"),
+        (dict(t_stop=float("nan")), "t_stop must be positive"),
+        (dict(model="brownian"), "model must be one of"),
+        (dict(scheme="rk4"), "scheme must be one of"),
+        (dict(dim=4), "dim must be"),
+        (dict(sample_times=[0.5, 0.2]), "increasing"),
+        (dict(sample_times=[0.5, 5.0]), "past t_stop"),
+        (dict(tamsd_lags=[0.0]), "tamsd_lags"),
+        (dict(initial="hot"), "initial must be one of"),
+        (dict(model="udsbm"), "finite tau0"),
+        (dict(initial="udsbm"), "App. C"),
+        # step counts past int64 (or infinite) are refused with the numbers, before any cast
+        (
+            dict(t_stop=1e300),
+            "t_stop / dt = 1e\\+300 / 0.01 = 1e\\+302 steps; a run takes at most 2\\*\\*62",
+        ),
+        (dict(dt=5e-324), "t_stop / dt = 1.0 / 5e-324 = inf steps"),
+        (dict(sample_times=[0.0, 1e300]), "past t_stop"),
+        (dict(tamsd_lags=[1e300]), "tamsd_lags must be at least dt and at most t_stop"),
+        (dict(tamsd_lags=[float("nan")]), "tamsd_lags must be at least dt and at most t_stop"),
+    ],
+)
 def test_bad_input(kwargs, match):
     base = dict(gamma0=G0, D0=D0, dt=0.01, t_stop=1.0)
     base.update(kwargs)
@@ -355,9 +494,17 @@ def _assert_rounding_close(got, want):
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * scale)
 
 
-@pytest.mark.parametrize("model,scheme,dim", [
-    ("langevin", "em", 3), ("langevin", "exact", 3), ("udsbm", "em", 3), ("udsbm", "exact", 3),
-    ("langevin", "exact", 1), ("udsbm", "em", 2)])
+@pytest.mark.parametrize(
+    "model,scheme,dim",
+    [
+        ("langevin", "em", 3),
+        ("langevin", "exact", 3),
+        ("udsbm", "em", 3),
+        ("udsbm", "exact", 3),
+        ("langevin", "exact", 1),
+        ("udsbm", "em", 2),
+    ],
+)
 def test_the_engine_is_the_reference_integrator_to_rounding(model, scheme, dim):
     """Every position at every step, the final velocities, the ensemble MSD sums and the
     TAMSD over the engine's windows (lags 1 and 33 and 60 steps: strides 1, 2, 3)."""
@@ -372,8 +519,9 @@ def test_the_engine_is_the_reference_integrator_to_rounding(model, scheme, dim):
     for m, lag in enumerate(lags):
         stride = granular._core.sde_lag_stride(lag)
         windows = len(range(0, 61 - lag, stride))
-        _assert_rounding_close(tamsd[:, m] / windows,
-                               sde_reference.tamsd_per_particle(xs, lag, stride))
+        _assert_rounding_close(
+            tamsd[:, m] / windows, sde_reference.tamsd_per_particle(xs, lag, stride)
+        )
 
 
 def test_the_reference_covers_the_ziggurat_tail_and_wedges():
@@ -387,8 +535,7 @@ def test_the_reference_covers_the_ziggurat_tail_and_wedges():
             tails += sum(abs(rs.normal()) > sde_reference.ZIG_R for _ in range(6))
     assert tails >= 3
     v0 = np.zeros((n, 3))
-    kw = dict(model="udsbm", scheme="exact", gamma0=G0, D0=D0, tau0=TAU0, dt=0.05,
-              n_steps=n_steps)
+    kw = dict(model="udsbm", scheme="exact", gamma0=G0, D0=D0, tau0=TAU0, dt=0.05, n_steps=n_steps)
     pos, v, _, _ = sde_reference.engine(v0, key, **kw)
     xs, vs = sde_reference.run(v0, key, **kw)
     _assert_rounding_close(pos, xs)
@@ -398,16 +545,36 @@ def test_the_reference_covers_the_ziggurat_tail_and_wedges():
 def test_run_draws_from_its_seed_as_documented():
     """langevin.run: key and initial velocities from SeedSequence(seed).spawn(2), then the
     engine; particles numbered from 0 whatever the chunking (first > 0 here)."""
-    r = langevin.run(5, gamma0=G0, D0=D0, dt=0.05, t_stop=1.0, scheme="em",
-                     sample_times=np.arange(21) * 0.05, store_positions=True, seed=42)
+    r = langevin.run(
+        5,
+        gamma0=G0,
+        D0=D0,
+        dt=0.05,
+        t_stop=1.0,
+        scheme="em",
+        sample_times=np.arange(21) * 0.05,
+        store_positions=True,
+        seed=42,
+    )
     key_seq, vel_seq = np.random.SeedSequence(42).spawn(2)
     key = int(key_seq.generate_state(1, dtype=np.uint64)[0])
     v0 = np.random.default_rng(vel_seq).normal(scale=math.sqrt(VT), size=(5, 3))
-    xs, vs = sde_reference.run(v0, key, model="langevin", scheme="em", gamma0=G0, D0=D0,
-                               tau0=math.inf, dt=0.05, n_steps=20)
+    xs, vs = sde_reference.run(
+        v0, key, model="langevin", scheme="em", gamma0=G0, D0=D0, tau0=math.inf, dt=0.05, n_steps=20
+    )
     _assert_rounding_close(r.positions, xs)
     _assert_rounding_close(r.final_velocities, vs[-1])
-    part, _, _, _ = sde_reference.engine(v0[2:4], key, model="langevin", scheme="em",
-                                         gamma0=G0, D0=D0, tau0=math.inf, dt=0.05,
-                                         n_steps=20, first=2, n=5)
+    part, _, _, _ = sde_reference.engine(
+        v0[2:4],
+        key,
+        model="langevin",
+        scheme="em",
+        gamma0=G0,
+        D0=D0,
+        tau0=math.inf,
+        dt=0.05,
+        n_steps=20,
+        first=2,
+        n=5,
+    )
     np.testing.assert_array_equal(part, r.positions[:, 2:4])

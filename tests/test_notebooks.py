@@ -1,4 +1,5 @@
 """The notebooks run from top to bottom (small sizes) with only the public API."""
+
 import json
 from pathlib import Path
 
@@ -31,13 +32,21 @@ def test_notebook_runs(path, tmp_path, monkeypatch):
     monkeypatch.setenv("GRANULAR_QUICK", "1")
     monkeypatch.setenv("MPLBACKEND", "Agg")
     nb = nbformat.read(path, as_version=4)
-    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code"), "outputs must be stripped in git"
+    assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code"), (
+        "outputs must be stripped in git"
+    )
     assert path.stat().st_size < COMMITTED_LIMIT
-    client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
-                                     resources={"metadata": {"path": str(tmp_path)}})
+    client = nbclient.NotebookClient(
+        nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
+    )
     client.execute()
-    errors = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
-              if o.get("output_type") == "error"]
+    errors = [
+        o
+        for c in nb.cells
+        if c.cell_type == "code"
+        for o in c.get("outputs", [])
+        if o.get("output_type") == "error"
+    ]
     assert not errors
     text = list(_text_outputs(nb))
     bars = [t for t in text if "\r" in t and "|" in t]
@@ -46,4 +55,8 @@ def test_notebook_runs(path, tmp_path, monkeypatch):
 
 
 def test_there_are_three_notebooks():
-    assert [p.stem for p in NOTEBOOKS] == ["01_quickstart", "02_thesis_reproduction", "03_langevin_vs_edmd"]
+    assert [p.stem for p in NOTEBOOKS] == [
+        "01_quickstart",
+        "02_thesis_reproduction",
+        "03_langevin_vs_edmd",
+    ]

@@ -5,6 +5,7 @@ environment) from a copy of the files git tracks (or would: new files not ignore
 so the checkout is not touched (setuptools writes ``granular.egg-info`` beside the sources).
 About 3 s with pip's cache warm.
 """
+
 import re
 import shutil
 import subprocess
@@ -27,8 +28,12 @@ def _tracked_files():
     if shutil.which("git") is None or not (ROOT / ".git").exists():
         pytest.skip("needs a git checkout to know the tracked files (an unpacked sdist has none)")
     # tracked files and new ones not yet added (but not ignored): what the next commit's clone has
-    out = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
-                         cwd=ROOT, capture_output=True, check=True)
+    out = subprocess.run(
+        ["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
+        cwd=ROOT,
+        capture_output=True,
+        check=True,
+    )
     return [name for name in out.stdout.decode().split("\0") if name and (ROOT / name).is_file()]
 
 
@@ -41,14 +46,18 @@ def sdist_names(tmp_path_factory):
         (src / name).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(ROOT / name, src / name)
     dist = tmp_path_factory.mktemp("dist")
-    done = subprocess.run([sys.executable, "-m", "build", "--sdist", "--outdir", str(dist),
-                           str(src)], capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [sys.executable, "-m", "build", "--sdist", "--outdir", str(dist), str(src)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 0, f"python -m build --sdist failed:\n{done.stdout}\n{done.stderr}"
     (archive,) = dist.glob("*.tar.gz")
     with tarfile.open(archive) as tar:
         names = [m.name for m in tar.getmembers() if m.isfile()]
     top = names[0].split("/")[0]
-    return tracked, {name[len(top) + 1:] for name in names}
+    return tracked, {name[len(top) + 1 :] for name in names}
 
 
 def test_sdist_holds_sources_tests_notebooks_and_images(sdist_names):
@@ -57,8 +66,9 @@ def test_sdist_holds_sources_tests_notebooks_and_images(sdist_names):
     assert {"tests/conftest.py", "csrc/edmd.c", "granular/cli/demo.py"} <= set(wanted)  # seen
     missing = sorted(set(wanted) - shipped)
     assert not missing, f"tracked files missing from the sdist (add them to MANIFEST.in): {missing}"
-    assert not [name for name in shipped if name.endswith((".pyc", ".so", ".o"))], \
+    assert not [name for name in shipped if name.endswith((".pyc", ".so", ".o"))], (
         "build products in the sdist"
+    )
 
 
 def test_sdist_holds_every_image_the_readme_shows(sdist_names):
@@ -98,8 +108,13 @@ def test_extras_cover_einstein_msd_and_the_notebooks():
     extras = _extras()
     assert {"mdanalysis", "tidynamics"} <= extras["interop"]
     assert {"matplotlib", "dask", "nbconvert", "ipykernel", "ipywidgets"} <= extras["notebooks"]
-    missing = (extras["plot"] | extras["interop"] | extras["parallel"] | extras["notebooks"]
-               | {"build", "nbclient", "nbformat", "pytest"}) - extras["test"]
+    missing = (
+        extras["plot"]
+        | extras["interop"]
+        | extras["parallel"]
+        | extras["notebooks"]
+        | {"build", "nbclient", "nbformat", "pytest"}
+    ) - extras["test"]
     assert not missing, f"the test extra lacks {sorted(missing)}"
 
 

@@ -1,4 +1,5 @@
 """Every plot renders to PNG, returns its axes and labels its axes with units."""
+
 import numpy as np
 import pytest
 
@@ -17,7 +18,12 @@ def test_all_plots_render(tmp_path):
         plot.collisions_per_particle(t, 3 * t, label="PBC"),
         plot.speed_distribution(v),
         plot.haff(t, theory.haff_temperature(t, 1.0, 2.0), tau0=2.0),
-        plot.msd(t, theory.msd_langevin(t, 0.1, 5.0), error=0.01 * t, theory_values=theory.msd_langevin(t, 0.1, 5.0)),
+        plot.msd(
+            t,
+            theory.msd_langevin(t, 0.1, 5.0),
+            error=0.01 * t,
+            theory_values=theory.msd_langevin(t, 0.1, 5.0),
+        ),
         plot.diffusivity(t, 0.1 * np.ones(20), theory_values=0.1 * np.ones(20)),
         plot.msd_vs_tamsd(t, t, t[::4], t[::4]),
         plot.snapshot(rng.random((30, 2)), 0.02, [0, 0], [1, 1]),
@@ -29,7 +35,7 @@ def test_all_plots_render(tmp_path):
             assert "[" in label or "dimensionless" in label, f"plot {k}: no unit in {label!r}"
         ax.figure.savefig(tmp_path / f"f{k}.png")
         assert (tmp_path / f"f{k}.png").stat().st_size > 1000
-    fig, ax = plt.subplots()
+    _, ax = plt.subplots()
     assert plot.energy(t, np.ones(20), ax=ax) is ax
     plt.close("all")
 
@@ -37,8 +43,12 @@ def test_all_plots_render(tmp_path):
 def _texts(ax):
     """Every piece of text a reader sees on the axes: labels, title, legend entries."""
     legend = ax.get_legend()
-    return [ax.get_xlabel(), ax.get_ylabel(), ax.get_title(),
-            *([t.get_text() for t in legend.get_texts()] if legend else [])]
+    return [
+        ax.get_xlabel(),
+        ax.get_ylabel(),
+        ax.get_title(),
+        *([t.get_text() for t in legend.get_texts()] if legend else []),
+    ]
 
 
 def test_demo_panels_read_well():
@@ -56,17 +66,23 @@ def test_demo_panels_read_well():
         c = theory.langevin_coefficients(300, 0.037, 1.0, xi, 0.66)
         T = theory.haff_temperature(t, 0.66, c.tau0) if xi < 1 else np.full_like(t, 0.66)
         msd = theory.msd_granular(t, c.D0, c.gamma0, c.tau0)
-        res = SimpleNamespace(mean=dict(msd=msd, temperature=T), error=dict(msd=0.01 * msd, temperature=0.01 * T),
-                              times=t, runs=[dict(velocities=[rng.normal(size=(300, 3)) * np.sqrt(T[-1])])])
+        res = SimpleNamespace(
+            mean=dict(msd=msd, temperature=T),
+            error=dict(msd=0.01 * msd, temperature=0.01 * T),
+            times=t,
+            runs=[dict(velocities=[rng.normal(size=(300, 3)) * np.sqrt(T[-1])])],
+        )
         results[label] = (res, msd, T, c)
-    fig, axes = plt.subplots(1, 4)
+    _, axes = plt.subplots(1, 4)
     demo._msd(axes[0], t, results)
     demo._temperature(axes[1], t, results)
     demo._speeds(axes[2], "molecular", results)
     demo._speeds(axes[3], "granular", results)
     theories = [line for line in axes[0].get_lines() if "theory" in line.get_label()]
     assert len(theories) == 2
-    assert len({(line.get_linestyle(), line.get_color()) for line in theories}) == 2, "theories look alike"
+    assert len({(line.get_linestyle(), line.get_color()) for line in theories}) == 2, (
+        "theories look alike"
+    )
     for ax in axes:
         for label in (ax.get_xlabel(), ax.get_ylabel()):
             assert "[" in label or "dimensionless" in label, f"no unit in {label!r}"

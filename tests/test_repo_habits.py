@@ -4,6 +4,7 @@ equation number in the user documentation tied to the thesis it comes from.
 
 Checks on files of the source tree skip where there is none (the sanitizer build runs the
 suite from a copy of tests/)."""
+
 import importlib.metadata
 import re
 from pathlib import Path
@@ -20,12 +21,14 @@ README_MAX_LINES = 300
 README_MAX_BYTES = 16_000
 
 # The thesis, defined once per document as [G20] with its full reference.
-THESIS_TITLE = ("Simulation methods for granular gas dynamics in periodic three-dimensional "
-                "systems")
+THESIS_TITLE = "Simulation methods for granular gas dynamics in periodic three-dimensional systems"
 # A reference to a numbered part of the thesis: eq. 2.68, eqs. 4.1-4.2, Table 2.2, ch. 4,
 # section 4.2.2, Fig. 4.8 ... Each must be written "[G20] eq. 2.68".
-NUMBERED = re.compile(r"\b(?:eqs?\.|equations?|Tables?|Figs?\.|Figures?|ch\.|chapters?|"
-                      r"sec\.|sections?|App\.)\s*\(?\d+(?:\.\d+)*", re.IGNORECASE)
+NUMBERED = re.compile(
+    r"\b(?:eqs?\.|equations?|Tables?|Figs?\.|Figures?|ch\.|chapters?|"
+    r"sec\.|sections?|App\.)\s*\(?\d+(?:\.\d+)*",
+    re.IGNORECASE,
+)
 # A bare "(2.68)" or "thesis 2.22", the way the old README cited equations without a reference
 BARE = re.compile(r"\([1-9A-F]\.\d{1,3}\)|\bthesis'?\s+\d\.\d{1,3}\b")
 
@@ -52,6 +55,7 @@ def _user_docs():
 
 # -- one version ----------------------------------------------------------------------------
 
+
 def test_installed_version_is_granular_version():
     # the metadata is written at install time from granular.__version__; a mismatch means the
     # version was changed without reinstalling, or written somewhere else as well
@@ -68,15 +72,18 @@ def test_version_is_written_once():
 
 def test_citation_and_changelog_name_this_version():
     cff = _source_file("CITATION.cff").read_text()
-    assert re.search(rf"^version:\s*{re.escape(granular.__version__)}\s*$", cff, re.M), \
+    assert re.search(rf"^version:\s*{re.escape(granular.__version__)}\s*$", cff, re.M), (
         f"CITATION.cff does not say version {granular.__version__}"
+    )
     changelog = _source_file("CHANGELOG.md").read_text()
     assert "## [Unreleased]" in changelog
-    assert f"## [{granular.__version__}]" in changelog, \
+    assert f"## [{granular.__version__}]" in changelog, (
         f"CHANGELOG.md has no section for {granular.__version__}"
+    )
 
 
 # -- license --------------------------------------------------------------------------------
+
 
 def test_license_file_matches_pyproject():
     declared = _pyproject()["project"]["license"]
@@ -84,7 +91,7 @@ def test_license_file_matches_pyproject():
     text = _source_file("LICENSE").read_text()
     assert text.startswith("MIT License\n")
     assert "Copyright (c) 2026 the granular developers" in text
-    assert "THE SOFTWARE IS PROVIDED \"AS IS\"" in text
+    assert 'THE SOFTWARE IS PROVIDED "AS IS"' in text
 
 
 def test_installed_metadata_carries_the_license():
@@ -95,13 +102,15 @@ def test_installed_metadata_carries_the_license():
 
 # -- README ---------------------------------------------------------------------------------
 
+
 def test_readme_within_its_budget():
     readme = _source_file("README.md")
     lines = readme.read_text().count("\n")
     size = readme.stat().st_size
     assert lines <= README_MAX_LINES and size <= README_MAX_BYTES, (
         f"README.md is {lines} lines, {size} bytes (budget {README_MAX_LINES} lines, "
-        f"{README_MAX_BYTES} bytes): move internals to docs/engine.md or docs/performance.md")
+        f"{README_MAX_BYTES} bytes): move internals to docs/engine.md or docs/performance.md"
+    )
 
 
 def test_readme_keeps_the_install_and_test_commands():
@@ -118,8 +127,9 @@ def test_local_links_and_images_exist(doc):
     targets = re.findall(r"\]\(([^)\s#]+)(?:#[^)\s]*)?\)", path.read_text())
     local = [t for t in targets if "://" not in t]
     if doc == "README.md":
-        assert any(t.startswith("docs/") and t.endswith(".png") for t in local), \
+        assert any(t.startswith("docs/") and t.endswith(".png") for t in local), (
             "the README shows no image from docs/: this test checks nothing"
+        )
     missing = [t for t in local if not (path.parent / t).exists()]
     assert not missing, f"{doc} links to files that do not exist: {missing}"
 
@@ -129,14 +139,20 @@ def test_every_equation_number_cites_the_thesis():
         text = path.read_text()
         name = path.relative_to(ROOT)
         refs = list(NUMBERED.finditer(text))
-        uncited = [m.group(0) for m in refs
-                   if not re.search(r"\[G20\]\s*$", text[max(0, m.start() - 8):m.start()])]
+        uncited = [
+            m.group(0)
+            for m in refs
+            if not re.search(r"\[G20\]\s*$", text[max(0, m.start() - 8) : m.start()])
+        ]
         assert not uncited, f"{name}: numbers not written as '[G20] eq. ...': {uncited}"
         bare = BARE.findall(text)
         assert not bare, f"{name}: equation numbers without [G20]: {bare}"
         if refs:
             flat = " ".join(text.split())
-            definition = re.search(r"\[G20\][^\n]{0,40}?A\. Gjersvoll, \*([^*]+)\*, master's "
-                                   r"thesis[^.]*NTNU[^.]*2020", flat)
+            definition = re.search(
+                r"\[G20\][^\n]{0,40}?A\. Gjersvoll, \*([^*]+)\*, master's "
+                r"thesis[^.]*NTNU[^.]*2020",
+                flat,
+            )
             assert definition, f"{name} cites [G20] but never gives its full reference"
             assert definition.group(1) == THESIS_TITLE

@@ -1,5 +1,6 @@
 """Speed against accuracy and the failure maps (quick sizes): the artefacts exist, each
 method fails where it should, and never hangs."""
+
 import json
 import math
 
@@ -18,7 +19,9 @@ def test_failure_maps_pin_each_failure_mode():
     # EM's stationary velocity bias follows 2 / (2 - gamma dt) - 1 (5 standard errors of
     # the mean over 3 x 2000 Gaussian components, sqrt(2/6000) = 1.8%)
     for g in (0.5, 1.0, 1.5):
-        assert abs(by_g[g]["em_v2_bias"] - (2 / (2 - g) - 1)) < 5 * math.sqrt(2 / 6000) * (2 / (2 - g))
+        assert abs(by_g[g]["em_v2_bias"] - (2 / (2 - g) - 1)) < 5 * math.sqrt(2 / 6000) * (
+            2 / (2 - g)
+        )
         assert abs(by_g[g]["exact_v2_bias"]) < 5 * math.sqrt(2 / 6000)
     cells = speed_accuracy.collapse_map(quick=True)
     plain = {(c["eta"], c["xi"]): c for c in cells if c["contact_duration"] == 0}
@@ -30,7 +33,9 @@ def test_failure_maps_pin_each_failure_mode():
     # a run stopped by the event budget is neither ok nor tc: it did not reach its goal.
     # 4000 events per particle suffice for every cell here; 10 suffice for none
     assert "budget" not in {c["status"] for c in cells}
-    starved = speed_accuracy.collapse_map(quick=True, contact_durations=(1e-4,), events_per_particle=10)
+    starved = speed_accuracy.collapse_map(
+        quick=True, contact_durations=(1e-4,), events_per_particle=10
+    )
     assert {c["status"] for c in starved} == {"budget"}
 
 
@@ -38,8 +43,22 @@ def test_speed_accuracy_cli_quick(tmp_path):
     import subprocess
     import sys
 
-    subprocess.run([sys.executable, "-m", "granular", "bench", "--speed-accuracy", "--quick",
-                    "--out", str(tmp_path)], check=True, capture_output=True, timeout=600)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "granular",
+            "bench",
+            "--speed-accuracy",
+            "--quick",
+            "--out",
+            str(tmp_path),
+        ],
+        check=True,
+        capture_output=True,
+        timeout=600,
+    )
+
     def refuse(constant):  # strict JSON: no Infinity or NaN, which other parsers reject
         raise ValueError(f"speed_accuracy.json holds {constant}, which is not JSON")
 
@@ -52,8 +71,14 @@ def test_speed_accuracy_cli_quick(tmp_path):
     # per gas: Euler-Maruyama up to gamma0 dt = 1.9, just short of its limit; the exact
     # scheme at the same steps and past the limit
     for gas in ("granular", "molecular"):
-        em, exact = ({round(p["gamma_dt"], 6) for p in data["points"] if p["gas"] == gas and p["method"] == m}
-                     for m in ("em", "exact"))
+        em, exact = (
+            {
+                round(p["gamma_dt"], 6)
+                for p in data["points"]
+                if p["gas"] == gas and p["method"] == m
+            }
+            for m in ("em", "exact")
+        )
         assert max(em) == 1.9 and em < exact and max(exact) > 2
     for name in ("speed_accuracy.png", "em_stability.png", "collapse_map.png", "dense_cost.png"):
         assert (tmp_path / name).stat().st_size > 5000
@@ -74,8 +99,14 @@ def test_collapse_map_chart_reads_well():
     import matplotlib.pyplot as plt
     from matplotlib.patches import Rectangle
 
-    cells = [dict(contact_duration=tc, eta=eta, xi=xi, status="collapse" if xi < 0.5 and tc == 0 else "ok")
-             for tc in (0.0, 1e-4) for eta in (0.05, 0.2, 0.4, 0.6, 0.7) for xi in (0.9, 0.7, 0.5, 0.3, 0.1)]
+    cells = [
+        dict(
+            contact_duration=tc, eta=eta, xi=xi, status="collapse" if xi < 0.5 and tc == 0 else "ok"
+        )
+        for tc in (0.0, 1e-4)
+        for eta in (0.05, 0.2, 0.4, 0.6, 0.7)
+        for xi in (0.9, 0.7, 0.5, 0.3, 0.1)
+    ]
     fig = speed_accuracy._collapse_map(plt, cells)
     legend = [t.get_text().split(":")[0] for t in fig.legends[0].get_texts()]
     assert sorted(legend) == ["collapse", "ok"]
@@ -83,8 +114,12 @@ def test_collapse_map_chart_reads_well():
     for ax in fig.axes:
         squares = [p.get_window_extent(renderer) for p in ax.patches if isinstance(p, Rectangle)]
         assert len(squares) == 25 and len(ax.texts) == 25
-        for text, square in zip(ax.texts, squares):
+        for text, square in zip(ax.texts, squares, strict=True):
             box = text.get_window_extent(renderer)
-            assert square.x0 <= box.x0 and box.x1 <= square.x1 and square.y0 <= box.y0 and box.y1 <= square.y1, \
-                text.get_text()
+            assert (
+                square.x0 <= box.x0
+                and box.x1 <= square.x1
+                and square.y0 <= box.y0
+                and box.y1 <= square.y1
+            ), text.get_text()
     plt.close(fig)

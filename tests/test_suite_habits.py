@@ -1,6 +1,7 @@
 """The suite's own habits: the slow list in conftest names tests that exist (a renamed test
 would silently drop out of it), and no test module imports another (shared code lives in
 tests/helpers/)."""
+
 import ast
 from pathlib import Path
 
@@ -11,8 +12,11 @@ MODULES = sorted(HERE.glob("test_*.py"))
 
 
 def _functions(path):
-    return {node.name for node in ast.walk(ast.parse(path.read_text()))
-            if isinstance(node, ast.FunctionDef)}
+    return {
+        node.name
+        for node in ast.walk(ast.parse(path.read_text()))
+        if isinstance(node, ast.FunctionDef)
+    }
 
 
 def test_every_slow_entry_names_a_test():
@@ -32,5 +36,6 @@ def test_no_test_module_imports_another():
                 imported = [node.module.split(".")[0]]
             else:
                 continue
-            assert not set(imported) & names, \
+            assert not set(imported) & names, (
                 f"{path.name} imports {imported}: move what it shares to tests/helpers/"
+            )

@@ -1,6 +1,7 @@
 """Each formula of granular.theory against an independent evaluation: numerical
 integration of the velocity autocorrelation function it comes from, a differential
 equation solved numerically, or a known limit."""
+
 import math
 
 import numpy as np
@@ -15,7 +16,10 @@ D0, G0, TAU0 = 0.07, 9.0, 1.5
 def msd_from_vacf(vacf, t, dim=3, start=0.0):
     """MSD over [start, t] = 2 int_start^t dt1 int_t1^t dt2 <v(t1) v(t2)> (2.59), per
     dimension times dim; adaptive quadrature, relative accuracy ~1e-10."""
-    inner = lambda t1: integrate.quad(lambda t2: vacf(t1, t2), t1, t, epsabs=0, epsrel=1e-12, limit=200)[0]
+
+    def inner(t1):
+        return integrate.quad(lambda t2: vacf(t1, t2), t1, t, epsabs=0, epsrel=1e-12, limit=200)[0]
+
     return dim * 2 * integrate.quad(inner, start, t, epsabs=0, epsrel=1e-11, limit=200)[0]
 
 
@@ -23,11 +27,20 @@ def msd_from_vacf(vacf, t, dim=3, start=0.0):
 def test_msd_formulas_are_the_double_integrals_of_their_vacf(t):
     T0_m = D0 * G0  # T0 / m = D0 gamma0 (2.55)
     a = G0 * TAU0
-    langevin = lambda t1, t2: T0_m * math.exp(-G0 * (t2 - t1))  # (2.66)
-    granular = lambda t1, t2: T0_m * (1 + t2 / TAU0) ** (-a - 1) * (1 + t1 / TAU0) ** (a - 1)  # (2.77)
-    udsbm = lambda t1, t2: T0_m * a / (a - 1) * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)  # (2.111)
+
+    def langevin(t1, t2):  # (2.66)
+        return T0_m * math.exp(-G0 * (t2 - t1))
+
+    def granular(t1, t2):  # (2.77)
+        return T0_m * (1 + t2 / TAU0) ** (-a - 1) * (1 + t1 / TAU0) ** (a - 1)
+
+    def udsbm(t1, t2):  # (2.111)
+        return T0_m * a / (a - 1) * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)
+
     assert theory.msd_langevin(t, D0, G0) == pytest.approx(msd_from_vacf(langevin, t), rel=1e-8)
-    assert theory.msd_granular(t, D0, G0, TAU0) == pytest.approx(msd_from_vacf(granular, t), rel=1e-8)
+    assert theory.msd_granular(t, D0, G0, TAU0) == pytest.approx(
+        msd_from_vacf(granular, t), rel=1e-8
+    )
     assert theory.msd_udsbm(t, D0, G0, TAU0) == pytest.approx(msd_from_vacf(udsbm, t), rel=1e-8)
 
 
@@ -39,12 +52,23 @@ def test_msd_with_other_initial_speeds(t):
     a = G0 * TAU0
     vs_l = D0 * G0
     vs_u = theory.udsbm_v0_sq(D0, G0, TAU0)
-    lang = lambda t1, t2: vs_l * math.exp(-G0 * (t2 - t1)) + (v0 - vs_l) * math.exp(-G0 * (t1 + t2))
-    phi = lambda s: (1 + s / TAU0) ** (-a)
-    uds = lambda t1, t2: (vs_u * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)
-                          + (v0 - vs_u) * phi(t1) * phi(t2))
-    assert theory.msd_langevin(t, D0, G0, v0_sq=v0) == pytest.approx(msd_from_vacf(lang, t), rel=1e-8)
-    assert theory.msd_udsbm(t, D0, G0, TAU0, v0_sq=v0) == pytest.approx(msd_from_vacf(uds, t), rel=1e-8)
+
+    def lang(t1, t2):
+        return vs_l * math.exp(-G0 * (t2 - t1)) + (v0 - vs_l) * math.exp(-G0 * (t1 + t2))
+
+    def phi(s):
+        return (1 + s / TAU0) ** (-a)
+
+    def uds(t1, t2):
+        stationary = vs_u * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)
+        return stationary + (v0 - vs_u) * phi(t1) * phi(t2)
+
+    assert theory.msd_langevin(t, D0, G0, v0_sq=v0) == pytest.approx(
+        msd_from_vacf(lang, t), rel=1e-8
+    )
+    assert theory.msd_udsbm(t, D0, G0, TAU0, v0_sq=v0) == pytest.approx(
+        msd_from_vacf(uds, t), rel=1e-8
+    )
 
 
 @pytest.mark.parametrize("start,lag", [(0.0, 0.5), (0.3, 0.05), (2.0, 0.7), (10.0, 4.0)])
@@ -56,15 +80,22 @@ def test_udsbm_increment_msd_is_the_double_integral_over_its_window(start, lag):
     v0 = 0.3
     a = G0 * TAU0
     vs = theory.udsbm_v0_sq(D0, G0, TAU0)
-    phi = lambda s: (1 + s / TAU0) ** (-a)
-    uds = lambda t1, t2: (vs * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)
-                          + (v0 - vs) * phi(t1) * phi(t2))
+
+    def phi(s):
+        return (1 + s / TAU0) ** (-a)
+
+    def uds(t1, t2):
+        stationary = vs * (1 + t1 / TAU0) ** (a - 2) * (1 + t2 / TAU0) ** (-a)
+        return stationary + (v0 - vs) * phi(t1) * phi(t2)
+
     got = theory.udsbm_increment_msd(lag, start, D0, G0, TAU0, v0_sq=v0)
     assert got == pytest.approx(msd_from_vacf(uds, start + lag, start=start), rel=1e-8)
     assert theory.udsbm_increment_msd(lag, start, D0, G0, TAU0) == pytest.approx(
-        theory.msd_udsbm(lag / (1 + start / TAU0), D0, G0, TAU0), rel=1e-10)
+        theory.msd_udsbm(lag / (1 + start / TAU0), D0, G0, TAU0), rel=1e-10
+    )
     assert theory.udsbm_increment_msd(lag, 0.0, D0, G0, TAU0, v0_sq=v0) == pytest.approx(
-        theory.msd_udsbm(lag, D0, G0, TAU0, v0_sq=v0), rel=1e-10)
+        theory.msd_udsbm(lag, D0, G0, TAU0, v0_sq=v0), rel=1e-10
+    )
 
 
 def test_udsbm_increment_msd_at_lags_short_against_the_start():
@@ -84,20 +115,29 @@ def test_udsbm_increment_msd_at_lags_short_against_the_start():
 def test_msd_limits_and_numerical_stability():
     t = np.array([1e-12, 1e-9, 1e-6])
     T0_m = D0 * G0
-    for f in (lambda t: theory.msd_langevin(t, D0, G0),
-              lambda t: theory.msd_granular(t, D0, G0, TAU0),
-              lambda t: theory.msd_udsbm(t, D0, G0, TAU0, v0_sq=T0_m)):
+    for f in (
+        lambda t: theory.msd_langevin(t, D0, G0),
+        lambda t: theory.msd_granular(t, D0, G0, TAU0),
+        lambda t: theory.msd_udsbm(t, D0, G0, TAU0, v0_sq=T0_m),
+    ):
         np.testing.assert_allclose(f(t), theory.msd_ballistic(t, T0_m), rtol=1e-5)
         assert f(0.0) == 0.0
     big = 1e6
     # the asymptotes with their offsets, reached to exp(-gamma0 t) and
     # (t/tau0)^(-gamma0 tau0) -- far below rounding at t = 1e6
-    assert theory.msd_langevin(big, D0, G0) == pytest.approx(theory.msd_diffusive(big, D0, gamma0=G0), rel=1e-13)
+    assert theory.msd_langevin(big, D0, G0) == pytest.approx(
+        theory.msd_diffusive(big, D0, gamma0=G0), rel=1e-13
+    )
     assert theory.msd_granular(big, D0, G0, TAU0) == pytest.approx(
-        theory.msd_logarithmic(big, D0, TAU0, gamma0=G0), rel=1e-13)
-    assert theory.msd_langevin(big, D0, G0) == pytest.approx(theory.msd_diffusive(big, D0), rel=1e-6)
+        theory.msd_logarithmic(big, D0, TAU0, gamma0=G0), rel=1e-13
+    )
+    assert theory.msd_langevin(big, D0, G0) == pytest.approx(
+        theory.msd_diffusive(big, D0), rel=1e-6
+    )
     assert theory.msd_granular(3.0, D0, G0, math.inf) == theory.msd_langevin(3.0, D0, G0)
-    assert theory.msd_langevin(2.0, D0, G0, dim=2) == pytest.approx(theory.msd_langevin(2.0, D0, G0) * 2 / 3)
+    assert theory.msd_langevin(2.0, D0, G0, dim=2) == pytest.approx(
+        theory.msd_langevin(2.0, D0, G0) * 2 / 3
+    )
     with pytest.raises(ValueError, match="gamma0 \\* tau0 > 1"):
         theory.msd_udsbm(1.0, D0, 0.5, 1.0)
 
@@ -105,7 +145,10 @@ def test_msd_limits_and_numerical_stability():
 @pytest.mark.parametrize("dim", [2, 3])
 def test_maxwell_boltzmann_density_and_moments(dim):
     T, m = 1.7, 2.0
-    pdf = lambda v: theory.maxwell_boltzmann_pdf(v, T, m, dim)
+
+    def pdf(v):
+        return theory.maxwell_boltzmann_pdf(v, T, m, dim)
+
     norm = integrate.quad(pdf, 0, np.inf)[0]
     mean = integrate.quad(lambda v: v * pdf(v), 0, np.inf)[0]
     mean_sq = integrate.quad(lambda v: v * v * pdf(v), 0, np.inf)[0]
@@ -123,7 +166,8 @@ def test_contact_value_and_equation_of_state():
     # Carnahan-Starling: 1 + 4 eta g2 = (1 + eta + eta^2 - eta^3) / (1 - eta)^3
     for eta in (0.1, 0.3, 0.45):
         assert theory.compressibility_factor(eta) == pytest.approx(
-            (1 + eta + eta**2 - eta**3) / (1 - eta) ** 3, rel=1e-14)
+            (1 + eta + eta**2 - eta**3) / (1 - eta) ** 3, rel=1e-14
+        )
         # second virial coefficients: g2 -> 1 + 5/2 eta (3D), 1 + 25/16... low density slopes
     eps = 1e-7
     assert (theory.contact_value(eps) - 1) / eps == pytest.approx(2.5, rel=1e-5)  # exact B3 term
@@ -139,7 +183,10 @@ def test_haff_law_solves_its_cooling_equation(dim):
     is checked against EDMD in test_physics_edmd.test_two_dimensional_enskog_collision_rate."""
     n, xi, T0 = 1000.0, 0.7, 0.9
     r = 0.02 if dim == 3 else 0.01
-    rhs = lambda t, T: -(1 - xi**2) * theory.collision_frequency(n, r, T, dim=dim) * T / dim
+
+    def rhs(t, T):
+        return -(1 - xi**2) * theory.collision_frequency(n, r, T, dim=dim) * T / dim
+
     ts = np.linspace(0, 5, 11)
     sol = integrate.solve_ivp(rhs, (0, 5), [T0], t_eval=ts, rtol=1e-11, atol=1e-14)
     tau0 = theory.haff_tau0(n, r, xi, T0, dim=dim)

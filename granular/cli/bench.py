@@ -1,6 +1,7 @@
 """Throughput benchmarks: pair collisions per second of the event-driven engine (and the
 Langevin engine's workloads when it is present).  Figures are printed and written as
 JSON, never asserted: speed is measured here, not in the tests."""
+
 from __future__ import annotations
 
 import math
@@ -28,8 +29,19 @@ EDMD_WORKLOADS = [
 LARGE_WORKLOADS = [("edmd-3d-eta0.065-n1e6", 3, 1_000_000, 0.065, 10.0)]
 
 
-def edmd_workload(name, dim, n, eta, collisions, *, boundary="periodic", restitution=1.0,
-                  equilibrate=10.0, windows=3, seed=0):
+def edmd_workload(
+    name,
+    dim,
+    n,
+    eta,
+    collisions,
+    *,
+    boundary="periodic",
+    restitution=1.0,
+    equilibrate=10.0,
+    windows=3,
+    seed=0,
+):
     """Time one EDMD workload: an equilibrated molecular gas, then `collisions` more
     collisions per particle in `windows` consecutive windows; the fastest window is
     reported (on a shared machine the others measure the neighbours too)."""
@@ -50,11 +62,23 @@ def edmd_workload(name, dim, n, eta, collisions, *, boundary="periodic", restitu
         if best is None or pairs / seconds > best[0] / best[2]:
             best = (pairs, events, seconds)
     pairs, events, seconds = best
-    return dict(name=name, engine="edmd", dim=dim, n=n, packing_fraction=round(scene.packing_fraction, 6),
-                boundary=boundary, restitution=restitution, pair_collisions=pairs, events=events,
-                seconds=seconds, pair_collisions_per_second=pairs / seconds,
-                ns_per_event=1e9 * seconds / events, windows=windows,
-                cells=list(after["cells"][:dim]), shell=after["shell"])
+    return dict(
+        name=name,
+        engine="edmd",
+        dim=dim,
+        n=n,
+        packing_fraction=round(scene.packing_fraction, 6),
+        boundary=boundary,
+        restitution=restitution,
+        pair_collisions=pairs,
+        events=events,
+        seconds=seconds,
+        pair_collisions_per_second=pairs / seconds,
+        ns_per_event=1e9 * seconds / events,
+        windows=windows,
+        cells=list(after["cells"][:dim]),
+        shell=after["shell"],
+    )
 
 
 def run(quick=False, large=False, langevin=True, out=print):
@@ -66,9 +90,12 @@ def run(quick=False, large=False, langevin=True, out=print):
             n, coll = min(n, 2000), 5.0
         r = edmd_workload(name, dim, n, eta, coll)
         results.append(r)
-        out(f"{r['name']:<28} N={r['n']:>8}  {r['pair_collisions_per_second'] / 1e6:6.3f} M pair collisions/s"
-            f"  ({r['ns_per_event']:.0f} ns/event, {r['events'] / r['pair_collisions']:.2f} events/collision"
-            f"{', neighbour lists' if r['shell'] > 0 else ''})")
+        out(
+            f"{r['name']:<28} N={r['n']:>8}  {r['pair_collisions_per_second'] / 1e6:6.3f} M pair "
+            f"collisions/s  ({r['ns_per_event']:.0f} ns/event, "
+            f"{r['events'] / r['pair_collisions']:.2f} "
+            f"events/collision{', neighbour lists' if r['shell'] > 0 else ''})"
+        )
     if langevin:
         try:
             from . import bench_langevin
@@ -77,16 +104,22 @@ def run(quick=False, large=False, langevin=True, out=print):
         if bench_langevin is not None:
             for r in bench_langevin.workloads(quick=quick):
                 results.append(r)
-                out(f"{r['name']:<28} N={r['n']:>8}  {r['particle_steps_per_second'] / 1e6:8.1f} M particle-steps/s"
-                    f"  (NumPy: {r['numpy_particle_steps_per_second'] / 1e6:.1f} M/s; peak {r['peak_memory_mb']:.1f} MB)")
+                out(
+                    f"{r['name']:<28} N={r['n']:>8}  {r['particle_steps_per_second'] / 1e6:8.1f} M "
+                    f"particle-steps/s  (NumPy: {r['numpy_particle_steps_per_second'] / 1e6:.1f} "
+                    f"M/s; peak {r['peak_memory_mb']:.1f} MB)"
+                )
     return results
 
 
 def main(json_path=None, quick=False, large=False):
     results = run(quick=quick, large=large)
     if json_path:
-        meta = dict(python=platform.python_version(), machine=platform.machine(),
-                    processor=platform.processor())
+        meta = dict(
+            python=platform.python_version(),
+            machine=platform.machine(),
+            processor=platform.processor(),
+        )
         for r in results:
             r.setdefault("host", meta)
         write_json(json_path, results)

@@ -8,8 +8,10 @@ Each record has the keys every bench record has (name, engine, dim, n, seconds, 
 EDMD ones -- packing_fraction, boundary, restitution, pair_collisions,
 pair_collisions_per_second -- set to None: independent particles in free space have none
 of them) plus the Langevin ones."""
+
 from __future__ import annotations
 
+import functools
 import time
 import tracemalloc
 
@@ -18,8 +20,9 @@ import numpy as np
 from .. import langevin
 
 G0, D0 = 9.26, 0.072  # the thesis' standard gas
-_NOT_EDMD = dict.fromkeys(("packing_fraction", "boundary", "restitution", "pair_collisions",
-                           "pair_collisions_per_second"))
+_NOT_EDMD = dict.fromkeys(
+    ("packing_fraction", "boundary", "restitution", "pair_collisions", "pair_collisions_per_second")
+)
 
 
 def numpy_em(n, steps, dt, dim=3, seed=0):
@@ -59,11 +62,23 @@ def _measure(fn):
 
 
 def _record(name, r, seconds, peak, numpy_rate):
-    steps = int(round(r.t_stop / r.dt))
-    return dict(name=name, engine="langevin", dim=r.dim, n=r.n, **_NOT_EDMD, model=r.model,
-                scheme=r.scheme, dt=r.dt, steps=steps, tamsd_lags=len(r.tamsd_lags),
-                seconds=seconds, particle_steps_per_second=r.n * steps / seconds,
-                peak_memory_mb=peak, numpy_particle_steps_per_second=numpy_rate)
+    steps = round(r.t_stop / r.dt)
+    return dict(
+        name=name,
+        engine="langevin",
+        dim=r.dim,
+        n=r.n,
+        **_NOT_EDMD,
+        model=r.model,
+        scheme=r.scheme,
+        dt=r.dt,
+        steps=steps,
+        tamsd_lags=len(r.tamsd_lags),
+        seconds=seconds,
+        particle_steps_per_second=r.n * steps / seconds,
+        peak_memory_mb=peak,
+        numpy_particle_steps_per_second=numpy_rate,
+    )
 
 
 def _size(n):
@@ -76,17 +91,48 @@ def workloads(quick=False):
     for n, steps in cases:
         dt = 0.01
         np_steps = max(10, steps // 20)
-        _, np_seconds, _ = _measure(lambda: numpy_em(n, np_steps, dt))
+        _, np_seconds, _ = _measure(functools.partial(numpy_em, n, np_steps, dt))
         for scheme in ("em", "exact"):
-            r, seconds, peak = _measure(lambda: langevin.run(n, gamma0=G0, D0=D0, dt=dt, t_stop=steps * dt,
-                                                             scheme=scheme, seed=1))
-            out.append(_record(f"langevin-3d-{scheme}-{_size(n)}", r, seconds, peak,
-                               n * np_steps / np_seconds))
+            r, seconds, peak = _measure(
+                functools.partial(
+                    langevin.run,
+                    n,
+                    gamma0=G0,
+                    D0=D0,
+                    dt=dt,
+                    t_stop=steps * dt,
+                    scheme=scheme,
+                    seed=1,
+                )
+            )
+            out.append(
+                _record(
+                    f"langevin-3d-{scheme}-{_size(n)}", r, seconds, peak, n * np_steps / np_seconds
+                )
+            )
     # the issue's memory case: N = 1000, t = 1000, dt = 0.01, MSD and 30 TAMSD lags
     n, t_stop = (1_000, 1000.0) if not quick else (200, 20.0)
     lags = log_lags(30, t_stop / 2, 0.01)
-    r, seconds, peak = _measure(lambda: langevin.run(n, gamma0=G0, D0=D0, tau0=0.972, dt=0.01, t_stop=t_stop,
-                                                     scheme="em", tamsd_lags=lags, seed=1))
-    out.append(_record(f"udsbm-3d-em-{_size(n)}-t{t_stop:g}-{len(r.tamsd_lags)}lags", r, seconds, peak,
-                       float("nan")))
+    r, seconds, peak = _measure(
+        lambda: langevin.run(
+            n,
+            gamma0=G0,
+            D0=D0,
+            tau0=0.972,
+            dt=0.01,
+            t_stop=t_stop,
+            scheme="em",
+            tamsd_lags=lags,
+            seed=1,
+        )
+    )
+    out.append(
+        _record(
+            f"udsbm-3d-em-{_size(n)}-t{t_stop:g}-{len(r.tamsd_lags)}lags",
+            r,
+            seconds,
+            peak,
+            float("nan"),
+        )
+    )
     return out

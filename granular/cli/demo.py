@@ -17,6 +17,7 @@ and so underestimates diffusion by a few percent at eta = 0.065 (the thesis meas
 this gas; tests/helpers/margins.py); Haff's law uses the Maxwellian (Enskog) cooling rate, with the
 same approximation, and the real gas cools more slowly (the thesis' Fig. 4.10).
 """
+
 from __future__ import annotations
 
 import math
@@ -39,67 +40,115 @@ def _equilibrated(n, radius, seed):
 
 def main(out="granular-demo", quick=False, runs=None, backend="processes"):
     started = time.perf_counter()
-    n, radius, t_stop = (1000, 0.025, 100.0) if not quick else (300, 0.025 * (1000 / 300) ** (1 / 3), 10.0)
+    n, radius, t_stop = (
+        (1000, 0.025, 100.0) if not quick else (300, 0.025 * (1000 / 300) ** (1 / 3), 10.0)
+    )
     runs = runs or (8 if not quick else 20)
     os.makedirs(out, exist_ok=True)
     times = np.concatenate([[0.0], np.logspace(-2, math.log10(t_stop), 40)])
     start = _equilibrated(n, radius, seed=2020)
-    print(f"granular demo: N = {n}, r = {radius:.4g}, eta = {start.packing_fraction:.4f}, periodic unit box, "
-          f"T0 = {start.temperature:.4f}, t = 0 .. {t_stop:g}, {runs} runs each")
+    print(
+        f"granular demo: N = {n}, r = {radius:.4g}, eta = {start.packing_fraction:.4f}, periodic "
+        f"unit box, T0 = {start.temperature:.4f}, t = 0 .. {t_stop:g}, {runs} runs each"
+    )
 
     rows, results = [], {}
     for label, xi in (("molecular", 1.0), ("granular", 0.8)):
         scene = start.replace(restitution=xi)
-        res = ensemble(scene, runs, seed=1, backend=backend, t_stop=t_stop, sample_times=times,
-                       quantities=("msd", "temperature", "collisions_per_particle", "velocities"),
-                       progress=False)
+        res = ensemble(
+            scene,
+            runs,
+            seed=1,
+            backend=backend,
+            t_stop=t_stop,
+            sample_times=times,
+            quantities=("msd", "temperature", "collisions_per_particle", "velocities"),
+            progress=False,
+        )
         if res.failures:
             raise RuntimeError(f"{len(res.failures)} runs failed: {res.failures[0]}")
         c = theory.langevin_coefficients(n, radius, 1.0, xi, start.temperature)
         msd_th = theory.msd_granular(times, c.D0, c.gamma0, c.tau0)
-        T_th = theory.haff_temperature(times, start.temperature, c.tau0) if xi < 1 else np.full_like(times, start.temperature)
+        T_th = (
+            theory.haff_temperature(times, start.temperature, c.tau0)
+            if xi < 1
+            else np.full_like(times, start.temperature)
+        )
         results[label] = (res, msd_th, T_th, c)
         k = len(times) - 1
-        rows.append(dict(gas=label, xi=xi, runs=res.count, t_end=float(times[k]),
-                         T_end=float(res.mean["temperature"][k]),
-                         T_end_error=float(res.error["temperature"][k]), T_end_theory=float(T_th[k]),
-                         msd_end=float(res.mean["msd"][k]), msd_end_error=float(res.error["msd"][k]),
-                         msd_end_theory=float(msd_th[k]),
-                         collisions_per_particle=float(res.mean["collisions_per_particle"][k]),
-                         tau0_theory=c.tau0))
+        rows.append(
+            dict(
+                gas=label,
+                xi=xi,
+                runs=res.count,
+                t_end=float(times[k]),
+                T_end=float(res.mean["temperature"][k]),
+                T_end_error=float(res.error["temperature"][k]),
+                T_end_theory=float(T_th[k]),
+                msd_end=float(res.mean["msd"][k]),
+                msd_end_error=float(res.error["msd"][k]),
+                msd_end_theory=float(msd_th[k]),
+                collisions_per_particle=float(res.mean["collisions_per_particle"][k]),
+                tau0_theory=c.tau0,
+            )
+        )
 
     names = _figures(out, times, results)
     write_json(os.path.join(out, "summary.json"), rows)
-    print(f"{'gas':<10} {'T(t_end)':>22} {'Haff/const':>10} {'MSD(t_end)':>20} {'theory':>9} {'coll/part':>9}")
+    print(
+        f"{'gas':<10} {'T(t_end)':>22} {'Haff/const':>10} {'MSD(t_end)':>20} {'theory':>9} "
+        f"{'coll/part':>9}"
+    )
     for r in rows:
-        print(f"{r['gas']:<10} {r['T_end']:>12.4g} +- {r['T_end_error']:<7.2g}{r['T_end_theory']:>10.4g} "
-              f"{r['msd_end']:>10.4g} +- {r['msd_end_error']:<6.2g}{r['msd_end_theory']:>9.4g} "
-              f"{r['collisions_per_particle']:>9.0f}")
-    dev = lambda ours, error, th: f"{ours / th - 1:+.1%} +- {error / th:.1%}"  # noqa: E731
+        print(
+            f"{r['gas']:<10} {r['T_end']:>12.4g} +- "
+            f"{r['T_end_error']:<7.2g}{r['T_end_theory']:>10.4g} {r['msd_end']:>10.4g} +- "
+            f"{r['msd_end_error']:<6.2g}{r['msd_end_theory']:>9.4g} "
+            f"{r['collisions_per_particle']:>9.0f}"
+        )
+
+    def dev(ours, error, th):
+        return f"{ours / th - 1:+.1%} +- {error / th:.1%}"
+
     mol, gran = rows
-    print(f"relative deviation from theory +- standard error: molecular MSD "
-          f"{dev(mol['msd_end'], mol['msd_end_error'], mol['msd_end_theory'])}, granular MSD "
-          f"{dev(gran['msd_end'], gran['msd_end_error'], gran['msd_end_theory'])}, granular T "
-          f"{dev(gran['T_end'], gran['T_end_error'], gran['T_end_theory'])}.\n  Why they may differ: the MSD "
-          f"theory uses Enskog's D0, which misses velocity correlations (diffusion a few % faster "
-          f"at eta = {start.packing_fraction:.3f}; the thesis measured +4 %), and Haff's law the "
-          f"Maxwellian cooling rate, which misses them too (the gas cools more slowly).")
+    print(
+        "relative deviation from theory +- standard error: molecular MSD "
+        f"{dev(mol['msd_end'], mol['msd_end_error'], mol['msd_end_theory'])}, granular MSD "
+        f"{dev(gran['msd_end'], gran['msd_end_error'], gran['msd_end_theory'])}, granular T "
+        f"{dev(gran['T_end'], gran['T_end_error'], gran['T_end_theory'])}.\n  Why they may differ: "
+        "the MSD theory uses Enskog's D0, which misses velocity correlations (diffusion a few % "
+        f"faster at eta = {start.packing_fraction:.3f}; the thesis measured +4 %), and Haff's law "
+        "the Maxwellian cooling rate, which misses them too (the gas cools more slowly)."
+    )
     print(f"{', '.join(names)} and summary.json in {out}/  ({time.perf_counter() - started:.1f} s)")
     return rows
 
 
 def _msd(ax, times, results):
     for label, (res, msd_th, _, _) in results.items():
-        plot.msd(times, res.mean["msd"], error=res.error["msd"], theory_values=msd_th, ax=ax,
-                 label=f"{label} gas (EDMD)", theory_style="k--" if label == "molecular" else "k:",
-                 theory_label=f"{label}: theory " + ("(2.68)" if label == "molecular" else "(2.79)"))
+        plot.msd(
+            times,
+            res.mean["msd"],
+            error=res.error["msd"],
+            theory_values=msd_th,
+            ax=ax,
+            label=f"{label} gas (EDMD)",
+            theory_style="k--" if label == "molecular" else "k:",
+            theory_label=f"{label}: theory " + ("(2.68)" if label == "molecular" else "(2.79)"),
+        )
     ax.set_title("mean squared displacement")
 
 
 def _temperature(ax, times, results):
     res, _, _, c = results["granular"]
-    plot.haff(times, res.mean["temperature"], tau0=c.tau0, ax=ax, error=res.error["temperature"],
-              label=r"granular gas, $\xi$ = 0.8 (EDMD)")
+    plot.haff(
+        times,
+        res.mean["temperature"],
+        tau0=c.tau0,
+        ax=ax,
+        error=res.error["temperature"],
+        label=r"granular gas, $\xi$ = 0.8 (EDMD)",
+    )
     mol = results["molecular"][0]
     ax.plot(times[1:], mol.mean["temperature"][1:], "-", color="0.5", label="molecular gas (EDMD)")
     ax.legend()
@@ -109,8 +158,12 @@ def _temperature(ax, times, results):
 def _speeds(ax, label, results):
     res = results[label][0]
     v = np.array([run["velocities"][-1] for run in res.runs])  # (runs, N, 3) at the last time
-    plot.speed_distribution(v.reshape(-1, v.shape[-1]), temperature=float(res.mean["temperature"][-1]),
-                            ax=ax, label=f"{label} gas, t = {res.times[-1]:g}")
+    plot.speed_distribution(
+        v.reshape(-1, v.shape[-1]),
+        temperature=float(res.mean["temperature"][-1]),
+        ax=ax,
+        label=f"{label} gas, t = {res.times[-1]:g}",
+    )
     ax.set_title(f"speeds of the {label} gas at the end")
 
 
@@ -122,19 +175,31 @@ def _figures(out, times, results):
     import matplotlib.pyplot as plt
 
     def save(name, *draws):
-        fig, axes = plt.subplots(1, len(draws), figsize=(5.5 * len(draws), 4.2), layout="constrained",
-                                 squeeze=False)
-        for ax, draw in zip(axes[0], draws):
+        fig, axes = plt.subplots(
+            1, len(draws), figsize=(5.5 * len(draws), 4.2), layout="constrained", squeeze=False
+        )
+        for ax, draw in zip(axes[0], draws, strict=True):
             draw(ax)
         fig.savefig(os.path.join(out, name), dpi=120)
         plt.close(fig)
         return name
 
-    msd = lambda ax: _msd(ax, times, results)  # noqa: E731
-    temperature = lambda ax: _temperature(ax, times, results)  # noqa: E731
-    return [save("demo.png", msd, temperature), save("msd.png", msd), save("temperature.png", temperature),
-            save("speeds.png", lambda ax: _speeds(ax, "molecular", results),
-                 lambda ax: _speeds(ax, "granular", results))]
+    def msd(ax):
+        return _msd(ax, times, results)
+
+    def temperature(ax):
+        return _temperature(ax, times, results)
+
+    return [
+        save("demo.png", msd, temperature),
+        save("msd.png", msd),
+        save("temperature.png", temperature),
+        save(
+            "speeds.png",
+            lambda ax: _speeds(ax, "molecular", results),
+            lambda ax: _speeds(ax, "granular", results),
+        ),
+    ]
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,4 +1,5 @@
 """How the applications write their results: strict JSON, which any parser reads."""
+
 from __future__ import annotations
 
 import json

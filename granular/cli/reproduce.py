@@ -32,6 +32,7 @@ instead of eq. 3.3, and the mean collision time of (2.42) rather than the printe
 (2.70)-(2.71).  Granular runs start, as in the thesis, from an equilibrated molecular gas
 whose velocity vectors are shuffled among the particles for each run (section 3.8).
 """
+
 from __future__ import annotations
 
 import functools
@@ -61,14 +62,14 @@ class Config:
         # 18 s against 31 s for all of it), and the C core releases the GIL
         self.backend = backend or ("threads" if quick else "processes")
         self.n3, self.r3 = (1000, 0.025) if not quick else (250, 0.025 * 4 ** (1 / 3))
-        self.n2, self.r2 = (2000, 0.005) if not quick else (400, 0.005 * 5 ** 0.5)
+        self.n2, self.r2 = (2000, 0.005) if not quick else (400, 0.005 * 5**0.5)
         self.t_long = 100.0 if not quick else 10.0
         # t_stop of the time-averaged MSDs of Fig. 4.23 (the thesis: 10 and 100); includes
         # t_long, the t_stop of Figs 4.21-4.22
         self.tamsd_t_stops = (10.0, 100.0, 1000.0) if not quick else (1.0, 10.0, 50.0)
         # the thesis' run counts x 5
-        self.runs_few = runs or (20 if not quick else QUICK_RUNS)     # thesis: 4
-        self.runs_many = runs or (100 if not quick else QUICK_RUNS)   # thesis: 20
+        self.runs_few = runs or (20 if not quick else QUICK_RUNS)  # thesis: 4
+        self.runs_many = runs or (100 if not quick else QUICK_RUNS)  # thesis: 20
         self.c_speed = 0.2  # collisions per particle per particle (c_stop = 0.2 N)
 
 
@@ -86,14 +87,25 @@ def _checked(res):
     average fewer runs than it says."""
     if res.failures:
         f = res.failures[0]
-        raise RuntimeError(f"{len(res.failures)} runs failed; run {f.index}: {f.error}\n{f.traceback}")
+        raise RuntimeError(
+            f"{len(res.failures)} runs failed; run {f.index}: {f.error}\n{f.traceback}"
+        )
     return res
 
 
 def _row(id_, quantity, ours, error=None, runs=None, thesis=None, theory_value=None):
-    f = lambda x: None if x is None or (isinstance(x, float) and not math.isfinite(x)) else float(x)  # noqa: E731
-    return {"id": id_, "quantity": quantity, "ours": f(ours), "ours_error": f(error),
-            "runs": runs, "thesis": f(thesis), "theory": f(theory_value)}
+    def f(x):
+        return None if x is None or (isinstance(x, float) and not math.isfinite(x)) else float(x)
+
+    return {
+        "id": id_,
+        "quantity": quantity,
+        "ours": f(ours),
+        "ours_error": f(error),
+        "runs": runs,
+        "thesis": f(thesis),
+        "theory": f(theory_value),
+    }
 
 
 def _mean_row(id_, quantity, per_run, thesis=None, theory_value=None):
@@ -128,6 +140,7 @@ def equilibrium_scene(cfg, seed=2020, boundary="periodic"):
 
 # -- 4.1: verification ------------------------------------------------------------------------
 
+
 def _fig_4_1(cfg, out):
     """Two disks in a head-on collision between walls."""
     s = Scene([[0.25, 0.5], [0.75, 0.5]], [[0.5, 0.0], [-0.5, 0.0]], 0.05, boundary="walls")
@@ -151,9 +164,15 @@ def _fig_4_2_to_4_4(cfg, out):
     for boundary in ("periodic", "walls"):
         eq = equilibrium_scene(cfg, boundary=boundary)
         for xi in (1.0, 0.8):
-            res[boundary, xi] = _checked_ensemble(eq.replace(restitution=xi), cfg.runs_few, seed=42,
-                                                  backend=cfg.backend, t_stop=t[-1], sample_times=t,
-                                                  quantities=("kinetic_energy", "collisions_per_particle"))
+            res[boundary, xi] = _checked_ensemble(
+                eq.replace(restitution=xi),
+                cfg.runs_few,
+                seed=42,
+                backend=cfg.backend,
+                t_stop=t[-1],
+                sample_times=t,
+                quantities=("kinetic_energy", "collisions_per_particle"),
+            )
     fig, ax = _fig()
     drifts = []
     for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
@@ -170,15 +189,31 @@ def _fig_4_2_to_4_4(cfg, out):
         fig, ax = _fig()
         for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
             r = res[boundary, xi]
-            ax.errorbar(t, r.mean["collisions_per_particle"], yerr=r.error["collisions_per_particle"],
-                        label=name, errorevery=10)
+            ax.errorbar(
+                t,
+                r.mean["collisions_per_particle"],
+                yerr=r.error["collisions_per_particle"],
+                label=name,
+                errorevery=10,
+            )
         ax.set_xlabel(plot.TIME)
         ax.set_ylabel(plot.COLLISIONS)
-        ax.set_title(f"Fig. {fig_no.replace('_', '.')}: " + ("molecular gas" if xi == 1 else r"granular gas, $\xi$ = 0.8"))
+        ax.set_title(
+            f"Fig. {fig_no.replace('_', '.')}: "
+            + ("molecular gas" if xi == 1 else r"granular gas, $\xi$ = 0.8")
+        )
         ax.legend()
         names.append(_save(fig, out, f"fig{fig_no}_collisions.png"))
-    rows = [_row("energy.drift.xi1", f"max |E(t)/E(0) - 1| over {2 * cfg.runs_few} runs, molecular gas, "
-                 f"PBC and RBC, t <= {t[-1]:g}", max(drifts), thesis=1e-14, theory_value=0.0)]
+    rows = [
+        _row(
+            "energy.drift.xi1",
+            f"max |E(t)/E(0) - 1| over {2 * cfg.runs_few} runs, molecular gas, "
+            f"PBC and RBC, t <= {t[-1]:g}",
+            max(drifts),
+            thesis=1e-14,
+            theory_value=0.0,
+        )
+    ]
     return names, rows
 
 
@@ -207,8 +242,15 @@ def _fig_4_5_to_4_7(cfg, out):
         per_run = [analysis.speed_statistics(vr, temperature=T) for vr in v]
         mb = theory.maxwell_boltzmann_moments(T, dim=dim)
         for key, label in (("mean", "<v>"), ("mean_sq", "<v^2>"), ("std", "std(v)")):
-            rows.append(_mean_row(f"table4.1.{dim}d.{key}", f"{label}, {dim}D, N = {n} (T = {T:.4g})",
-                                  [p[key]["ours"] for p in per_run], None, mb[key]))
+            rows.append(
+                _mean_row(
+                    f"table4.1.{dim}d.{key}",
+                    f"{label}, {dim}D, N = {n} (T = {T:.4g})",
+                    [p[key]["ours"] for p in per_run],
+                    None,
+                    mb[key],
+                )
+            )
         if dim == 3:
             fig, ax = _fig()
             plot.speed_distribution(v[0], temperature=T, ax=ax, label="one run")
@@ -222,12 +264,22 @@ def _fig_4_8_and_4_10(cfg, out):
     t = np.linspace(0, cfg.t_long, 201)
     names, rows = [], []
     fig, ax = _fig()
-    for label, boundary, wall_e in (("PBC", "periodic", 1.0), ("RBC", "walls", 1.0),
-                                    ("RBC, inelastic walls", "walls", 0.8)):
+    for label, boundary, wall_e in (
+        ("PBC", "periodic", 1.0),
+        ("RBC", "walls", 1.0),
+        ("RBC, inelastic walls", "walls", 0.8),
+    ):
         eq = equilibrium_scene(cfg, boundary=boundary)
         s = eq.replace(restitution=0.8, wall_restitution=wall_e)
-        r = _checked_ensemble(s, cfg.runs_few, seed=8, backend=cfg.backend, t_stop=t[-1], sample_times=t,
-                              quantities=("temperature",))
+        r = _checked_ensemble(
+            s,
+            cfg.runs_few,
+            seed=8,
+            backend=cfg.backend,
+            t_stop=t[-1],
+            sample_times=t,
+            quantities=("temperature",),
+        )
         ax.plot(t[1:], r.mean["temperature"][1:], label=label)
         T0 = eq.temperature
     c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, 0.8, T0)
@@ -242,15 +294,34 @@ def _fig_4_8_and_4_10(cfg, out):
 
     eq = equilibrium_scene(cfg)
     fig, axes = _fig(3)
-    for ax, xi in zip(axes, (0.99, 0.5, 0.3)):
-        r = _checked_ensemble(eq.replace(restitution=xi), cfg.runs_few, seed=9, backend=cfg.backend,
-                              t_stop=t[-1], sample_times=t, quantities=("temperature",))
+    for ax, xi in zip(axes, (0.99, 0.5, 0.3), strict=True):
+        r = _checked_ensemble(
+            eq.replace(restitution=xi),
+            cfg.runs_few,
+            seed=9,
+            backend=cfg.backend,
+            t_stop=t[-1],
+            sample_times=t,
+            quantities=("temperature",),
+        )
         c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, eq.temperature)
-        row = _mean_row(f"haff.tau0.xi{xi}", f"Haff tau0 fitted over t <= {t[-1]:g}, xi = {xi}; theory (2.45)",
-                        [analysis.fit_haff_tau0(t, run["temperature"])[0] for run in r.runs], None, c.tau0)
+        row = _mean_row(
+            f"haff.tau0.xi{xi}",
+            f"Haff tau0 fitted over t <= {t[-1]:g}, xi = {xi}; theory (2.45)",
+            [analysis.fit_haff_tau0(t, run["temperature"])[0] for run in r.runs],
+            None,
+            c.tau0,
+        )
         rows.append(row)
-        plot.haff(t, r.mean["temperature"], c.tau0, temperature0=eq.temperature, ax=ax,
-                  error=r.error["temperature"], label=rf"EDMD, fit $\tau_0$ = {row['ours']:.3g}")
+        plot.haff(
+            t,
+            r.mean["temperature"],
+            c.tau0,
+            temperature0=eq.temperature,
+            ax=ax,
+            error=r.error["temperature"],
+            label=rf"EDMD, fit $\tau_0$ = {row['ours']:.3g}",
+        )
         ax.set_title(rf"Fig. 4.10: $\xi$ = {xi}")
     names.append(_save(fig, out, "fig4_10_haff_xi.png"))
     return names, rows
@@ -262,8 +333,9 @@ def _fig_4_9(cfg, out):
     fig, axes = _fig(4, size=(3.6, 3.6))
     k = 0
     for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
-        s = Scene.random(cfg.n2, cfg.r2, dim=2, boundary=boundary, restitution=0.8,
-                         contact_duration=1e-3, seed=3)
+        s = Scene.random(
+            cfg.n2, cfg.r2, dim=2, boundary=boundary, restitution=0.8, contact_duration=1e-3, seed=3
+        )
         sim = Simulation(s)
         for t_snap in (2.5, 10.0):
             sim.run(t_stop=t_snap, sample_times=[t_snap], store=())
@@ -272,11 +344,12 @@ def _fig_4_9(cfg, out):
             axes[k].set_xticks([])
             axes[k].set_yticks([])
             k += 1
-    fig.suptitle(r"Fig. 4.9: 2D granular gas, $\xi$ = 0.8, N = %d" % cfg.n2)
+    fig.suptitle(rf"Fig. 4.9: 2D granular gas, $\xi$ = 0.8, N = {cfg.n2}")
     return [_save(fig, out, "fig4_9_clusters_2d.png")], []
 
 
 # -- 4.1.4: Brownian motion of the EDMD gas ----------------------------------------------------
+
 
 def _fig_4_11_to_4_16_and_F(cfg, out):
     """MSD (Figs 4.11-4.13), diffusivity (4.14-4.16), linear axes and slopes (F.1-F.2).
@@ -291,88 +364,168 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
     names, rows = [], []
     figF, axF = _fig(2)
     for xi, fig_msd, fig_d in ((1.0, "4_11", "4_14"), (0.8, "4_12", "4_15"), (0.3, "4_13", "4_16")):
-        r = _checked_ensemble(eq.replace(restitution=xi), cfg.runs_few, seed=10, backend=cfg.backend,
-                              t_stop=t[-1], sample_times=t, quantities=("msd",))
+        r = _checked_ensemble(
+            eq.replace(restitution=xi),
+            cfg.runs_few,
+            seed=10,
+            backend=cfg.backend,
+            t_stop=t[-1],
+            sample_times=t,
+            quantities=("msd",),
+        )
         c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, eq.temperature)
         th = theory.msd_granular(t, c.D0, c.gamma0, c.tau0)
         equation = "(2.68)" if xi == 1 else "(2.79)"
         fig, ax = _fig()
-        plot.msd(t, r.mean["msd"], error=r.error["msd"], theory_values=th, ax=ax,
-                 label=f"EDMD, {len(r.runs)} runs", theory_label=equation)
-        ax.set_title(f"Fig. {fig_msd.replace('_', '.')}: MSD, " + (r"$\xi$ = %g" % xi))
+        plot.msd(
+            t,
+            r.mean["msd"],
+            error=r.error["msd"],
+            theory_values=th,
+            ax=ax,
+            label=f"EDMD, {len(r.runs)} runs",
+            theory_label=equation,
+        )
+        ax.set_title(f"Fig. {fig_msd.replace('_', '.')}: MSD, " + rf"$\xi$ = {xi:g}")
         names.append(_save(fig, out, f"fig{fig_msd}_msd_xi{xi}.png"))
         fig, ax = _fig()
         dims = [analysis.diffusivity(t, run["msd"]) for run in r.runs]
-        dm, de = analysis.ensemble_mean(dims)
+        dm, _ = analysis.ensemble_mean(dims)
         plot.diffusivity(t, dm, theory_values=c.D0 / (1 + t / c.tau0), ax=ax, label="EDMD")
-        ax.set_title(f"Fig. {fig_d.replace('_', '.')}: diffusivity, " + (r"$\xi$ = %g" % xi))
+        ax.set_title(f"Fig. {fig_d.replace('_', '.')}: diffusivity, " + rf"$\xi$ = {xi:g}")
         names.append(_save(fig, out, f"fig{fig_d}_diffusivity_xi{xi}.png"))
         if xi in THESIS_SLOPES:
             log = xi < 1
-            slope = lambda msd: analysis.fit_slope(t[window], msd[window], log=log)[0]  # noqa: E731
+
+            def slope(msd, log=log):
+                return analysis.fit_slope(t[window], msd[window], log=log)[0]
+
             measured, thesis_theory = THESIS_SLOPES[xi]
             asymptote = ("6 D0", 6 * c.D0) if xi == 1 else ("6 D0 tau0", 6 * c.D0 * c.tau0)
-            quantity = (f"slope of the MSD against {'ln t' if log else 't'}, fitted over t in "
-                        f"[{cfg.t_long / 10:g}, {cfg.t_long:g}]; theory: {equation} fitted the same way "
-                        f"(its asymptote {asymptote[0]} = {asymptote[1]:.4g}); thesis (N = 1000, App. F): "
-                        f"measured {measured:.3f}, theory {thesis_theory:.3f}")
-            row = _mean_row(f"msd.slope.xi{xi:g}", quantity, [slope(run["msd"]) for run in r.runs],
-                            None if cfg.quick else measured, slope(th))
+            quantity = (
+                f"slope of the MSD against {'ln t' if log else 't'}, fitted over t in "
+                f"[{cfg.t_long / 10:g}, {cfg.t_long:g}]; theory: {equation} fitted the same way "
+                f"(its asymptote {asymptote[0]} = {asymptote[1]:.4g}); thesis (N = 1000, App. F): "
+                f"measured {measured:.3f}, theory {thesis_theory:.3f}"
+            )
+            row = _mean_row(
+                f"msd.slope.xi{xi:g}",
+                quantity,
+                [slope(run["msd"]) for run in r.runs],
+                None if cfg.quick else measured,
+                slope(th),
+            )
             rows.append(row)
             ax = axF[0 if xi == 1 else 1]
-            plot.msd(t, r.mean["msd"], error=r.error["msd"], theory_values=th, ax=ax, loglog=False,
-                     label="EDMD")
+            plot.msd(
+                t,
+                r.mean["msd"],
+                error=r.error["msd"],
+                theory_values=th,
+                ax=ax,
+                loglog=False,
+                label="EDMD",
+            )
             if log:
                 ax.set_xscale("log")
-            ax.set_title(f"Fig. F.{1 if xi == 1 else 2}: slope {row['ours']:.3f} vs theory {row['theory']:.3f}")
+            ax.set_title(
+                f"Fig. F.{1 if xi == 1 else 2}: slope {row['ours']:.3f} vs theory "
+                f"{row['theory']:.3f}"
+            )
     names.append(_save(figF, out, "figF_linear_axes.png"))
     return names, rows
 
 
 # -- 4.2: Langevin models ----------------------------------------------------------------------
 
+
 def _fig_4_17_to_4_23(cfg, out):
     """Langevin and UDSBM by Euler-Maruyama (4.17-4.20) and ergodicity (4.21-4.23)."""
     names, rows = [], []
     v0_sq = THESIS_T0  # per component: every particle starts at speed sqrt(2), as in the thesis
-    coeff = {xi: theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, THESIS_T0) for xi in (1.0, 0.8, 0.5)}
+    coeff = {
+        xi: theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, THESIS_T0)
+        for xi in (1.0, 0.8, 0.5)
+    }
     t_samples = np.concatenate([[0.0], np.logspace(-2, math.log10(cfg.t_long), 50)])
 
     def run(xi, dt, t_stop, scheme="em", lags=None, samples=t_samples):
         c = coeff[xi]
         samples = np.unique(np.round(np.asarray(samples) / dt)) * dt  # whole steps
-        task = functools.partial(langevin.run, cfg.n3, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=dt,
-                                 t_stop=t_stop, scheme=scheme, initial="fixed",
-                                 speed=math.sqrt(2.0), sample_times=samples, tamsd_lags=lags)
+        task = functools.partial(
+            langevin.run,
+            cfg.n3,
+            gamma0=c.gamma0,
+            D0=c.D0,
+            tau0=c.tau0,
+            dt=dt,
+            t_stop=t_stop,
+            scheme=scheme,
+            initial="fixed",
+            speed=math.sqrt(2.0),
+            sample_times=samples,
+            tamsd_lags=lags,
+        )
         return _checked(ensemble(task, cfg.runs_few, seed=11, backend=cfg.backend))
 
     def msd_theory(xi, t):
         c = coeff[xi]
-        return (theory.msd_langevin(t, c.D0, c.gamma0, v0_sq=v0_sq) if xi == 1 else
-                theory.msd_udsbm(t, c.D0, c.gamma0, c.tau0, v0_sq=v0_sq))
+        return (
+            theory.msd_langevin(t, c.D0, c.gamma0, v0_sq=v0_sq)
+            if xi == 1
+            else theory.msd_udsbm(t, c.D0, c.gamma0, c.tau0, v0_sq=v0_sq)
+        )
 
     for xi, fig_no in ((1.0, "4_17"), (0.8, "4_18"), (0.5, "4_19")):
         r = run(xi, 0.01, cfg.t_long)
         th = msd_theory(xi, r.times)
         model = "Langevin" if xi == 1 else f"UDSBM, xi = {xi}"
         fig, ax = _fig()
-        plot.msd(r.times, r.mean["msd"], error=r.error["msd"], theory_values=th, ax=ax,
-                 label=r"Euler-Maruyama, $\Delta t$ = 0.01",
-                 theory_label="(2.68)" if xi == 1 else "(2.113) + start")
-        ax.set_title(f"Fig. {fig_no.replace('_', '.')}: " + ("Langevin" if xi == 1 else rf"UDSBM, $\xi$ = {xi}"))
+        plot.msd(
+            r.times,
+            r.mean["msd"],
+            error=r.error["msd"],
+            theory_values=th,
+            ax=ax,
+            label=r"Euler-Maruyama, $\Delta t$ = 0.01",
+            theory_label="(2.68)" if xi == 1 else "(2.113) + start",
+        )
+        ax.set_title(
+            f"Fig. {fig_no.replace('_', '.')}: "
+            + ("Langevin" if xi == 1 else rf"UDSBM, $\xi$ = {xi}")
+        )
         names.append(_save(fig, out, f"fig{fig_no}_sde_msd_xi{xi}.png"))
-        rows.append(_mean_row(f"sde.msd.xi{xi:g}", f"{model}: MSD at t = {r.times[-1]:g}, Euler-Maruyama "
-                              f"dt = 0.01; theory {'(2.68)' if xi == 1 else '(2.113)'} with the initial "
-                              "speed sqrt(2)", [run_["msd"][-1] for run_ in r.runs], None, th[-1]))
+        rows.append(
+            _mean_row(
+                f"sde.msd.xi{xi:g}",
+                f"{model}: MSD at t = {r.times[-1]:g}, Euler-Maruyama "
+                f"dt = 0.01; theory {'(2.68)' if xi == 1 else '(2.113)'} with the initial "
+                "speed sqrt(2)",
+                [run_["msd"][-1] for run_ in r.runs],
+                None,
+                th[-1],
+            )
+        )
 
     fig, ax = _fig()
     c = coeff[0.8]
     for dt in (0.01, 0.1, 1.0):
         stable = c.gamma0 * dt < 2  # Euler-Maruyama's stability limit
         r = run(0.8, dt, cfg.t_long, scheme="em" if stable else "exact")
-        ax.plot(r.times[1:], r.mean["msd"][1:], "o-", ms=3,
-                label=rf"$\Delta t$ = {dt} (" + ("Euler-Maruyama" if stable else "exact: Euler-Maruyama "
-                                                 rf"diverges, $\gamma_0 \Delta t$ = {c.gamma0 * dt:.1f}") + ")")
+        ax.plot(
+            r.times[1:],
+            r.mean["msd"][1:],
+            "o-",
+            ms=3,
+            label=rf"$\Delta t$ = {dt} ("
+            + (
+                "Euler-Maruyama"
+                if stable
+                else "exact: Euler-Maruyama "
+                rf"diverges, $\gamma_0 \Delta t$ = {c.gamma0 * dt:.1f}"
+            )
+            + ")",
+        )
     ax.plot(t_samples[1:], msd_theory(0.8, t_samples[1:]), "k--", label="theory")
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -388,30 +541,48 @@ def _fig_4_17_to_4_23(cfg, out):
         lags = np.unique(np.round(np.logspace(-2, math.log10(t_stop / 2), 24), 2))
         if lag_ref <= t_stop / 2:
             lags = np.unique(np.append(lags, lag_ref))
-        r = run(xi, 0.01, t_stop, lags=lags, samples=np.unique(np.append(t_samples[t_samples <= t_stop], lags)))
+        r = run(
+            xi,
+            0.01,
+            t_stop,
+            lags=lags,
+            samples=np.unique(np.append(t_samples[t_samples <= t_stop], lags)),
+        )
         lags = r.mean["tamsd_lags"]
         c = coeff[xi]
-        tamsd_th = langevin.theory_tamsd(lags, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=0.01,
-                                         t_stop=t_stop, v0_sq=v0_sq)
+        tamsd_th = langevin.theory_tamsd(
+            lags, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=0.01, t_stop=t_stop, v0_sq=v0_sq
+        )
         return r, lags, tamsd_th
 
     def ratio_row(label, xi, r, lags, tamsd_th):
         k_lag = int(np.argmin(np.abs(lags - lag_ref)))
         k_t = int(np.argmin(np.abs(r.times - lag_ref)))
         ratios = [run_["tamsd"][k_lag] / run_["msd"][k_t] for run_ in r.runs]
-        return _mean_row(f"ergodicity.{label}", f"TAMSD / MSD at lag = t = {lag_ref:g}, t_stop = "
-                         f"{r.times[-1]:g}, {label} (xi = {xi:g}), Euler-Maruyama dt = 0.01; theory: expected "
-                         "time average / ensemble MSD", ratios, None, tamsd_th[k_lag] / msd_theory(xi, lag_ref))
+        return _mean_row(
+            f"ergodicity.{label}",
+            f"TAMSD / MSD at lag = t = {lag_ref:g}, t_stop = "
+            f"{r.times[-1]:g}, {label} (xi = {xi:g}), Euler-Maruyama dt = 0.01; theory: expected "
+            "time average / ensemble MSD",
+            ratios,
+            None,
+            tamsd_th[k_lag] / msd_theory(xi, lag_ref),
+        )
 
     udsbm = {t_stop: ergodicity(0.8, t_stop) for t_stop in cfg.tamsd_t_stops}
-    for label, xi, (r, lags, tamsd_th), fig_no in (("langevin", 1.0, ergodicity(1.0, cfg.t_long), "4_21"),
-                                                   ("udsbm", 0.8, udsbm[cfg.t_long], "4_22")):
+    for label, xi, (r, lags, tamsd_th), fig_no in (
+        ("langevin", 1.0, ergodicity(1.0, cfg.t_long), "4_21"),
+        ("udsbm", 0.8, udsbm[cfg.t_long], "4_22"),
+    ):
         fig, ax = _fig()
         plot.msd_vs_tamsd(r.times, r.mean["msd"], lags, r.mean["tamsd"], ax=ax)
         ax.plot(lags, tamsd_th, "k--", lw=1, label="time-averaged MSD, theory")
         ax.legend()
-        ax.set_title(f"Fig. {fig_no.replace('_', '.')}: " + ("Langevin" if xi == 1 else rf"UDSBM, $\xi$ = {xi}")
-                     + rf", $t_{{stop}}$ = {cfg.t_long:g}")
+        ax.set_title(
+            f"Fig. {fig_no.replace('_', '.')}: "
+            + ("Langevin" if xi == 1 else rf"UDSBM, $\xi$ = {xi}")
+            + rf", $t_{{stop}}$ = {cfg.t_long:g}"
+        )
         names.append(_save(fig, out, f"fig{fig_no}_ergodicity_{label}_t{cfg.t_long:g}.png"))
         rows.append(ratio_row(label, xi, r, lags, tamsd_th))
 
@@ -420,8 +591,14 @@ def _fig_4_17_to_4_23(cfg, out):
     keep = longest.times > 0
     ax.plot(longest.times[keep], longest.mean["msd"][keep], "k-", label="ensemble MSD")
     for i, (t_stop, (r, lags, tamsd_th)) in enumerate(sorted(udsbm.items())):
-        ax.plot(lags, r.mean["tamsd"], "o", ms=3, color=f"C{i}",
-                label=rf"time-averaged MSD, $t_{{stop}}$ = {t_stop:g}")
+        ax.plot(
+            lags,
+            r.mean["tamsd"],
+            "o",
+            ms=3,
+            color=f"C{i}",
+            label=rf"time-averaged MSD, $t_{{stop}}$ = {t_stop:g}",
+        )
         ax.plot(lags, tamsd_th, "--", lw=1, color=f"C{i}")
     ax.plot([], [], "--", lw=1, color="0.4", label="time-averaged MSD, theory")
     ax.set_xscale("log")
@@ -434,9 +611,15 @@ def _fig_4_17_to_4_23(cfg, out):
     return names, rows
 
 
-FIGURES = {"4.1": _fig_4_1, "4.2-4.4": _fig_4_2_to_4_4, "4.5-4.7": _fig_4_5_to_4_7,
-           "4.8+4.10": _fig_4_8_and_4_10, "4.9": _fig_4_9, "4.11-4.16+F": _fig_4_11_to_4_16_and_F,
-           "4.17-4.23": _fig_4_17_to_4_23}
+FIGURES = {
+    "4.1": _fig_4_1,
+    "4.2-4.4": _fig_4_2_to_4_4,
+    "4.5-4.7": _fig_4_5_to_4_7,
+    "4.8+4.10": _fig_4_8_and_4_10,
+    "4.9": _fig_4_9,
+    "4.11-4.16+F": _fig_4_11_to_4_16_and_F,
+    "4.17-4.23": _fig_4_17_to_4_23,
+}
 
 
 def _run(name, cfg, out):
@@ -475,12 +658,15 @@ def main(out="granular-reproduce", quick=False, runs=None, backend=None):
     write_json(os.path.join(out, "summary.json"), rows)
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write(_report(rows, cfg, names, time.perf_counter() - started))
-    print(f"reproduced {len(names)} figures, {len(rows)} summary rows in {out}/ "
-          f"({time.perf_counter() - started:.0f} s)")
+    print(
+        f"reproduced {len(names)} figures, {len(rows)} summary rows in {out}/ "
+        f"({time.perf_counter() - started:.0f} s)"
+    )
     return rows
 
 
 # -- report.md ---------------------------------------------------------------------------------
+
 
 def _num(x):
     return "--" if x is None else f"{x:.4g}"
@@ -515,8 +701,11 @@ def _compare(row, key):
 def _sentence(row):
     runs = f" ({row['runs']} runs)" if row["runs"] else ""
     parts = [p for p in (_compare(row, "theory"), _compare(row, "thesis")) if p]
-    return f"- `{row['id']}`, {row['quantity']}: ours {_fmt(row['ours'], row['ours_error'])}{runs}; " \
-           + "; ".join(parts) + "."
+    return (
+        f"- `{row['id']}`, {row['quantity']}: ours {_fmt(row['ours'], row['ours_error'])}{runs}; "
+        + "; ".join(parts)
+        + "."
+    )
 
 
 def _xi(row):
@@ -526,84 +715,126 @@ def _xi(row):
 def _notes(cfg, by_id):
     """The physics beside the numbers, per section: (title, row id prefix, sentences).
     Every claim about agreement is conditional on the rows."""
+
     def significant(prefix, sign):
         return [r for i, r in by_id.items() if i.startswith(prefix) and (_z(r) or 0) * sign > SIGMA]
 
     drift = by_id["energy.drift.xi1"]["ours"]
-    energy = [f"The largest relative change of the molecular gas' energy, {drift:.1e}, is "
-              + ("rounding (below 1e-12)." if drift < 1e-12 else "more than rounding (above 1e-12).")]
+    energy = [
+        f"The largest relative change of the molecular gas' energy, {drift:.1e}, is "
+        + ("rounding (below 1e-12)." if drift < 1e-12 else "more than rounding (above 1e-12).")
+    ]
 
-    speeds = ["<v^2> agrees by construction: T is measured from the kinetic energy of the same runs, as "
-              "in the thesis.  The thesis' own Table 4.1 numbers did not survive the text conversion, so "
-              "that column is empty."]
+    speeds = [
+        "<v^2> agrees by construction: T is measured from the kinetic energy of the same runs, as "
+        "in the thesis.  The thesis' own Table 4.1 numbers did not survive the text conversion, so "
+        "that column is empty."
+    ]
 
-    haff = ["(2.45) is Enskog's tau0 for a homogeneous cooling state with a Maxwellian velocity "
-            "distribution.  The real cooling state is not quite Maxwellian (Sonine coefficient a2), and "
-            "inelastic collisions build up velocity correlations and, at late times, inhomogeneities: "
-            "corrections of a few percent that grow with 1 - xi."]
+    haff = [
+        "(2.45) is Enskog's tau0 for a homogeneous cooling state with a Maxwellian velocity "
+        "distribution.  The real cooling state is not quite Maxwellian (Sonine coefficient a2), "
+        "and inelastic collisions build up velocity correlations and, at late times, "
+        "inhomogeneities: corrections of a few percent that grow with 1 - xi."
+    ]
     above, below = significant("haff.", 1), significant("haff.", -1)
     if above:
-        haff.append(f"Where the fit lies above (2.45) (xi = {', '.join(map(_xi, above))}) the gas cools more "
-                    "slowly than that theory says; the thesis too found 'computed values somewhat higher "
-                    "than theory' at low xi.")
+        haff.append(
+            f"Where the fit lies above (2.45) (xi = {', '.join(map(_xi, above))}) the gas cools "
+            "more slowly than that theory says; the thesis too found 'computed values somewhat "
+            "higher than theory' at low xi."
+        )
     if below:
-        haff.append(f"Where the fit lies below (2.45) (xi = {', '.join(map(_xi, below))}) the gas cools faster "
-                    "than that theory says.")
+        haff.append(
+            f"Where the fit lies below (2.45) (xi = {', '.join(map(_xi, below))}) the gas cools "
+            "faster than that theory says."
+        )
     if not above and not below:
         haff.append(f"Every fitted tau0 agrees with (2.45) within {SIGMA:g} standard errors.")
 
     (m1, t1), (m8, t8) = THESIS_SLOPES[1.0], THESIS_SLOPES[0.8]
     c1, c8 = _thesis_coefficients(1.0), _thesis_coefficients(0.8)
     ours8 = 6 * c8.D0 * c8.tau0
-    slopes = ["Theory's slope is its MSD curve fitted over the same window with the same fit, so the "
-              "columns compare like with like; the asymptotic slopes the thesis quoted are in the "
-              "quantity text."]
+    slopes = [
+        "Theory's slope is its MSD curve fitted over the same window with the same fit, so the "
+        "columns compare like with like; the asymptotic slopes the thesis quoted are in the "
+        "quantity text."
+    ]
     if cfg.quick:
-        slopes.append("Quick mode runs a smaller system over shorter times, so the thesis' App. F values "
-                      "(N = 1000) are quoted, not compared.")
-    slopes.append(f"The thesis measured its molecular slope {m1:.3f} against 6 D0 = {t1:.3f} ({m1 / t1 - 1:+.0%}); "
-                  f"(2.52) for its system gives 6 D0 = {6 * c1.D0:.3f}.  For xi = 0.8 it measured {m8:.3f} and "
-                  f"quoted {t8:.3f} as theory, while (2.45) and (2.52) for its system give 6 D0 tau0 = {ours8:.3f}"
-                  + (": its theory value does not follow from its own equations." if abs(ours8 / t8 - 1) > 0.02
-                     else "."))
+        slopes.append(
+            "Quick mode runs a smaller system over shorter times, so the thesis' App. F values "
+            "(N = 1000) are quoted, not compared."
+        )
+    slopes.append(
+        f"The thesis measured its molecular slope {m1:.3f} against 6 D0 = {t1:.3f} "
+        f"({m1 / t1 - 1:+.0%}); (2.52) for its system gives 6 D0 = {6 * c1.D0:.3f}.  For xi = 0.8 "
+        f"it measured {m8:.3f} and quoted {t8:.3f} as theory, while (2.45) and (2.52) for its "
+        f"system give 6 D0 tau0 = {ours8:.3f}"
+        + (
+            ": its theory value does not follow from its own equations."
+            if abs(ours8 / t8 - 1) > 0.02
+            else "."
+        )
+    )
     above = significant("msd.slope.", 1)
     if above:
-        slopes.append(f"Where our slope lies above theory ({', '.join(r['id'] for r in above)}): Enskog's D0 "
-                      "(2.52) neglects velocity correlations and underestimates hard-sphere self-diffusion by "
-                      "a few percent at eta = 0.065, and for xi < 1 a tau0 above (2.45) (see Haff's law) "
-                      "raises the slope against ln t further.")
+        slopes.append(
+            f"Where our slope lies above theory ({', '.join(r['id'] for r in above)}): Enskog's D0 "
+            "(2.52) neglects velocity correlations and underestimates hard-sphere self-diffusion "
+            "by a few percent at eta = 0.065, and for xi < 1 a tau0 above (2.45) (see Haff's law) "
+            "raises the slope against ln t further."
+        )
 
     cq = {xi: theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, THESIS_T0) for xi in (1.0, 0.8)}
     g_max = max(c.gamma0 for c in cq.values()) * 0.01
     g_dt1, g_thesis = cq[0.8].gamma0, c8.gamma0
-    sde = [f"Euler-Maruyama at dt = 0.01 (gamma0 dt up to {g_max:.3f} here) biases the stationary <v^2> by "
-           f"up to 2 / (2 - gamma0 dt) - 1 = {2 / (2 - g_max) - 1:.1%}; the theory includes the transient "
-           "of the thesis' fixed initial speed sqrt(2).",
-           f"At dt = 1 (Fig. 4.20) gamma0 dt = {g_dt1:.1f} for xi = 0.8 here"
-           + (", past Euler-Maruyama's stability limit 2, so the figure shows the exact scheme there."
-              if g_dt1 >= 2 else ", within Euler-Maruyama's stability limit 2.")
-           + (f"  With the thesis' coefficients gamma0 dt = {g_thesis:.1f}: its dt = 1 curve cannot have been "
-              "Euler-Maruyama as printed." if g_thesis >= 2 else ""),
-           "UDSBM is a model of the granular gas, not the gas: it tracks the EDMD MSD only up to O(1 - xi), "
-           "because its velocity autocorrelation (2.111) differs from the gas' (2.77) unless gamma0 tau0 >> 1 "
-           f"(thesis 4.2.2); here gamma0 tau0 = {cq[0.8].gamma0 * cq[0.8].tau0:.1f} at xi = 0.8."]
+    sde = [
+        f"Euler-Maruyama at dt = 0.01 (gamma0 dt up to {g_max:.3f} here) biases the stationary "
+        f"<v^2> by up to 2 / (2 - gamma0 dt) - 1 = {2 / (2 - g_max) - 1:.1%}; the theory includes "
+        "the transient of the thesis' fixed initial speed sqrt(2).",
+        f"At dt = 1 (Fig. 4.20) gamma0 dt = {g_dt1:.1f} for xi = 0.8 here"
+        + (
+            ", past Euler-Maruyama's stability limit 2, so the figure shows the exact scheme there."
+            if g_dt1 >= 2
+            else ", within Euler-Maruyama's stability limit 2."
+        )
+        + (
+            f"  With the thesis' coefficients gamma0 dt = {g_thesis:.1f}: its dt = 1 curve cannot "
+            "have been Euler-Maruyama as printed."
+            if g_thesis >= 2
+            else ""
+        ),
+        "UDSBM is a model of the granular gas, not the gas: it tracks the EDMD MSD only up to "
+        "O(1 - xi), because its velocity autocorrelation (2.111) differs from the gas' (2.77) "
+        "unless gamma0 tau0 >> 1 (thesis 4.2.2); here gamma0 tau0 = "
+        f"{cq[0.8].gamma0 * cq[0.8].tau0:.1f} at xi = 0.8.",
+    ]
 
     ud = by_id["ergodicity.udsbm"]
-    ergodicity = ["Theory: for the Langevin model the ratio is 1 (the thermal initial <v^2> makes its "
-                  "increments stationary); for UDSBM it is the expected time average over the same windows, "
-                  "from the velocity correlations of the linear SDE, over its ensemble MSD."]
+    ergodicity = [
+        "Theory: for the Langevin model the ratio is 1 (the thermal initial <v^2> makes its "
+        "increments stationary); for UDSBM it is the expected time average over the same windows, "
+        "from the velocity correlations of the linear SDE, over its ensemble MSD."
+    ]
     if ud["ours"] + SIGMA * ud["ours_error"] < 1:
-        ergodicity.append("UDSBM's time average stays below its ensemble MSD: it is not ergodic, as in the "
-                          "thesis and ref. [15].")
-    ergodicity.append("Fig. 4.23 sets its time averages for t_stop = "
-                      + ", ".join(f"{t:g}" for t in cfg.tamsd_t_stops) + " beside their theory.")
+        ergodicity.append(
+            "UDSBM's time average stays below its ensemble MSD: it is not ergodic, as in the "
+            "thesis and ref. [15]."
+        )
+    ergodicity.append(
+        "Fig. 4.23 sets its time averages for t_stop = "
+        + ", ".join(f"{t:g}" for t in cfg.tamsd_t_stops)
+        + " beside their theory."
+    )
 
-    return [("Energy (Fig. 4.2)", "energy.", energy),
-            ("Speed distributions (Table 4.1, Figs 4.5-4.7)", "table4.1.", speeds),
-            ("Haff's law (Fig. 4.10)", "haff.", haff),
-            ("Long-time MSD slopes (App. F)", "msd.slope.", slopes),
-            ("Langevin and UDSBM (Figs 4.17-4.20)", "sde.", sde),
-            ("Ergodicity (Figs 4.21-4.23)", "ergodicity.", ergodicity)]
+    return [
+        ("Energy (Fig. 4.2)", "energy.", energy),
+        ("Speed distributions (Table 4.1, Figs 4.5-4.7)", "table4.1.", speeds),
+        ("Haff's law (Fig. 4.10)", "haff.", haff),
+        ("Long-time MSD slopes (App. F)", "msd.slope.", slopes),
+        ("Langevin and UDSBM (Figs 4.17-4.20)", "sde.", sde),
+        ("Ergodicity (Figs 4.21-4.23)", "ergodicity.", ergodicity),
+    ]
 
 
 def _report(rows, cfg, names, seconds):
@@ -614,9 +845,10 @@ def _report(rows, cfg, names, seconds):
         "",
         f"System: N = {cfg.n3}, r = {cfg.r3:.4g} (3D), N = {cfg.n2}, r = {cfg.r2:.4g} (2D); "
         f"{cfg.runs_few} runs where the thesis used 4, {cfg.runs_many} where it used 20"
-        + (" (quick mode: small sizes, short times)" if cfg.quick else "") + f". Took {seconds:.0f} s.",
-        "Errors are standard errors of the mean over the runs (central limit theorem); 'agrees' means "
-        f"within {SIGMA:g} of them.",
+        + (" (quick mode: small sizes, short times)" if cfg.quick else "")
+        + f". Took {seconds:.0f} s.",
+        "Errors are standard errors of the mean over the runs (central limit theorem); 'agrees' "
+        f"means within {SIGMA:g} of them.",
         "",
         "| id | quantity | ours | runs | thesis | theory | ours/theory - 1 |",
         "|---|---|---|---|---|---|---|",
@@ -624,8 +856,10 @@ def _report(rows, cfg, names, seconds):
     for r in rows:
         rel = f"{r['ours'] / r['theory'] - 1:+.2%}" if r["theory"] else "--"
         quantity = r["quantity"].replace("|", "\\|")
-        lines.append(f"| {r['id']} | {quantity} | {_fmt(r['ours'], r['ours_error'])} | {r['runs'] or '--'} | "
-                     f"{_num(r['thesis'])} | {_num(r['theory'])} | {rel} |")
+        lines.append(
+            f"| {r['id']} | {quantity} | {_fmt(r['ours'], r['ours_error'])} | {r['runs'] or '--'} "
+            f"| {_num(r['thesis'])} | {_num(r['theory'])} | {rel} |"
+        )
     lines += ["", "## Where we agree, and where not"]
     by_id = {r["id"]: r for r in rows}
     for title, prefix, notes in _notes(cfg, by_id):
@@ -636,9 +870,9 @@ def _report(rows, cfg, names, seconds):
         "",
         "### Slips of the thesis, corrected",
         "",
-        "Isotropic initial directions instead of eq. 3.3 (a uniform polar angle puts too much speed along "
-        "z), the mean collision time of (2.42) instead of (2.70)-(2.71) (which make it proportional to "
-        "sqrt(T)), and the Euler-Maruyama noise term sqrt(2D) gamma dW.",
+        "Isotropic initial directions instead of eq. 3.3 (a uniform polar angle puts too much "
+        "speed along z), the mean collision time of (2.42) instead of (2.70)-(2.71) (which make "
+        "it proportional to sqrt(T)), and the Euler-Maruyama noise term sqrt(2D) gamma dW.",
         "",
         "## Figures",
         "",

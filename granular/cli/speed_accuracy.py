@@ -28,6 +28,7 @@ stability limit (refused at gamma0*dt >= 2) beside the exact scheme; inelastic c
 2D disks between walls over restitution and area fraction, with and without the TC
 model; the cost of EDMD per unit time as the packing approaches the dense limit.
 """
+
 from __future__ import annotations
 
 import functools
@@ -38,8 +39,16 @@ import time
 
 import numpy as np
 
-from .. import (InelasticCollapseError, Scene, Simulation, UnstableStepError, analysis, ensemble,
-                langevin, theory)
+from .. import (
+    InelasticCollapseError,
+    Scene,
+    Simulation,
+    UnstableStepError,
+    analysis,
+    ensemble,
+    langevin,
+    theory,
+)
 from ..simulation import _LIST_SHELL  # the shell of shell="auto": dense_cost measures it
 from .bench_langevin import log_lags
 from .output import write_json
@@ -68,7 +77,7 @@ def _errors(times, msd, t_ref, ref, slope_ref, log, t_fit):
     return float(np.max(np.abs(msd[ok] / ref_at - 1))), float(abs(slope / slope_ref - 1))
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _equilibrated(n, seed):
     """N particles at the standard density (box scaled), equilibrated at T0, and the CPU
     seconds that took (cached: both gases start from the same state)."""
@@ -83,8 +92,16 @@ def _edmd_msd(n, xi, runs, times, seed):
     the CPU seconds of the runs plus the equilibration."""
     start, equilibration = _equilibrated(n, seed)
     t0 = clock()
-    res = ensemble(start.replace(restitution=xi), runs, seed=seed, backend="serial",
-                   t_stop=times[-1], sample_times=times, quantities=("msd",), progress=False)
+    res = ensemble(
+        start.replace(restitution=xi),
+        runs,
+        seed=seed,
+        backend="serial",
+        t_stop=times[-1],
+        sample_times=times,
+        quantities=("msd",),
+        progress=False,
+    )
     return res.mean["msd"], equilibration + clock() - t0
 
 
@@ -106,18 +123,54 @@ def speed_accuracy_points(quick=False):
         log = xi < 1
         sel = times >= t_fit
         slope_ref = analysis.fit_slope(times[sel], ref[sel], log=log)[0]
-        refs[xi] = dict(times=times.tolist(), msd=ref.tolist(), theory=th.tolist(), runs=ref_runs,
-                        seconds=ref_cost, slope=slope_ref)
+        refs[xi] = dict(
+            times=times.tolist(),
+            msd=ref.tolist(),
+            theory=th.tolist(),
+            runs=ref_runs,
+            seconds=ref_cost,
+            slope=slope_ref,
+        )
         slope_th = analysis.fit_slope(times[sel], th[sel], log=log)[0]
 
-        def add(method, label, msd, seconds, at=times, **extra):
+        # this iteration's reference and theory bound as defaults, not looked up at call time
+        def add(
+            method,
+            label,
+            msd,
+            seconds,
+            at=times,
+            *,
+            xi=xi,
+            ref=ref,
+            slope_ref=slope_ref,
+            th=th,
+            slope_th=slope_th,
+            log=log,
+            **extra,
+        ):
             e_ref, s_ref = _errors(at, msd, times, ref, slope_ref, log, t_fit)
             e_th, s_th = _errors(at, msd, times, th, slope_th, log, t_fit)
-            points.append(dict(gas="molecular" if xi == 1 else "granular", xi=xi, method=method,
-                               label=label, seconds=seconds, msd_error=e_ref, slope_error=s_ref,
-                               msd_error_theory=e_th, slope_error_theory=s_th, **extra))
+            points.append(
+                dict(
+                    gas="molecular" if xi == 1 else "granular",
+                    xi=xi,
+                    method=method,
+                    label=label,
+                    seconds=seconds,
+                    msd_error=e_ref,
+                    slope_error=s_ref,
+                    msd_error_theory=e_th,
+                    slope_error_theory=s_th,
+                    **extra,
+                )
+            )
 
-        sizes = [(250, 1), (250, 4), (1000, 1), (1000, 4), (4000, 1)] if not quick else [(125, 1), (250, 2)]
+        sizes = (
+            [(250, 1), (250, 4), (1000, 1), (1000, 4), (4000, 1)]
+            if not quick
+            else [(125, 1), (250, 2)]
+        )
         for n, runs in sizes:
             msd, sec = _edmd_msd(n, xi, runs, times, seed=n + runs)
             add("edmd", f"N={n}, runs={runs}", msd, sec, n=n, runs=runs)
@@ -128,11 +181,28 @@ def speed_accuracy_points(quick=False):
         for scheme, dts in (("em", em_dts), ("exact", em_dts + [g / c.gamma0 for g in beyond])):
             for dt in dts:
                 t0 = clock()
-                r = langevin.run(n_sde, gamma0=c.gamma0, D0=c.D0, tau0=c.tau0, dt=dt, t_stop=t_max,
-                                 scheme=scheme, sample_times=times, seed=5)
+                r = langevin.run(
+                    n_sde,
+                    gamma0=c.gamma0,
+                    D0=c.D0,
+                    tau0=c.tau0,
+                    dt=dt,
+                    t_stop=t_max,
+                    scheme=scheme,
+                    sample_times=times,
+                    seed=5,
+                )
                 sec = clock() - t0
-                add(scheme, f"{r.model} {scheme}, dt={dt:.3g}", r.msd(), sec, at=r.times, dt=dt,
-                    n=n_sde, gamma_dt=c.gamma0 * dt)
+                add(
+                    scheme,
+                    f"{r.model} {scheme}, dt={dt:.3g}",
+                    r.msd(),
+                    sec,
+                    at=r.times,
+                    dt=dt,
+                    n=n_sde,
+                    gamma_dt=c.gamma0 * dt,
+                )
     return points, refs
 
 
@@ -150,8 +220,16 @@ def em_stability(quick=False):
         row = dict(gamma_dt=gdt, dt=dt)
         for scheme in ("em", "exact"):
             try:
-                r = langevin.run(n, gamma0=c.gamma0, D0=c.D0, dt=dt, t_stop=t_max, scheme=scheme,
-                                 sample_times=times, seed=1)
+                r = langevin.run(
+                    n,
+                    gamma0=c.gamma0,
+                    D0=c.D0,
+                    dt=dt,
+                    t_stop=t_max,
+                    scheme=scheme,
+                    sample_times=times,
+                    seed=1,
+                )
                 ok = r.times > 0
                 row[scheme] = float(np.max(np.abs(r.msd()[ok] / th[ok] - 1)))
                 row[f"{scheme}_v2_bias"] = float(r.v2[-1] / (3 * c.gamma0 * c.D0) - 1)
@@ -176,20 +254,30 @@ def collapse_map(quick=False, contact_durations=(0.0, 1e-4), events_per_particle
         for eta in etas:
             r = math.sqrt(eta / (n * math.pi))
             for xi in xis:
-                s = Scene.random(n, r, dim=2, boundary="walls", restitution=xi, contact_duration=tc, seed=1)
+                s = Scene.random(
+                    n, r, dim=2, boundary="walls", restitution=xi, contact_duration=tc, seed=1
+                )
                 sim = Simulation(s)
                 t0 = clock()
                 cell = dict(contact_duration=tc, eta=eta, xi=xi)
                 try:
                     goal = {"collisions_per_particle": 100, "events": events_per_particle * n}
                     tr = sim.run(stop_when=goal, store=())
-                    status = ("budget" if tr.stop_reason == "events"
-                              else "tc" if sim.stats["tc_elastic_collisions"] else "ok")
+                    status = (
+                        "budget"
+                        if tr.stop_reason == "events"
+                        else "tc"
+                        if sim.stats["tc_elastic_collisions"]
+                        else "ok"
+                    )
                     cell.update(status=status, stop=tr.stop_reason)
                 except InelasticCollapseError as e:
                     cell.update(status="collapse", time=e.time, particles=list(e.particles))
-                cell.update(seconds=clock() - t0, tc_elastic_collisions=sim.stats["tc_elastic_collisions"],
-                            collisions_per_particle=sim.stats["collisions_per_particle"])
+                cell.update(
+                    seconds=clock() - t0,
+                    tc_elastic_collisions=sim.stats["tc_elastic_collisions"],
+                    collisions_per_particle=sim.stats["collisions_per_particle"],
+                )
                 cells.append(cell)
     return cells
 
@@ -199,15 +287,21 @@ def dense_cost(quick=False):
     3D with cells and with neighbour lists (the shell Simulation's shell="auto" uses),
     the evidence for where "auto" switches."""
     rows = []
-    cases = [(3, (0.1, 0.2, 0.3, 0.4, 0.45, 0.5, 0.55, 0.6), (0.0, _LIST_SHELL)),
-             (2, (0.1, 0.3, 0.5, 0.6, 0.7, 0.8), (0.0,))]
+    cases = [
+        (3, (0.1, 0.2, 0.3, 0.4, 0.45, 0.5, 0.55, 0.6), (0.0, _LIST_SHELL)),
+        (2, (0.1, 0.3, 0.5, 0.6, 0.7, 0.8), (0.0,)),
+    ]
     for dim, etas, shells in cases:
         # a full face-centred cubic lattice (4 k^3 sites) reaches the densest 3D cases
         n = (2048 if dim == 3 else 2000) if not quick else (256 if dim == 3 else 300)
         if quick:
             etas = (etas[0], etas[-1])  # the dilute and the densest case
         for eta, shell in itertools.product(etas, shells):
-            r = ((eta / (n * 4 / 3 * math.pi)) ** (1 / 3) if dim == 3 else math.sqrt(eta / (n * math.pi)))
+            r = (
+                (eta / (n * 4 / 3 * math.pi)) ** (1 / 3)
+                if dim == 3
+                else math.sqrt(eta / (n * math.pi))
+            )
             sim = Simulation(Scene.random(n, r, dim=dim, temperature=1.0, seed=2), shell=shell)
             sim.run(stop_when={"collisions_per_particle": 5}, store=())
             b = sim.stats
@@ -216,10 +310,17 @@ def dense_cost(quick=False):
             sec = clock() - t0
             a = sim.stats
             pairs = a["pair_collisions"] - b["pair_collisions"]
-            rows.append(dict(dim=dim, eta=eta, n=n, shell=shell,
-                             seconds_per_time=sec / (a["time"] - b["time"]),
-                             ns_per_collision=1e9 * sec / pairs,
-                             collisions_per_particle_per_time=2 * pairs / n / (a["time"] - b["time"])))
+            rows.append(
+                dict(
+                    dim=dim,
+                    eta=eta,
+                    n=n,
+                    shell=shell,
+                    seconds_per_time=sec / (a["time"] - b["time"]),
+                    ns_per_collision=1e9 * sec / pairs,
+                    collisions_per_particle_per_time=2 * pairs / n / (a["time"] - b["time"]),
+                )
+            )
     return rows
 
 
@@ -240,23 +341,54 @@ def scene_costs(quick=False):
         return 1e9 * sec / (sim.stats["pair_collisions"] - b["pair_collisions"])
 
     n = 2000
-    rows.append(dict(case="3D periodic, eta 0.1", ns_per_collision=per_collision(
-        Scene.random(n, (0.1 / (n * 4 / 3 * math.pi)) ** (1 / 3), seed=1))))
-    rows.append(dict(case="2D periodic, eta 0.1", ns_per_collision=per_collision(
-        Scene.random(n, math.sqrt(0.1 / (n * math.pi)), dim=2, seed=1))))
-    rows.append(dict(case="3D walls, eta 0.1", ns_per_collision=per_collision(
-        Scene.random(n, (0.1 / (n * 4 / 3 * math.pi)) ** (1 / 3), boundary="walls", seed=1))))
+    rows.append(
+        dict(
+            case="3D periodic, eta 0.1",
+            ns_per_collision=per_collision(
+                Scene.random(n, (0.1 / (n * 4 / 3 * math.pi)) ** (1 / 3), seed=1)
+            ),
+        )
+    )
+    rows.append(
+        dict(
+            case="2D periodic, eta 0.1",
+            ns_per_collision=per_collision(
+                Scene.random(n, math.sqrt(0.1 / (n * math.pi)), dim=2, seed=1)
+            ),
+        )
+    )
+    rows.append(
+        dict(
+            case="3D walls, eta 0.1",
+            ns_per_collision=per_collision(
+                Scene.random(n, (0.1 / (n * 4 / 3 * math.pi)) ** (1 / 3), boundary="walls", seed=1)
+            ),
+        )
+    )
     for small in (20, 100):
-        rows.append(dict(case=f"3D periodic, eta 0.1, N = {small}", ns_per_collision=per_collision(
-            Scene.random(small, (0.1 / (small * 4 / 3 * math.pi)) ** (1 / 3), seed=1))))
+        rows.append(
+            dict(
+                case=f"3D periodic, eta 0.1, N = {small}",
+                ns_per_collision=per_collision(
+                    Scene.random(small, (0.1 / (small * 4 / 3 * math.pi)) ** (1 / 3), seed=1)
+                ),
+            )
+        )
     # one tracer of radius 0.1 among spheres of radius 0.008 (eta 0.065 in all)
     small = 2000 if not quick else 500
     r_small = ((0.065 - 4 / 3 * math.pi * 0.1**3) / (small * 4 / 3 * math.pi)) ** (1 / 3)
     radii = np.r_[0.1, np.full(small, r_small)]
     tracer = Scene.random(small + 1, radii, mass=(radii / r_small) ** 3, seed=1)
-    for big_ratio, how in ((3.0, "kept out of the cell grid"), (math.inf, "in cells as wide as it")):
-        rows.append(dict(case=f"3D, one tracer {0.1 / r_small:.1f}x wider than {small} others, {how}",
-                         ns_per_collision=per_collision(tracer, big_ratio=big_ratio)))
+    for big_ratio, how in (
+        (3.0, "kept out of the cell grid"),
+        (math.inf, "in cells as wide as it"),
+    ):
+        rows.append(
+            dict(
+                case=f"3D, one tracer {0.1 / r_small:.1f}x wider than {small} others, {how}",
+                ns_per_collision=per_collision(tracer, big_ratio=big_ratio),
+            )
+        )
     s = Scene.random(1000, R, seed=1)
     for store in ((), ("positions", "velocities")):
         sim = Simulation(s)
@@ -264,22 +396,41 @@ def scene_costs(quick=False):
         tr = sim.run(t_stop=10.0, sample_times=np.linspace(0, 10, 1001), store=store)
         sec = clock() - t0
         mb = sum(a.nbytes for a in (tr.positions, tr.velocities) if a is not None) / 2**20
-        rows.append(dict(case=f"1000 samples, store={store or 'statistics only'}", seconds=sec,
-                         stored_megabytes=mb))
+        rows.append(
+            dict(
+                case=f"1000 samples, store={store or 'statistics only'}",
+                seconds=sec,
+                stored_megabytes=mb,
+            )
+        )
     for lags in (0, 30):
         t0 = clock()
-        r = langevin.run(1000, gamma0=9.26, D0=0.072, dt=0.01, t_stop=100.0 if not quick else 10.0,
-                         tamsd_lags=log_lags(lags, 10.0, 0.01) if lags else None, scheme="em", seed=1)
-        rows.append(dict(case=f"Langevin EM, N = 1000, {len(r.tamsd_lags)} TAMSD lags accumulated",
-                         seconds=clock() - t0))
+        r = langevin.run(
+            1000,
+            gamma0=9.26,
+            D0=0.072,
+            dt=0.01,
+            t_stop=100.0 if not quick else 10.0,
+            tamsd_lags=log_lags(lags, 10.0, 0.01) if lags else None,
+            scheme="em",
+            seed=1,
+        )
+        rows.append(
+            dict(
+                case=f"Langevin EM, N = 1000, {len(r.tamsd_lags)} TAMSD lags accumulated",
+                seconds=clock() - t0,
+            )
+        )
     return rows
 
 
 # the collapse map's outcomes, in legend order, with their colours and meanings
-COLLAPSE_STATUS = {"ok": ("tab:green", "ok: reached 100 collisions per particle"),
-                   "tc": ("tab:blue", "tc: reached it, TC model acting"),
-                   "budget": ("tab:orange", "budget: event budget ran out first"),
-                   "collapse": ("tab:red", "collapse: inelastic collapse")}
+COLLAPSE_STATUS = {
+    "ok": ("tab:green", "ok: reached 100 collisions per particle"),
+    "tc": ("tab:blue", "tc: reached it, TC model acting"),
+    "budget": ("tab:orange", "budget: event budget ran out first"),
+    "collapse": ("tab:red", "collapse: inelastic collapse"),
+}
 
 
 def _collapse_map(plt, cells):
@@ -290,12 +441,15 @@ def _collapse_map(plt, cells):
     tcs = sorted({c["contact_duration"] for c in cells})
     etas = sorted({c["eta"] for c in cells})
     xis = sorted({c["xi"] for c in cells})
-    fig, axes = plt.subplots(1, len(tcs), figsize=(4.5 * len(tcs) + 1.5, 4.2), layout="constrained",
-                             squeeze=False)
-    for ax, tc in zip(axes[0], tcs):
+    fig, axes = plt.subplots(
+        1, len(tcs), figsize=(4.5 * len(tcs) + 1.5, 4.2), layout="constrained", squeeze=False
+    )
+    for ax, tc in zip(axes[0], tcs, strict=True):
         for c in (c for c in cells if c["contact_duration"] == tc):
             x, y = etas.index(c["eta"]), xis.index(c["xi"])
-            ax.add_patch(Rectangle((x - 0.45, y - 0.45), 0.9, 0.9, color=COLLAPSE_STATUS[c["status"]][0]))
+            ax.add_patch(
+                Rectangle((x - 0.45, y - 0.45), 0.9, 0.9, color=COLLAPSE_STATUS[c["status"]][0])
+            )
             ax.text(x, y, c["status"], ha="center", va="center", fontsize=8, color="w")
         ax.set_xlim(-0.5, len(etas) - 0.5)
         ax.set_ylim(-0.5, len(xis) - 0.5)
@@ -303,10 +457,20 @@ def _collapse_map(plt, cells):
         ax.set_yticks(range(len(xis)), [f"{x:g}" for x in xis])
         ax.set_xlabel("area fraction")
         ax.set_ylabel(r"restitution $\xi$")
-        ax.set_title("2D disks, walls, " + ("no TC model" if tc == 0 else rf"TC model $t_c$ = {tc:g}"))
+        ax.set_title(
+            "2D disks, walls, " + ("no TC model" if tc == 0 else rf"TC model $t_c$ = {tc:g}")
+        )
     seen = {c["status"] for c in cells}
-    fig.legend(handles=[Patch(color=color, label=text) for status, (color, text) in COLLAPSE_STATUS.items()
-                        if status in seen], loc="outside lower center", ncols=len(seen), fontsize=8)
+    fig.legend(
+        handles=[
+            Patch(color=color, label=text)
+            for status, (color, text) in COLLAPSE_STATUS.items()
+            if status in seen
+        ],
+        loc="outside lower center",
+        ncols=len(seen),
+        fontsize=8,
+    )
     return fig
 
 
@@ -329,16 +493,30 @@ def _charts(out, points, refs, stab, cells, dense):
                     # a label at every step would pile up where the steps cost alike
                     pts = sorted(pts, key=lambda p: p["dt"])
                     marker += "-"
-                ax.loglog([p["seconds"] for p in pts], [max(p[key], 1e-5) for p in pts], marker,
-                          label={"edmd": "EDMD (N, runs)", "em": r"Langevin/UDSBM, Euler-Maruyama ($\Delta t$)",
-                                 "exact": r"Langevin/UDSBM, exact scheme ($\Delta t$)"}[method])
-                for p in (pts if method == "edmd" else (pts[0], pts[-1])):
-                    ax.annotate(p["label"] if method == "edmd" else rf"$\Delta t$ = {p['dt']:.3g}",
-                                (p["seconds"], max(p[key], 1e-5)),
-                                fontsize=6, xytext=(3, 3), textcoords="offset points")
+                ax.loglog(
+                    [p["seconds"] for p in pts],
+                    [max(p[key], 1e-5) for p in pts],
+                    marker,
+                    label={
+                        "edmd": "EDMD (N, runs)",
+                        "em": r"Langevin/UDSBM, Euler-Maruyama ($\Delta t$)",
+                        "exact": r"Langevin/UDSBM, exact scheme ($\Delta t$)",
+                    }[method],
+                )
+                for p in pts if method == "edmd" else (pts[0], pts[-1]):
+                    ax.annotate(
+                        p["label"] if method == "edmd" else rf"$\Delta t$ = {p['dt']:.3g}",
+                        (p["seconds"], max(p[key], 1e-5)),
+                        fontsize=6,
+                        xytext=(3, 3),
+                        textcoords="offset points",
+                    )
             ax.set_xlabel("CPU seconds, one core (EDMD: equilibration included)")
-            ax.set_ylabel("max relative MSD error vs EDMD reference" if key == "msd_error"
-                          else "relative error of the long-time slope")
+            ax.set_ylabel(
+                "max relative MSD error vs EDMD reference"
+                if key == "msd_error"
+                else "relative error of the long-time slope"
+            )
             ax.set_title(f"{gas} gas" + (r", $\xi$ = 0.8" if gas == "granular" else ""))
             ax.legend(fontsize=7)
     fig.savefig(os.path.join(out, "speed_accuracy.png"), dpi=110)
@@ -347,8 +525,12 @@ def _charts(out, points, refs, stab, cells, dense):
     fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
     g = [r["gamma_dt"] for r in stab]
     for scheme, marker in (("em", "s-"), ("exact", "^-")):
-        ax.loglog(g, [r[scheme] if r[scheme] is not None else np.nan for r in stab], marker,
-                  label={"em": "Euler-Maruyama", "exact": "exact scheme"}[scheme])
+        ax.loglog(
+            g,
+            [r[scheme] if r[scheme] is not None else np.nan for r in stab],
+            marker,
+            label={"em": "Euler-Maruyama", "exact": "exact scheme"}[scheme],
+        )
     ax.axvline(2.0, color="r", ls=":", label=r"EM refused ($\gamma_0 \Delta t \geq 2$)")
     ax.set_xlabel(r"$\gamma_0 \Delta t$")
     ax.set_ylabel("max relative MSD error vs (2.68)")
@@ -380,18 +562,34 @@ def main(out="speed-accuracy", quick=False):
     os.makedirs(out, exist_ok=True)
     started = time.perf_counter()
     points, refs = speed_accuracy_points(quick)
-    print(f"  speed/accuracy points: {len(points)}  ({time.perf_counter() - started:.0f} s)", flush=True)
+    print(
+        f"  speed/accuracy points: {len(points)}  ({time.perf_counter() - started:.0f} s)",
+        flush=True,
+    )
     stab = em_stability(quick)
     cells = collapse_map(quick)
     dense = dense_cost(quick)
     costs = scene_costs(quick)
     _charts(out, points, refs, stab, cells, dense)
-    write_json(os.path.join(out, "speed_accuracy.json"),
-               dict(seconds="CPU-seconds of one process, every method serial on one thread",
-                    points=points, references=refs, em_stability=stab, collapse_map=cells,
-                    dense_cost=dense, scene_costs=costs))
+    write_json(
+        os.path.join(out, "speed_accuracy.json"),
+        dict(
+            seconds="CPU-seconds of one process, every method serial on one thread",
+            points=points,
+            references=refs,
+            em_stability=stab,
+            collapse_map=cells,
+            dense_cost=dense,
+            scene_costs=costs,
+        ),
+    )
     print(f"{'method':<34} {'CPU s':>8} {'MSD err':>8} {'slope err':>9}")
     for p in points:
-        print(f"{p['gas'][:4] + ' ' + p['label']:<34} {p['seconds']:>8.2f} {p['msd_error']:>8.3f} {p['slope_error']:>9.3f}")
+        print(
+            f"{p['gas'][:4] + ' ' + p['label']:<34} {p['seconds']:>8.2f} {p['msd_error']:>8.3f} "
+            f"{p['slope_error']:>9.3f}"
+        )
     print(f"charts and speed_accuracy.json in {out}/ ({time.perf_counter() - started:.0f} s)")
-    return dict(points=points, em_stability=stab, collapse_map=cells, dense_cost=dense, scene_costs=costs)
+    return dict(
+        points=points, em_stability=stab, collapse_map=cells, dense_cost=dense, scene_costs=costs
+    )

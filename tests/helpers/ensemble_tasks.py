@@ -1,4 +1,5 @@
 """Picklable functions for the ensemble tests (workers import them by module name)."""
+
 import threading
 import weakref
 
