@@ -12,6 +12,7 @@
 #ifndef GR_EDMD_H
 #define GR_EDMD_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "common.h"
@@ -68,10 +69,11 @@ typedef struct {
 
 typedef struct {
     double t;               /* current time of the system */
-    int64_t events;         /* all events processed, cell crossings included */
+    int64_t events;         /* all events processed, crossings and exits included */
     int64_t pair;           /* pair collisions */
     int64_t wall;           /* wall collisions */
-    int64_t crossings;      /* cell crossings, or neighbour-list rebuilds with lists */
+    int64_t crossings;      /* cell crossings (none with neighbour lists) */
+    int64_t shell_exits;    /* neighbour lists: shell exits, each rebuilding one list */
     int64_t invalid;        /* events found stale on pop (partner collided since) */
     int64_t elastic_tc;     /* pair collisions made elastic by the TC model */
     double virial;          /* sum over pair collisions of r_ij . dp_j */
@@ -92,6 +94,15 @@ typedef struct gr_edmd gr_edmd;
 int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
                 const double *vel, const double *radius, const double *mass, gr_error *err);
 void gr_edmd_free(gr_edmd *s);
+
+/* The checks of gr_edmd_new without building a system: arguments, finiteness, the box,
+ * overlaps (through a cell grid, O(N)).  Same status codes. */
+int gr_edmd_check(const gr_edmd_config *cfg, const double *pos, const double *vel,
+                  const double *radius, const double *mass, gr_error *err);
+
+/* What the engine allocates per particle, in bytes, with and without neighbour lists
+ * (at the lists' starting capacity), for estimates of memory before a run. */
+size_t gr_edmd_bytes_per_particle(int dim, int lists);
 
 /* Process events.  Returns a GR_STOP_* reason, or GR_ERR_COLLAPSE / GR_ERR_NONFINITE
  * (the state stays consistent and inspectable after an error), or GR_ERR_NOMEM (a

@@ -100,7 +100,8 @@ class Simulation:
     @property
     def stats(self):
         """Counters since the start: events, pair_collisions, wall_collisions,
-        cell_crossings (neighbour-list rebuilds with lists), stale_events,
+        cell_crossings (cell mode), shell_exits (neighbour lists: each rebuilds one
+        list), stale_events,
         tc_elastic_collisions, virial, wall_impulse, kinetic_energy,
         kinetic_time_integral, time, cells, shell (0: cells); and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
