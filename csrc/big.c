@@ -5,11 +5,23 @@
 
 #include "big.h"
 #include "cells.h"
+#include "common.h"
 
 static int cmp_radius(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
+}
+
+int gr_big_cut(const double *radius, int32_t n, double ratio, double *cut)
+{
+    double *sorted = malloc((size_t)n * sizeof *sorted);
+    if (!sorted) return GR_ERR_NOMEM;
+    memcpy(sorted, radius, (size_t)n * sizeof *sorted);
+    qsort(sorted, (size_t)n, sizeof *sorted, cmp_radius);
+    *cut = ratio * sorted[n / 2];
+    free(sorted);
+    return GR_OK;
 }
 
 int gr_big_choose(gr_big *b, int dim, int32_t n, const double *radius, const double *L,
@@ -20,18 +32,14 @@ int gr_big_choose(gr_big *b, int dim, int32_t n, const double *radius, const dou
     b->r_small = rmax;
     b->n = 0;
     if (!(ratio < INFINITY) || n < 2) return GR_OK;
-    double *sorted = malloc((size_t)n * sizeof *sorted);
-    if (!sorted) return GR_ERR_NOMEM;
-    memcpy(sorted, radius, (size_t)n * sizeof *sorted);
-    qsort(sorted, (size_t)n, sizeof *sorted, cmp_radius);
-    const double cut = ratio * sorted[n / 2];
+    double cut;
+    if (gr_big_cut(radius, n, ratio, &cut) != GR_OK) return GR_ERR_NOMEM;
     int32_t count = 0;
     double r_small = 0.0;
     for (int32_t i = 0; i < n; i++) {
-        if (sorted[i] > cut) count++;
-        else r_small = sorted[i];
+        if (radius[i] > cut) count++;
+        else if (radius[i] > r_small) r_small = radius[i];
     }
-    free(sorted);
     if (count == 0 || count > GR_BIG_MAX) return GR_OK;
     double k[3];
     gr_cells_dims(dim, n, L, 2.0 * r_small * cell_factor, k);

@@ -33,4 +33,8 @@ typedef struct {
 int gr_big_choose(gr_big *b, int dim, int32_t n, const double *radius, const double *L,
                   double ratio, double cell_factor);
 
+/* The cut: ratio times the upper median radius (radius n / 2 in increasing order);
+ * wider than this is big.  GR_OK or GR_ERR_NOMEM. */
+int gr_big_cut(const double *radius, int32_t n, double ratio, double *cut);
+
 #endif

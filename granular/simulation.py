@@ -9,7 +9,7 @@ import numpy as np
 from . import _core
 from .errors import (FrozenGasError, GranularError, HeatedWallsError, InelasticCollapseError,
                      NoProgressError)
-from .scene import _ENGINE_BYTES_PER_PARTICLE, BIG_RATIO, Scene, _check_memory, frozen_energy
+from .scene import BIG_RATIO, Scene, _check_memory, frozen_energy
 from .trajectory import Trajectory, _pressure_volume
 
 _STOP_KEYS = ("collisions_per_particle", "kinetic_energy", "events")
@@ -26,8 +26,6 @@ _STORE = ("positions", "velocities")
 # so cells.
 _LIST_SHELL = 0.25
 _LIST_MIN_PACKING = 0.4
-# Lists add per particle: a row of 32 entries, its copy while reordering, the centre.
-_LIST_BYTES_PER_PARTICLE = 300
 
 
 class Simulation:
@@ -61,7 +59,7 @@ class Simulation:
         if not isinstance(scene, Scene):
             raise TypeError(f"Simulation needs a granular.Scene, got {type(scene).__name__}")
         self._initial = scene
-        big = np.max(scene.radii) > big_ratio * np.median(scene.radii)
+        big = np.max(scene.radii) > _core.big_cut(scene.radii, big_ratio)
         if isinstance(shell, str) and shell == "auto":
             dense = scene.dim == 3 and scene.packing_fraction >= _LIST_MIN_PACKING
             shell = _LIST_SHELL if dense and not big else 0.0
@@ -74,10 +72,13 @@ class Simulation:
                 f"neighbour lists (shell = {shell}) with particles wider than big_ratio = "
                 f"{big_ratio} times the median: every list would reach as far as the widest; "
                 "use shell=0 (cells keep the big ones out) or big_ratio=math.inf to insist")
-        if shell > 0:
-            _check_memory((_ENGINE_BYTES_PER_PARTICLE + _LIST_BYTES_PER_PARTICLE) * scene.n,
-                          "the event-driven engine's state with neighbour lists")
-        self._engine = scene._engine(cell_factor, big_ratio, shell)
+        _check_memory(_core.edmd_bytes_per_particle(scene.dim, shell > 0) * scene.n,
+                      "the event-driven engine's state" + (" with neighbour lists" if shell > 0 else ""))
+        self._engine = _core.EDMD(scene.positions, scene.velocities, scene.radii, scene.masses,
+                                  scene.lower, scene.upper, scene.boundary == "periodic",
+                                  scene.wall_restitution, scene.restitution,
+                                  scene.contact_duration, float(cell_factor), float(big_ratio),
+                                  float(shell))
         # held for a whole run: the engine's own busy flag covers one C call only, and two
         # interleaved runs would write each other's samples
         self._running = threading.Lock()
