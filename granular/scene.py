@@ -3,11 +3,10 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 
 import numpy as np
 
-from . import _core
+from . import _core, _edmd
 
 BOUNDARIES = ("periodic", "walls")
 
@@ -93,19 +92,6 @@ def frozen_energy(radii, masses):
     each other (speeds estimated with the largest mass, to be safe)."""
     speed = _SCALE_LO / (2.0 * float(np.min(radii)))
     return 0.5 * len(radii) * float(np.max(masses)) * speed * speed
-
-
-def _check_memory(need, what):
-    """Refuse, before allocating, anything that would take more than half of this
-    machine's memory (on Linux an allocation that large may 'succeed' and end in the
-    out-of-memory killer instead of an exception)."""
-    try:
-        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return
-    if need > 0.5 * total:
-        raise MemoryError(f"{what} needs {need / 2**30:.1f} GiB, more than half of this "
-                          f"machine's {total / 2**30:.1f} GiB")
 
 
 def _box_corners(box, dim):
@@ -348,21 +334,20 @@ class Scene:
         positions, G = _place_lattice(rng_pos, radii, lo, hi, periodic)
         # Melt the lattice: elastic collisions with thermal velocities until no lattice
         # order is left, then keep the positions and give the scene the velocities asked for.
-        from .simulation import Simulation
-
         melt_v = _draw_velocities(rng_melt, n, dim, masses, None, 1.0, n > 1)
         hot = cls(positions, melt_v, radii, masses, box=(lo, hi), boundary=boundary)
-        sim = Simulation(hot)
+        engine = _edmd.build(hot)  # as Simulation(hot) would
         melt = _LATTICE_MELT_COLLISIONS
         while True:
-            sim.run(stop_when={"collisions_per_particle": melt}, store=())
+            _edmd.run_collisions(engine, melt)
             if eta >= _FREEZING[dim] or melt >= _LATTICE_MELT_MAX or n < 50:
                 break
             # unwrapped positions: G is a reciprocal vector of the periodic box too
-            if _lattice_order(sim.unwrapped_positions, G) < _MELTED_ORDER:
+            wrapped, _, image = engine.state()
+            if _lattice_order(wrapped + image * hot.lengths, G) < _MELTED_ORDER:
                 break
             melt += _LATTICE_MELT_COLLISIONS
-        return cls(sim.scene.positions, velocities, radii, masses, **common)
+        return cls(engine.state()[0], velocities, radii, masses, **common)
 
     @classmethod
     def seed_brownian_disks(cls, seed=None):
