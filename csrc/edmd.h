@@ -8,7 +8,14 @@
  * allocates output for the caller, prints or exits.
  *
  * Status codes (common.h): GR_OK or a GR_STOP_* reason (positive) on success, GR_ERR_*
- * (negative) on failure, with a gr_error filled in. */
+ * (negative) on failure, with a gr_error filled in.
+ *
+ * The engine's files: edmd.c the event loop, the events and the predictions (read it
+ * first); engine.h the system's struct; schedstate.h a particle's scheduling state;
+ * cells.c/.h the cell grid; nlist.c/.h the neighbour lists; big.c/.h big particles;
+ * calendar.c/.h the queue; collide.h two-body geometry; build.c construction;
+ * validate.c the checks of a configuration; renumber.c renumbering in cell order;
+ * sample.c samples, state and counters. */
 #ifndef GR_EDMD_H
 #define GR_EDMD_H
 
@@ -37,10 +44,10 @@ typedef struct {
     double cell_factor;       /* cell width / largest diameter in the grid, >= 1 (speed knob) */
     double big_ratio;         /* particles more than this times the median diameter wide
                                * (at most GR_BIG_MAX of them) stay out of the cell grid
-                               * (>= 1; +inf: none) -- a speed knob, see edmd.c */
+                               * (>= 1; +inf: none) -- a speed knob, see big.h */
     double shell;             /* > 0: neighbour lists with a shell this many largest
                                * diameters thick (no big particles then); 0: cell
-                               * crossings -- a speed knob, see edmd.c */
+                               * crossings -- a speed knob, see nlist.h */
 } gr_edmd_config;
 
 typedef struct {
