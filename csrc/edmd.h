@@ -11,7 +11,7 @@
  * (negative) on failure, with a gr_error filled in.
  *
  * The engine's files: edmd.c the event loop, the events and the predictions (read it
- * first); engine.h the system's struct; schedstate.h a particle's scheduling state;
+ * first), search.h their pair searches; engine.h the system's struct; schedstate.h a particle's scheduling state;
  * cells.c/.h the cell grid; nlist.c/.h the neighbour lists; big.c/.h big particles;
  * calendar.c/.h the queue; collide.h two-body geometry; build.c construction;
  * validate.c the checks of a configuration; renumber.c renumbering in cell order;
