@@ -14,7 +14,7 @@ void gr_edmd_free(gr_edmd *s)
     free(s->P);
     free(s->mass);
     free(s->image);
-    free(s->ev);
+    free(s->sched);
     free(s->order.id_of);
     free(s->order.scratch);
     free(s->big.is_big);
@@ -45,7 +45,8 @@ size_t gr_edmd_bytes_per_particle(int dim, int lists)
                    + 8 * sizeof(int32_t) + 1;             /* cell heads and bits: at most 8 cells each */
     if (lists)
         bytes += (size_t)(dim + 1) * sizeof(double)       /* centre */
-                 + (size_t)(dim == 3 ? 32 : 16) * sizeof(int32_t) /* a row */
+                 + 2 * (size_t)(dim == 3 ? 32 : 16) * sizeof(int32_t) /* a row, its copy
+                                                                      * while renumbering */
                  + sizeof(int32_t);                       /* near */
     return bytes;
 }
@@ -75,11 +76,11 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->P = gr_big_alloc(bytes); /* records on cache-line boundaries: a 3D record is one line */
     s->mass = gr_big_alloc((size_t)n * sizeof *s->mass);
     s->image = calloc((size_t)n * d, sizeof *s->image);
-    s->ev = gr_big_alloc((size_t)n * sizeof *s->ev);
+    s->sched = gr_big_alloc((size_t)n * sizeof *s->sched);
     s->order.id_of = malloc((size_t)n * sizeof *s->order.id_of);
     s->big.is_big = calloc((size_t)n, sizeof *s->big.is_big);
     if (n >= GR_RENUMBER_MIN_N) s->order.scratch = malloc((size_t)n * scratch_per_particle(d));
-    if (!s->P || !s->mass || !s->image || !s->ev || !s->order.id_of || !s->big.is_big ||
+    if (!s->P || !s->mass || !s->image || !s->sched || !s->order.id_of || !s->big.is_big ||
         (n >= GR_RENUMBER_MIN_N && !s->order.scratch))
         status = GR_ERR_NOMEM;
     if (status == GR_OK) status = gr_cq_init(&s->queue, n);
@@ -116,12 +117,12 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         RAD(p, d) = radius[i];
         s->mass[i] = mass[i];
         msum += mass[i];
-        s->ev[i] = (gr_sched){.t_coll = INFINITY, .t_cross = INFINITY, .t_last = -INFINITY,
+        s->sched[i] = (gr_sched){.t_coll = INFINITY, .t_cross = INFINITY, .t_last = -INFINITY,
                               .count = 0, .pcount = 0, .partner = -1, .last = -1, .cross = -1,
                               .streak = 0};
         s->order.id_of[i] = i;
-        cell_coords(&s->cells, d, p, s->ev[i].c);
-        if (!s->big.is_big[i]) cell_insert(&s->cells, i, cell_of(&s->cells, d, s->ev[i].c));
+        cell_coords(&s->cells, d, p, s->sched[i].c);
+        if (!s->big.is_big[i]) cell_insert(&s->cells, i, cell_of(&s->cells, d, s->sched[i].c));
     }
     s->kinetic = 0.5 * v2m;
     /* The collapse test's notion of "one instant": a billionth of the time a particle

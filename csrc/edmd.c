@@ -34,7 +34,7 @@
 #define PREFETCH_PARTICLE(s, i)                                                          \
     do {                                                                                \
         GR_PREFETCH(rec((s), (i)));                                                      \
-        GR_PREFETCH(&(s)->ev[(i)]);                                                      \
+        GR_PREFETCH(&(s)->sched[(i)]);                                                      \
         GR_PREFETCH(&(s)->cells.next[(i)]);                                              \
         GR_PREFETCH(&(s)->cells.prev[(i)]);                                              \
         GR_CQ_PREFETCH(&(s)->queue, (i));                                                \
@@ -94,7 +94,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const gr_edmd_sto
         }
         if (te <= s->t_prev_event) {
             if (++s->same_instant > pileup) {
-                gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), uid(s, s->ev[i].partner), te, (double)pileup,
+                gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), uid(s, s->sched[i].partner), te, (double)pileup,
                              "events pile up at one instant");
                 return GR_ERR_COLLAPSE;
             }
@@ -104,7 +104,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const gr_edmd_sto
         }
         set_clock(s, te);
         s->events++;
-        gr_sched *e = &s->ev[i];
+        gr_sched *e = &s->sched[i];
         {
             int32_t h = gr_cq_hint(&s->queue);
             if (h >= 0) PREFETCH_PARTICLE(s, h);
@@ -115,7 +115,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const gr_edmd_sto
             if (s->nl.shell > 0.0) status = do_shell_exit(s, dim, i, te, err);
             else do_cross(s, dim, i, te);
         } else if (e->partner >= 0) {
-            if (s->ev[e->partner].count != e->pcount) { /* partner collided since: stale */
+            if (s->sched[e->partner].count != e->pcount) { /* partner collided since: stale */
                 s->invalid++;
                 move(dim, rec(s, i), te);
                 predict(s, dim, i);
@@ -186,7 +186,7 @@ static inline double kinetic_of(const gr_edmd *s, int dim, int32_t i)
  * previous one of the same particle within eps_t. */
 static inline int streak(gr_edmd *s, int32_t i, double t)
 {
-    gr_sched *e = &s->ev[i];
+    gr_sched *e = &s->sched[i];
     if (t - e->t_last <= s->eps_t) e->streak += e->streak < INT8_MAX;
     else e->streak = 0;
     e->t_last = t;
@@ -206,8 +206,8 @@ static int do_pair(gr_edmd *s, int dim, int32_t i, int32_t j, double t, gr_error
     }
     double xi = s->cfg.restitution;
     if (s->cfg.contact_duration > 0.0 && xi < 1.0 &&
-        (t - s->ev[i].t_last < s->cfg.contact_duration ||
-         t - s->ev[j].t_last < s->cfg.contact_duration)) {
+        (t - s->sched[i].t_last < s->cfg.contact_duration ||
+         t - s->sched[j].t_last < s->cfg.contact_duration)) {
         xi = 1.0; /* TC model: within t_c of a previous collision, collide elastically */
         s->elastic_tc++;
     }
@@ -222,11 +222,11 @@ static int do_pair(gr_edmd *s, int dim, int32_t i, int32_t j, double t, gr_error
     s->kinetic += kinetic_of(s, dim, i) + kinetic_of(s, dim, j) - before;
     s->virial += vir;
     s->pair++;
-    s->ev[i].count++;
-    s->ev[j].count++;
+    s->sched[i].count++;
+    s->sched[j].count++;
     int collapse_i = streak(s, i, t), collapse_j = streak(s, j, t);
-    s->ev[i].last = j;
-    s->ev[j].last = i;
+    s->sched[i].last = j;
+    s->sched[j].last = i;
     if (collapse_i || collapse_j) {
         gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), uid(s, j), t, (double)GR_COLLAPSE_STREAK,
                      GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
@@ -247,7 +247,7 @@ static int do_wall(gr_edmd *s, int dim, int32_t i, int wall, double t, gr_error 
     move(dim, p, t);
     double before = kinetic_of(s, dim, i), vn = v[a];
     double ew = s->cfg.wall_restitution;
-    if (ew < 1.0 && s->cfg.contact_duration > 0.0 && t - s->ev[i].t_last < s->cfg.contact_duration)
+    if (ew < 1.0 && s->cfg.contact_duration > 0.0 && t - s->sched[i].t_last < s->cfg.contact_duration)
         ew = 1.0;
     v[a] = -v[a];
     if (ew != 1.0)
@@ -262,8 +262,8 @@ static int do_wall(gr_edmd *s, int dim, int32_t i, int wall, double t, gr_error 
     s->wall_impulse += s->mass[i] * (fabs(vn) + fabs(v[a]));
     s->kinetic += kinetic_of(s, dim, i) - before;
     s->wall++;
-    s->ev[i].count++;
-    s->ev[i].last = -2 - wall;
+    s->sched[i].count++;
+    s->sched[i].last = -2 - wall;
     if (streak(s, i, t)) {
         gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), -1, t, (double)GR_COLLAPSE_STREAK,
                      GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
@@ -282,7 +282,7 @@ static void schedule(gr_edmd *s, int32_t i);
 static void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 {
     double *p = rec(s, i);
-    gr_sched *e = &s->ev[i];
+    gr_sched *e = &s->sched[i];
     int32_t *c = e->c;
     const int a = e->cross >> 1, dir = (e->cross & 1) ? 1 : -1;
     move(dim, p, t);
@@ -315,15 +315,15 @@ static void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 static int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t, gr_error *err)
 {
     double *p = rec(s, i);
-    gr_sched *e = &s->ev[i];
+    gr_sched *e = &s->sched[i];
     move(dim, p, t);
     const int32_t *row = nl_row(&s->nl, i);
     /* the neighbours' list lengths and rows are misses: ask for all of them first */
     for (int k = 0; k < e->nn; k++) {
-        GR_PREFETCH(&s->ev[row[k] >> GR_NL_BITS]);
+        GR_PREFETCH(&s->sched[row[k] >> GR_NL_BITS]);
         GR_PREFETCH(nl_row(&s->nl, row[k] >> GR_NL_BITS));
     }
-    for (int k = 0; k < e->nn; k++) nl_unlink(&s->nl, s->ev, row[k] >> GR_NL_BITS, i);
+    for (int k = 0; k < e->nn; k++) nl_unlink(&s->nl, s->sched, row[k] >> GR_NL_BITS, i);
     e->nn = 0;
     if (s->cfg.periodic) {
         for (int a = 0; a < dim; a++) {
@@ -361,7 +361,7 @@ static void predict(gr_edmd *s, int dim, int32_t i)
     predict_wall(s, dim, i);
     if (s->nl.shell > 0.0) {
         const double *p = rec(s, i);
-        s->ev[i].t_cross = TIME(p, dim) + nl_exit_time(&s->nl, dim, p, VEL(p, dim),
+        s->sched[i].t_cross = TIME(p, dim) + nl_exit_time(&s->nl, dim, p, VEL(p, dim),
                                                        s->nl.centre + (size_t)i * (dim + 1));
         scan_list(s, dim, i);
     } else {
@@ -374,7 +374,7 @@ static void predict(gr_edmd *s, int dim, int32_t i)
 /* The queue key of i: the earlier of its collision and its crossing or shell exit. */
 static inline void schedule(gr_edmd *s, int32_t i)
 {
-    const gr_sched *e = &s->ev[i];
+    const gr_sched *e = &s->sched[i];
     gr_cq_update(&s->queue, i, e->t_coll < e->t_cross ? e->t_coll : e->t_cross);
 }
 
@@ -382,7 +382,7 @@ static inline void schedule(gr_edmd *s, int32_t i)
 static inline void predict_wall(gr_edmd *s, int dim, int32_t i)
 {
     const double *p = rec(s, i), *v = VEL(p, dim);
-    gr_sched *e = &s->ev[i];
+    gr_sched *e = &s->sched[i];
     e->t_coll = INFINITY;
     e->partner = -1;
     if (s->cfg.periodic) return;
@@ -412,7 +412,7 @@ static inline void predict_cross(gr_edmd *s, int dim, int32_t i)
      * next at random, and a mispredicted branch costs more than the arithmetic. */
     const gr_cells *g = &s->cells;
     const double *p = rec(s, i);
-    const int32_t *c = s->ev[i].c;
+    const int32_t *c = s->sched[i].c;
     double best = INFINITY;
     int32_t code = -1;
     for (int a = 0; a < dim; a++) {
@@ -428,8 +428,8 @@ static inline void predict_cross(gr_edmd *s, int dim, int32_t i)
         code += earlier * (2 * a + up - code); /* arithmetic: a select compiles to a branch */
         best = earlier ? dt : best;
     }
-    s->ev[i].t_cross = TIME(p, dim) + best;
-    s->ev[i].cross = (int8_t)code;
+    s->sched[i].t_cross = TIME(p, dim) + best;
+    s->sched[i].cross = (int8_t)code;
 }
 
 /* ---- the start ---- */

@@ -34,7 +34,7 @@ struct gr_edmd {
     double *P;            /* n * stride, 64-byte aligned */
     double *mass;
     int64_t *image;       /* n * dim periodic image counters */
-    gr_sched *ev;         /* n: each particle's scheduling state */
+    gr_sched *sched;      /* n: each particle's scheduling state */
     gr_cq queue;
     gr_cells cells;       /* with lists: the cells of the list centres */
     gr_big big;           /* none with lists */

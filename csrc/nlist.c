@@ -30,7 +30,7 @@ void gr_nlist_free(gr_nlist *nl)
     free(nl->near);
 }
 
-int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *ev)
+int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *sched)
 {
     const int32_t cap = 2 * nl->cap;
     int32_t *rows = cap > GR_NL_CAP_MAX ? NULL : gr_big_alloc((size_t)n * (size_t)cap * sizeof *rows);
@@ -40,7 +40,7 @@ int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *ev)
     }
     for (int32_t i = 0; i < n; i++)
         memcpy(rows + (size_t)i * cap, nl->rows + (size_t)i * nl->cap,
-               (size_t)ev[i].nn * sizeof *rows);
+               (size_t)sched[i].nn * sizeof *rows);
     free(nl->rows);
     nl->rows = rows;
     nl->cap = cap;

@@ -36,7 +36,7 @@ typedef struct {
     double shell;     /* delta, absolute; 0: no lists (cell-crossing mode) */
     double exit2;     /* squared distance from the centre that ends a list's life */
     double *centre;   /* n * (dim + 1): each list centre and the particle's radius */
-    int32_t *rows;    /* n * cap: i's neighbours from rows[i * cap] on, ev[i].nn of them */
+    int32_t *rows;    /* n * cap: i's neighbours from rows[i * cap] on, sched[i].nn of them */
     int32_t cap;
     int32_t *near;    /* n: room for a rebuild's new neighbours */
     int broken;       /* a list could not grow: lists are incomplete, no more events */
@@ -49,7 +49,7 @@ int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *
 void gr_nlist_free(gr_nlist *nl);
 /* Double the rows' capacity; on failure the lists are marked broken.  GR_OK or
  * GR_ERR_NOMEM. */
-int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *ev);
+int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *sched);
 
 static inline int32_t *nl_row(const gr_nlist *nl, int32_t i)
 {
@@ -58,28 +58,28 @@ static inline int32_t *nl_row(const gr_nlist *nl, int32_t i)
 
 /* List i and j as neighbours of each other, j seen from i through image `code`.
  * GR_OK or GR_ERR_NOMEM (a row could not grow). */
-static inline int nl_link(gr_nlist *nl, int dim, int32_t n, gr_sched *ev, int32_t i,
+static inline int nl_link(gr_nlist *nl, int dim, int32_t n, gr_sched *sched, int32_t i,
                           int32_t j, int32_t code)
 {
-    if (ev[i].nn == nl->cap || ev[j].nn == nl->cap) {
-        int status = gr_nlist_grow(nl, n, ev);
+    if (sched[i].nn == nl->cap || sched[j].nn == nl->cap) {
+        int status = gr_nlist_grow(nl, n, sched);
         if (status != GR_OK) return status;
     }
     const int32_t opposite = (dim == 3 ? 26 : 8) - code;
-    nl_row(nl, i)[ev[i].nn++] = (j << GR_NL_BITS) | code;
-    nl_row(nl, j)[ev[j].nn++] = (i << GR_NL_BITS) | opposite;
+    nl_row(nl, i)[sched[i].nn++] = (j << GR_NL_BITS) | code;
+    nl_row(nl, j)[sched[j].nn++] = (i << GR_NL_BITS) | opposite;
     return GR_OK;
 }
 
 /* Take i off j's list (order within a list does not matter). */
-static inline void nl_unlink(gr_nlist *nl, gr_sched *ev, int32_t j, int32_t i)
+static inline void nl_unlink(gr_nlist *nl, gr_sched *sched, int32_t j, int32_t i)
 {
     int32_t *row = nl_row(nl, j);
-    const int last = ev[j].nn - 1;
+    const int last = sched[j].nn - 1;
     for (int k = 0; k <= last; k++)
         if (row[k] >> GR_NL_BITS == i) {
             row[k] = row[last];
-            ev[j].nn--;
+            sched[j].nn--;
             return;
         }
 }

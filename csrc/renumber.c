@@ -33,7 +33,7 @@ int gr_renumber(gr_edmd *s)
         return GR_ERR_NOMEM;
     }
     for (int32_t i = 0; i < n; i++) {
-        const int32_t c = cell_of(g, d, s->ev[i].c);
+        const int32_t c = cell_of(g, d, s->sched[i].c);
         newpos[i] = c; /* the cell, for now */
         start[c + 1]++;
     }
@@ -60,7 +60,7 @@ int gr_renumber(gr_edmd *s)
         for (int32_t i = 0; i < n; i++) {
             const int32_t *from = nl_row(&s->nl, i);
             int32_t *to = rows + (size_t)newpos[i] * s->nl.cap;
-            for (int k = 0; k < s->ev[i].nn; k++) {
+            for (int k = 0; k < s->sched[i].nn; k++) {
                 const int32_t code = from[k] & GR_NL_CODE_MASK;
                 to[k] = (newpos[from[k] >> GR_NL_BITS] << GR_NL_BITS) | code;
             }
@@ -72,19 +72,19 @@ int gr_renumber(gr_edmd *s)
     {
         gr_sched *tmp = s->order.scratch;
         for (int32_t i = 0; i < n; i++) {
-            gr_sched e = s->ev[i];
+            gr_sched e = s->sched[i];
             if (e.partner >= 0) e.partner = newpos[e.partner];
             if (e.last >= 0) e.last = newpos[e.last];
             tmp[newpos[i]] = e;
         }
-        memcpy(s->ev, tmp, (size_t)n * sizeof *tmp);
+        memcpy(s->sched, tmp, (size_t)n * sizeof *tmp);
     }
     gr_cq_renumber(&s->queue, newpos);
     free(newpos);
     gr_cells_clear(g);
     for (int32_t i = n - 1; i >= 0; i--) { /* lists in increasing index order */
         if (s->big.is_big[i]) continue;
-        cell_insert(g, i, cell_of(g, d, s->ev[i].c));
+        cell_insert(g, i, cell_of(g, d, s->sched[i].c));
     }
     s->order.next = s->events + (int64_t)GR_RENUMBER_EVENTS_PER_N * n;
     return GR_OK;

@@ -17,8 +17,8 @@
  * approach left is rounding, e.g. after xi = 0. */
 static inline int rebound_now(const gr_edmd *s, int32_t i, int32_t j, double t, double dt)
 {
-    return dt == 0.0 && s->ev[i].last == j && s->ev[j].last == i && s->ev[i].t_last == t &&
-           s->ev[j].t_last == t;
+    return dt == 0.0 && s->sched[i].last == j && s->sched[j].last == i && s->sched[i].t_last == t &&
+           s->sched[j].t_last == t;
 }
 
 /* One candidate j (not i) for i's next pair collision (record p): j seen through an
@@ -43,17 +43,17 @@ static GR_ALWAYS_INLINE void try_pair(const gr_edmd *s, int dim, int32_t i, cons
     if (rebound_now(s, i, j, TIME(p, dim), dt)) return;
     *best = dt;
     *partner = j;
-    GR_PREFETCH(&s->ev[j]); /* its collision count is read when the scan ends */
+    GR_PREFETCH(&s->sched[j]); /* its collision count is read when the scan ends */
 }
 
 /* The earliest pair collision of i found by a scan, if it beats i's prediction. */
 static inline void keep_pair(gr_edmd *s, int dim, int32_t i, double best, int32_t partner)
 {
     if (partner < 0) return;
-    gr_sched *e = &s->ev[i];
+    gr_sched *e = &s->sched[i];
     e->t_coll = TIME(rec(s, i), dim) + best;
     e->partner = partner;
-    e->pcount = s->ev[partner].count;
+    e->pcount = s->sched[partner].count;
 }
 
 /* Pair collisions of i with the particles of one cell, seen through an image shift. */
@@ -82,8 +82,8 @@ static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
 {
     const gr_cells *g = &s->cells;
     const double *p = rec(s, i);
-    const int32_t *c = s->ev[i].c;
-    gr_sched *e = &s->ev[i];
+    const int32_t *c = s->sched[i].c;
+    gr_sched *e = &s->sched[i];
     double best = e->t_coll - TIME(p, dim);
     int32_t partner = -1;
     if (s->big.n && s->big.is_big[i]) {
@@ -125,7 +125,7 @@ static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, 
 {
     const gr_cells *g = &s->cells;
     const double *p = rec(s, i);
-    const int32_t *c = s->ev[i].c;
+    const int32_t *c = s->sched[i].c;
     int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int a = 0; a < dim; a++) {
         int32_t reach = (int32_t)ceil((RAD(p, dim) + s->big.r_small) / g->w[a]);
@@ -160,7 +160,7 @@ static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, 
 static void scan_list(gr_edmd *s, int dim, int32_t i)
 {
     const double *p = rec(s, i);
-    gr_sched *e = &s->ev[i];
+    gr_sched *e = &s->sched[i];
     const int32_t *row = nl_row(&s->nl, i);
     double best = (e->t_coll < e->t_cross ? e->t_coll : e->t_cross) - TIME(p, dim);
     int32_t partner = -1;
@@ -177,7 +177,7 @@ static inline void set_centre(gr_edmd *s, int dim, int32_t i)
     double *centre = s->nl.centre + (size_t)i * (dim + 1);
     centre[dim] = RAD(p, dim);
     for (int a = 0; a < dim; a++) centre[a] = p[a];
-    cell_coords(&s->cells, dim, p, s->ev[i].c);
+    cell_coords(&s->cells, dim, p, s->sched[i].c);
 }
 
 /* List mode: list i and every particle whose centre is within r_i + r_j + 2 delta of
@@ -188,7 +188,7 @@ static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
     const double *ci = s->nl.centre + (size_t)i * (dim + 1);
     const double reach = ci[dim] + 2.0 * s->nl.shell;
     gr_nbr nb[27];
-    const int count = cell_neighbours(g, dim, s->ev[i].c, -1, 0, nb);
+    const int count = cell_neighbours(g, dim, s->sched[i].c, -1, 0, nb);
     /* first the new neighbours, kept or not without a branch (about one candidate in
      * six is kept: as good as random) */
     int32_t m = 0, *near = s->nl.near;
@@ -209,7 +209,7 @@ static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
         }
     }
     for (int32_t k = 0; k < m; k++) {
-        int status = nl_link(&s->nl, dim, s->n, s->ev, i, near[k] >> GR_NL_BITS,
+        int status = nl_link(&s->nl, dim, s->n, s->sched, i, near[k] >> GR_NL_BITS,
                              near[k] & GR_NL_CODE_MASK);
         if (status != GR_OK) {
             gr_error_set(err, status, uid(s, i), -1, s->t, (double)s->nl.cap,
