@@ -10,6 +10,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "big.h"
 #include "common.h"
 #include "edmd.h"
 #include "rng.h"
@@ -148,22 +149,22 @@ static void EDMD_dealloc(EDMDObject *self)
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-static int EDMD_init(EDMDObject *self, PyObject *args, PyObject *kw)
+/* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
+ * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
+ * exception set. */
+static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_out,
+                          npy_intp *n_out)
 {
     static char *names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                             "periodic", "wall_restitution", "restitution",
                             "contact_duration", "cell_factor", "big_ratio", "shell", NULL};
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi;
     int periodic;
-    double wall_e, xi, tc, cell_factor, big_ratio = 3.0, shell = 0.0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpdddd|dd", names, &opos, &ovel, &orad,
+    double wall_e, xi, tc, cell_factor = 1.0, big_ratio = GR_BIG_RATIO, shell = 0.0;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpddd|ddd", names, &opos, &ovel, &orad,
                                      &omass, &olo, &ohi, &periodic, &wall_e, &xi, &tc,
                                      &cell_factor, &big_ratio, &shell))
         return -1;
-    if (self->sim) {
-        PyErr_SetString(PyExc_RuntimeError, "EDMD is already initialised");
-        return -1;
-    }
     npy_intp any2[2] = {-1, -1};
     PyArrayObject *pos = as_f64(opos, "positions", 2, any2);
     if (!pos) return -1;
@@ -198,15 +199,19 @@ static int EDMD_init(EDMDObject *self, PyObject *args, PyObject *kw)
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
     int status;
     Py_BEGIN_ALLOW_THREADS
-    status = gr_edmd_new(&self->sim, &cfg, PyArray_DATA(pos), PyArray_DATA(vel),
-                         PyArray_DATA(rad), PyArray_DATA(mass), &err);
+    if (sim)
+        status = gr_edmd_new(sim, &cfg, PyArray_DATA(pos), PyArray_DATA(vel),
+                             PyArray_DATA(rad), PyArray_DATA(mass), &err);
+    else
+        status = gr_edmd_check(&cfg, PyArray_DATA(pos), PyArray_DATA(vel), PyArray_DATA(rad),
+                               PyArray_DATA(mass), &err);
     Py_END_ALLOW_THREADS
     if (status != GR_OK) {
         raise_status(status, &err);
         goto done;
     }
-    self->dim = (int)d;
-    self->n = n;
+    if (dim_out) *dim_out = (int)d;
+    if (n_out) *n_out = n;
     ok = 1;
 done:
     Py_XDECREF(pos);
@@ -216,6 +221,84 @@ done:
     Py_XDECREF(lo);
     Py_XDECREF(hi);
     return ok ? 0 : -1;
+}
+
+static int EDMD_init(EDMDObject *self, PyObject *args, PyObject *kw)
+{
+    if (self->sim) {
+        PyErr_SetString(PyExc_RuntimeError, "EDMD is already initialised");
+        return -1;
+    }
+    return edmd_from_args(args, kw, &self->sim, &self->dim, &self->n);
+}
+
+static PyObject *edmd_check(PyObject *mod, PyObject *args, PyObject *kw)
+{
+    if (edmd_from_args(args, kw, NULL, NULL, NULL) < 0) return NULL;
+    Py_RETURN_NONE;
+}
+
+/* big_cut(radii, big_ratio): the engine's cut, big_ratio times the upper median radius. */
+static PyObject *big_cut(PyObject *mod, PyObject *args)
+{
+    PyObject *orad;
+    double ratio;
+    if (!PyArg_ParseTuple(args, "Od", &orad, &ratio)) return NULL;
+    npy_intp any1[1] = {-1};
+    PyArrayObject *rad = as_f64(orad, "radii", 1, any1);
+    if (!rad) return NULL;
+    const npy_intp n = PyArray_DIM(rad, 0);
+    double cut = NAN;
+    int status = n < 1 || n > INT32_MAX ? GR_ERR_VALUE
+                                        : gr_big_cut(PyArray_DATA(rad), (int32_t)n, ratio, &cut);
+    Py_DECREF(rad);
+    if (status == GR_ERR_NOMEM) return PyErr_NoMemory();
+    if (status != GR_OK) {
+        PyErr_SetString(PyExc_ValueError, "radii must hold between 1 and 2^31 - 1 entries");
+        return NULL;
+    }
+    return PyFloat_FromDouble(cut);
+}
+
+/* big_particles(radii, lengths, big_ratio, cell_factor): which particles the engine's
+ * cell grid keeps out (bool array), by the one rule in big.c. */
+static PyObject *big_particles(PyObject *mod, PyObject *args)
+{
+    PyObject *orad, *olen;
+    double ratio, cell_factor;
+    if (!PyArg_ParseTuple(args, "OOdd", &orad, &olen, &ratio, &cell_factor)) return NULL;
+    npy_intp any1[1] = {-1};
+    PyArrayObject *rad = as_f64(orad, "radii", 1, any1), *len = NULL;
+    PyObject *out = NULL;
+    if (!rad) return NULL;
+    const npy_intp n = PyArray_DIM(rad, 0);
+    if (!(len = as_f64(olen, "lengths", 1, any1))) goto done;
+    const npy_intp d = PyArray_DIM(len, 0);
+    if ((d != 2 && d != 3) || n < 1 || n > INT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "lengths must have 2 or 3 entries and radii at least one");
+        goto done;
+    }
+    out = PyArray_ZEROS(1, &n, NPY_BOOL, 0);
+    if (!out) goto done;
+    double L[3] = {1.0, 1.0, 1.0};
+    for (int a = 0; a < d; a++) L[a] = ((double *)PyArray_DATA(len))[a];
+    gr_big b = {0};
+    b.is_big = PyArray_DATA((PyArrayObject *)out); /* npy_bool is one byte, like uint8_t */
+    if (gr_big_choose(&b, (int)d, (int32_t)n, PyArray_DATA(rad), L, ratio, cell_factor) != GR_OK) {
+        Py_CLEAR(out);
+        PyErr_NoMemory();
+    }
+done:
+    Py_DECREF(rad);
+    Py_XDECREF(len);
+    return out;
+}
+
+static PyObject *edmd_bytes_per_particle(PyObject *mod, PyObject *args)
+{
+    int dim, lists;
+    if (!PyArg_ParseTuple(args, "ip", &dim, &lists)) return NULL;
+    return PyLong_FromSize_t(gr_edmd_bytes_per_particle(dim, lists));
 }
 
 static int check_ready(EDMDObject *self)
@@ -338,10 +421,11 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     if (!check_ready(self)) return NULL;
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
-    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d}", "time", c.t,
+    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d}", "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
-                         (long long)c.crossings, "stale_events", (long long)c.invalid,
+                         (long long)c.crossings, "shell_exits", (long long)c.shell_exits,
+                         "stale_events", (long long)c.invalid,
                          "tc_elastic_collisions", (long long)c.elastic_tc, "virial", c.virial,
                          "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic,
                          "kinetic_time_integral", c.kinetic_time, "cells",
@@ -548,6 +632,15 @@ static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *arg)
 /* ------------------------------------------------------------------------------------ */
 
 static PyMethodDef core_methods[] = {
+    /* the event-driven engine's rules, owned by the C core */
+    {"edmd_check", (PyCFunction)(void (*)(void))edmd_check, METH_VARARGS | METH_KEYWORDS,
+     "edmd_check(same arguments as EDMD): the checks of EDMD() without building it"},
+    {"big_cut", big_cut, METH_VARARGS,
+     "big_cut(radii, big_ratio): particles wider than this are big"},
+    {"big_particles", big_particles, METH_VARARGS,
+     "big_particles(radii, lengths, big_ratio, cell_factor): which the cell grid keeps out"},
+    {"edmd_bytes_per_particle", edmd_bytes_per_particle, METH_VARARGS,
+     "edmd_bytes_per_particle(dim, lists): what the engine allocates per particle"},
     /* ==== SDE methods begin ==== */
     {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
      "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
@@ -585,6 +678,14 @@ PyMODINIT_FUNC PyInit__core(void)
     PyModule_AddIntConstant(m, "STOP_COLLISIONS", GR_STOP_COLLISIONS);
     PyModule_AddIntConstant(m, "STOP_ENERGY", GR_STOP_ENERGY);
     PyModule_AddIntConstant(m, "STOP_IDLE", GR_STOP_IDLE);
+    PyModule_AddIntConstant(m, "BIG_MAX", GR_BIG_MAX);
+    PyObject *big_ratio = PyFloat_FromDouble(GR_BIG_RATIO);
+    if (!big_ratio || PyModule_AddObjectRef(m, "BIG_RATIO", big_ratio) < 0) {
+        Py_XDECREF(big_ratio);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_DECREF(big_ratio);
     /* ==== SDE constants ==== */
     PyObject *max_steps = PyLong_FromLongLong(GR_SDE_MAX_STEPS);
     if (!max_steps || PyModule_AddObjectRef(m, "SDE_MAX_STEPS", max_steps) < 0) {

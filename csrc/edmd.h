@@ -8,10 +8,18 @@
  * allocates output for the caller, prints or exits.
  *
  * Status codes (common.h): GR_OK or a GR_STOP_* reason (positive) on success, GR_ERR_*
- * (negative) on failure, with a gr_error filled in. */
+ * (negative) on failure, with a gr_error filled in.
+ *
+ * The engine's files: edmd.c the event loop, the events and the predictions (read it
+ * first), search.h their pair searches; engine.h the system's struct; schedstate.h a particle's scheduling state;
+ * cells.c/.h the cell grid; nlist.c/.h the neighbour lists; big.c/.h big particles;
+ * calendar.c/.h the queue; collide.h two-body geometry; build.c construction;
+ * validate.c the checks of a configuration; renumber.c renumbering in cell order;
+ * sample.c samples, state and counters. */
 #ifndef GR_EDMD_H
 #define GR_EDMD_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "common.h"
@@ -36,10 +44,10 @@ typedef struct {
     double cell_factor;       /* cell width / largest diameter in the grid, >= 1 (speed knob) */
     double big_ratio;         /* particles more than this times the median diameter wide
                                * (at most GR_BIG_MAX of them) stay out of the cell grid
-                               * (>= 1; +inf: none) -- a speed knob, see edmd.c */
+                               * (>= 1; +inf: none) -- a speed knob, see big.h */
     double shell;             /* > 0: neighbour lists with a shell this many largest
                                * diameters thick (no big particles then); 0: cell
-                               * crossings -- a speed knob, see edmd.c */
+                               * crossings -- a speed knob, see nlist.h */
 } gr_edmd_config;
 
 typedef struct {
@@ -68,10 +76,11 @@ typedef struct {
 
 typedef struct {
     double t;               /* current time of the system */
-    int64_t events;         /* all events processed, cell crossings included */
+    int64_t events;         /* all events processed, crossings and exits included */
     int64_t pair;           /* pair collisions */
     int64_t wall;           /* wall collisions */
-    int64_t crossings;      /* cell crossings, or neighbour-list rebuilds with lists */
+    int64_t crossings;      /* cell crossings (none with neighbour lists) */
+    int64_t shell_exits;    /* neighbour lists: shell exits, each rebuilding one list */
     int64_t invalid;        /* events found stale on pop (partner collided since) */
     int64_t elastic_tc;     /* pair collisions made elastic by the TC model */
     double virial;          /* sum over pair collisions of r_ij . dp_j */
@@ -92,6 +101,15 @@ typedef struct gr_edmd gr_edmd;
 int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
                 const double *vel, const double *radius, const double *mass, gr_error *err);
 void gr_edmd_free(gr_edmd *s);
+
+/* The checks of gr_edmd_new without building a system: arguments, finiteness, the box,
+ * overlaps (through a cell grid, O(N)).  Same status codes. */
+int gr_edmd_check(const gr_edmd_config *cfg, const double *pos, const double *vel,
+                  const double *radius, const double *mass, gr_error *err);
+
+/* What the engine allocates per particle, in bytes, with and without neighbour lists
+ * (at the lists' starting capacity), for estimates of memory before a run. */
+size_t gr_edmd_bytes_per_particle(int dim, int lists);
 
 /* Process events.  Returns a GR_STOP_* reason, or GR_ERR_COLLAPSE / GR_ERR_NONFINITE
  * (the state stays consistent and inspectable after an error), or GR_ERR_NOMEM (a

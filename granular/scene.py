@@ -3,9 +3,10 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 
 import numpy as np
+
+from . import _core, _edmd
 
 BOUNDARIES = ("periodic", "walls")
 
@@ -23,17 +24,11 @@ _FREEZING = {2: 0.70, 3: 0.494}
 # lattice, the mean of S(G) over the stars in a fluid: about 1 (S <= 2.85 below freezing,
 # Hansen-Verlet); 3 leaves residual order well below what tests/test_scene.py detects.
 _MELTED_ORDER = 3.0
-# Up to _BIG_MAX particles wider than BIG_RATIO times the median diameter (a tracer) are
-# kept out of neighbour searches sized for the others: in the engine's cell grid
-# (Simulation's big_ratio; csrc/edmd.c, GR_BIG_MAX) and in random placement.  The two
-# may differ at the margin (the engine takes the upper median and also needs a grid fine
-# enough for a big particle's block): the rule decides how a search is done, not what it
-# finds.
-BIG_RATIO = 3.0
-_BIG_MAX = 16
-# What the engine holds per particle (record, event, queue entry, cell links, counters,
-# image counters, reorder scratch, cells and buckets), rounded up from edmd.c/calendar.c.
-_ENGINE_BYTES_PER_PARTICLE = 400
+# Up to _core.BIG_MAX particles wider than BIG_RATIO times the median diameter (a tracer)
+# are kept out of neighbour searches sized for the others: in the engine's cell grid
+# (Simulation's big_ratio) and in random placement.  The rule and its default belong to
+# the engine (csrc/big.c); both ask it through _core.
+BIG_RATIO = _core.BIG_RATIO
 
 
 # float64 holds magnitudes from 2.2e-308 to 1.8e308.  The collision arithmetic
@@ -43,7 +38,7 @@ _ENGINE_BYTES_PER_PARTICLE = 400
 # for sums over particles and for a gas that cools or heats by many orders.
 _SCALE_LO, _SCALE_HI = 1e-140, 1e140
 # Coordinates must resolve a diameter far more finely than the engine's overlap
-# tolerance (a relative 1e-10 of the contact distance, csrc/edmd_dim.h): at most this
+# tolerance (a relative 1e-10 of the contact distance, csrc/validate.c): at most this
 # fraction of the smallest diameter per float64 step at the box's farthest corner.
 _RESOLUTION = 1e-11
 
@@ -97,19 +92,6 @@ def frozen_energy(radii, masses):
     each other (speeds estimated with the largest mass, to be safe)."""
     speed = _SCALE_LO / (2.0 * float(np.min(radii)))
     return 0.5 * len(radii) * float(np.max(masses)) * speed * speed
-
-
-def _check_memory(need, what):
-    """Refuse, before allocating, anything that would take more than half of this
-    machine's memory (on Linux an allocation that large may 'succeed' and end in the
-    out-of-memory killer instead of an exception)."""
-    try:
-        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return
-    if need > 0.5 * total:
-        raise MemoryError(f"{what} needs {need / 2**30:.1f} GiB, more than half of this "
-                          f"machine's {total / 2**30:.1f} GiB")
 
 
 def _box_corners(box, dim):
@@ -217,10 +199,11 @@ class Scene:
         self.contact_duration = float(contact_duration)
         if not (self.contact_duration >= 0 and math.isfinite(self.contact_duration)):
             raise ValueError(f"contact_duration must be finite and >= 0, got {contact_duration}")
-        # The engine's constructor checks the geometry (inside the box, overlaps, a
-        # periodic box wide enough) in O(N) through its cell grid.
-        _check_memory(_ENGINE_BYTES_PER_PARTICLE * n, "the event-driven engine's state")
-        self._engine()
+        # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
+        # the engine's own rules in O(N) through a cell grid, without building an engine.
+        _core.edmd_check(self.positions, self.velocities, self.radii, self.masses,
+                         self.lower, self.upper, self.boundary == "periodic",
+                         self.wall_restitution, self.restitution, self.contact_duration)
 
     # -- derived quantities ---------------------------------------------------------
     @property
@@ -284,14 +267,6 @@ class Scene:
         return (f"Scene(n={self.n}, dim={self.dim}, boundary={self.boundary!r}, "
                 f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
                 f"temperature={self.temperature:.4g})")
-
-    def _engine(self, cell_factor=1.0, big_ratio=BIG_RATIO, shell=0.0):
-        from . import _core
-
-        return _core.EDMD(self.positions, self.velocities, self.radii, self.masses,
-                          self.lower, self.upper, self.boundary == "periodic",
-                          self.wall_restitution, self.restitution, self.contact_duration,
-                          float(cell_factor), float(big_ratio), float(shell))
 
     # -- constructors ---------------------------------------------------------------
     @classmethod
@@ -359,21 +334,20 @@ class Scene:
         positions, G = _place_lattice(rng_pos, radii, lo, hi, periodic)
         # Melt the lattice: elastic collisions with thermal velocities until no lattice
         # order is left, then keep the positions and give the scene the velocities asked for.
-        from .simulation import Simulation
-
         melt_v = _draw_velocities(rng_melt, n, dim, masses, None, 1.0, n > 1)
         hot = cls(positions, melt_v, radii, masses, box=(lo, hi), boundary=boundary)
-        sim = Simulation(hot)
+        engine = _edmd.build(hot)  # as Simulation(hot) would
         melt = _LATTICE_MELT_COLLISIONS
         while True:
-            sim.run(stop_when={"collisions_per_particle": melt}, store=())
+            _edmd.run_collisions(engine, melt)
             if eta >= _FREEZING[dim] or melt >= _LATTICE_MELT_MAX or n < 50:
                 break
             # unwrapped positions: G is a reciprocal vector of the periodic box too
-            if _lattice_order(sim.unwrapped_positions, G) < _MELTED_ORDER:
+            wrapped, _, image = engine.state()
+            if _lattice_order(wrapped + image * hot.lengths, G) < _MELTED_ORDER:
                 break
             melt += _LATTICE_MELT_COLLISIONS
-        return cls(sim.scene.positions, velocities, radii, masses, **common)
+        return cls(engine.state()[0], velocities, radii, masses, **common)
 
     @classmethod
     def seed_brownian_disks(cls, seed=None):
@@ -421,9 +395,7 @@ def _place_rsa(rng, radii, lo, hi, periodic, patience=100, max_rounds=5000):
 
     n, dim = len(radii), len(lo)
     L = hi - lo
-    is_big = radii > BIG_RATIO * np.median(radii)
-    if is_big.sum() > _BIG_MAX:
-        is_big[:] = False
+    is_big = _core.big_particles(radii, L, BIG_RATIO, 1.0)
     r_small = float(radii[~is_big].max())
     order = np.argsort(-radii, kind="stable")  # big ones first: they are the hard ones
     placed = np.empty((0, dim))

@@ -6,28 +6,17 @@ import threading
 
 import numpy as np
 
-from . import _core
+from . import _core, _edmd
 from .errors import (FrozenGasError, GranularError, HeatedWallsError, InelasticCollapseError,
                      NoProgressError)
-from .scene import _ENGINE_BYTES_PER_PARTICLE, BIG_RATIO, Scene, _check_memory, frozen_energy
+from ._edmd import check_memory as _check_memory
+from .scene import BIG_RATIO, Scene, frozen_energy
 from .trajectory import Trajectory, _pressure_volume
 
 _STOP_KEYS = ("collisions_per_particle", "kinetic_energy", "events")
-# Events per call into C: about 0.1 s of work, so Ctrl-C and the progress bar respond
-# promptly while the Python overhead stays negligible.
-_CHUNK = 200_000
+_CHUNK = _edmd.CHUNK
 _STORE = ("positions", "velocities")
-# shell="auto": neighbour lists with this shell (in largest diameters) for dense 3D
-# scenes.  Measured (pair collisions/s, N = 1e4, melted Scene.random, cells vs lists
-# with shell 0.25, two runs each): packing 0.30 0.67-0.69 vs 0.47-0.50 M; 0.35 0.46-0.67
-# vs 0.53-0.54 M; 0.40 0.54-0.60 vs 0.60-0.64 M; 0.45 0.44-0.50 vs 0.68-0.73 M; shells
-# 0.15 / 0.35 were slower than 0.25 at 0.45 and 0.5.  At N = 2048 lists win from 0.3 on
-# (speed_accuracy.dense_cost).  2D at area fractions 0.6 and 0.68: within 5 % either way,
-# so cells.
-_LIST_SHELL = 0.25
-_LIST_MIN_PACKING = 0.4
-# Lists add per particle: a row of 32 entries, its copy while reordering, the centre.
-_LIST_BYTES_PER_PARTICLE = 300
+_LIST_SHELL = _edmd.LIST_SHELL  # see _edmd
 
 
 class Simulation:
@@ -61,23 +50,7 @@ class Simulation:
         if not isinstance(scene, Scene):
             raise TypeError(f"Simulation needs a granular.Scene, got {type(scene).__name__}")
         self._initial = scene
-        big = np.max(scene.radii) > big_ratio * np.median(scene.radii)
-        if isinstance(shell, str) and shell == "auto":
-            dense = scene.dim == 3 and scene.packing_fraction >= _LIST_MIN_PACKING
-            shell = _LIST_SHELL if dense and not big else 0.0
-        elif isinstance(shell, (bool, str)) or not isinstance(shell, (int, float, np.number)):
-            raise TypeError(f"shell must be 'auto' or a number >= 0, got {shell!r}")
-        elif shell > 0 and big:
-            # the shell is a fraction of the largest diameter: every small particle's
-            # list would reach as far as the big one's (thousands of entries each)
-            raise ValueError(
-                f"neighbour lists (shell = {shell}) with particles wider than big_ratio = "
-                f"{big_ratio} times the median: every list would reach as far as the widest; "
-                "use shell=0 (cells keep the big ones out) or big_ratio=math.inf to insist")
-        if shell > 0:
-            _check_memory((_ENGINE_BYTES_PER_PARTICLE + _LIST_BYTES_PER_PARTICLE) * scene.n,
-                          "the event-driven engine's state with neighbour lists")
-        self._engine = scene._engine(cell_factor, big_ratio, shell)
+        self._engine = _edmd.build(scene, cell_factor, big_ratio, shell)
         # held for a whole run: the engine's own busy flag covers one C call only, and two
         # interleaved runs would write each other's samples
         self._running = threading.Lock()
@@ -100,7 +73,8 @@ class Simulation:
     @property
     def stats(self):
         """Counters since the start: events, pair_collisions, wall_collisions,
-        cell_crossings (neighbour-list rebuilds with lists), stale_events,
+        cell_crossings (cell mode), shell_exits (neighbour lists: each rebuilds one
+        list), stale_events,
         tc_elastic_collisions, virial, wall_impulse, kinetic_energy,
         kinetic_time_integral, time, cells, shell (0: cells); and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)

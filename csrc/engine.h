@@ -1,0 +1,129 @@
+/* engine.h -- the inside of a gr_edmd, shared by the engine's C files (not by the
+ * binding, which sees edmd.h only).
+ *
+ * A particle record is P[i*stride ...] = x[dim] v[dim] t r: position at the particle's
+ * own time t, velocity, radius.  Times are absolute.  Functions take the dimension as
+ * an argument `dim`; the event loop (edmd.c) is compiled once for dim = 2 and once for
+ * dim = 3 (advance_2d, advance_3d), and the helpers it calls are inlined or cloned by
+ * the compiler with that constant, so a 2D scene never pays for a third dimension. */
+#ifndef GR_ENGINE_H
+#define GR_ENGINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "big.h"
+#include "calendar.h"
+#include "cells.h"
+#include "edmd.h"
+#include "nlist.h"
+#include "schedstate.h"
+
+/* renumbering: see renumber.c */
+typedef struct {
+    int32_t *id_of;       /* the caller's index of each internal particle */
+    void *scratch;        /* room for n records or n scheduling states, NULL: never */
+    int64_t next;         /* renumber when the event count reaches this */
+} gr_renumbering;
+
+struct gr_edmd {
+    gr_edmd_config cfg;
+    int dim, stride;      /* stride = doubles per particle record: x[dim] v[dim] t r */
+    int32_t n;
+    double L[3];
+    double *P;            /* n * stride, 64-byte aligned */
+    double *mass;
+    int64_t *image;       /* n * dim periodic image counters */
+    gr_sched *sched;      /* n: each particle's scheduling state */
+    gr_cq queue;
+    gr_cells cells;       /* with lists: the cells of the list centres */
+    gr_big big;           /* none with lists */
+    gr_nlist nl;          /* nl.shell == 0: cell-crossing mode */
+    gr_renumbering order;
+
+    /* time and counters */
+    double t, eps_t;
+    double t_prev_event;
+    int64_t same_instant;
+    int64_t events, pair, wall, invalid, elastic_tc;
+    int64_t crossings;    /* cell crossings */
+    int64_t shell_exits;  /* list mode: shell exits, each rebuilding one list */
+    double virial, wall_impulse, kinetic;
+    double kinetic_time;  /* integral of the total kinetic energy over time, for the pressure */
+};
+
+/* Consecutive collisions of one particle, each within eps_t of the previous, that are
+ * taken as inelastic collapse.  A gas never comes near this by chance (each such
+ * collision has a probability of order 1e-9).  A fast collapse completes in floating
+ * point within few collisions: three disks in a line with xi = 0.05 (< 7 - 4 sqrt 3)
+ * make 46 collisions, of which only 16 to 19 in a row fall within eps_t, so the
+ * threshold must stay well below that. */
+#define GR_COLLAPSE_STREAK 10
+#define GR_STR(x) #x
+#define GR_XSTR(x) GR_STR(x)
+
+/* Prefetching: at large N the particle an event touches is a cache miss in every
+ * per-particle array; asking for them one event ahead (and for a pair's partner before
+ * the first of them is used) overlaps those misses with useful work.  A hint only:
+ * compilers without the builtin lose speed, not correctness.  GR_ALWAYS_INLINE for the
+ * few helpers whose inlined copies must each see constant arguments. */
+#if defined(__GNUC__) || defined(__clang__)
+#define GR_PREFETCH(p) __builtin_prefetch(p)
+#define GR_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define GR_PREFETCH(p) ((void)(p))
+#define GR_ALWAYS_INLINE inline
+#endif
+
+/* the parts of record p, for dimension dim */
+#define VEL(p, dim) ((p) + (dim))
+#define TIME(p, dim) ((p)[2 * (dim)])
+#define RAD(p, dim) ((p)[2 * (dim) + 1])
+
+static inline double *rec(const gr_edmd *s, int32_t i) { return s->P + (size_t)i * s->stride; }
+
+/* The caller's index of internal particle i (negative codes pass through). */
+static inline int64_t uid(const gr_edmd *s, int32_t i) { return i < 0 ? -1 : s->order.id_of[i]; }
+
+/* The separation d along an axis of periodic length L seen through the nearest image
+ * (|d| < 3L/2, as between particles in the box). */
+static inline double nearest_image(double d, double L)
+{
+    return d > 0.5 * L ? d - L : d < -0.5 * L ? d + L : d;
+}
+
+/* Move record p along its straight line to time t. */
+static inline void move(int dim, double *p, double t)
+{
+    double dt = t - TIME(p, dim);
+    for (int a = 0; a < dim; a++) p[a] += VEL(p, dim)[a] * dt;
+    TIME(p, dim) = t;
+}
+
+/* Validation of a configuration (validate.c): arguments, radii, masses, finiteness, the
+ * box and who lies outside it.  GR_OK or an error with err filled. */
+int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const double *vel,
+                       const double *radius, const double *mass, gr_error *err);
+/* The first overlap among n particles (positions pos[i * pstride ...], radii
+ * radius[i * rstride]) in a box of sides L: big ones against everyone, the others
+ * through grid g, whose lists must hold every particle that is not big.  GR_OK or
+ * GR_ERR_OVERLAP with err filled. */
+int gr_find_overlap(int dim, int32_t n, const double *pos, size_t pstride,
+                    const double *radius, size_t rstride, int periodic, const double *L,
+                    const gr_cells *g, const gr_big *b, gr_error *err);
+
+/* Renumber the particles in the order of their cells (renumber.c).  GR_OK or
+ * GR_ERR_NOMEM (nothing changed then). */
+int gr_renumber(gr_edmd *s);
+/* Large systems renumber every GR_RENUMBER_EVENTS_PER_N * N events; small ones (below
+ * GR_RENUMBER_MIN_N) fit in the cache anyway and never do. */
+#define GR_RENUMBER_MIN_N 4096
+#define GR_RENUMBER_EVENTS_PER_N 16
+
+/* Write sample smp->next, the state at time ts, and advance smp->next (sample.c). */
+void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts);
+
+/* The first predictions of every particle (edmd.c); lists and cells must be built. */
+int gr_predict_all(gr_edmd *s, gr_error *err);
+
+#endif

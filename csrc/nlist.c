@@ -1,0 +1,48 @@
+/* nlist.c -- allocation and growth of the neighbour lists (nlist.h). */
+#define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
+#define _POSIX_C_SOURCE 200112L /* posix_memalign */
+#include <stdlib.h>
+#include <string.h>
+
+#include "hugemem.h"
+#include "nlist.h"
+
+int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *L)
+{
+    nl->shell = shell;
+    /* leave a hair early: two particles each within delta (1 - 1e-9) of centres more
+     * than sigma + 2 delta apart stay apart by more than rounding */
+    nl->exit2 = shell * (1.0 - 1e-9) * shell * (1.0 - 1e-9);
+    nl->cap = dim == 3 ? 32 : 16;
+    nl->centre = gr_big_alloc((size_t)n * (dim + 1) * sizeof *nl->centre);
+    nl->rows = gr_big_alloc((size_t)n * nl->cap * sizeof *nl->rows);
+    nl->near = malloc((size_t)n * sizeof *nl->near);
+    for (int code = 0; code < 32; code++)
+        for (int a = 0, k = code; a < 3; a++, k /= 3)
+            nl->img[code][a] = a < dim ? (double)(k % 3 - 1) * L[a] : 0.0;
+    return nl->centre && nl->rows && nl->near ? GR_OK : GR_ERR_NOMEM;
+}
+
+void gr_nlist_free(gr_nlist *nl)
+{
+    free(nl->centre);
+    free(nl->rows);
+    free(nl->near);
+}
+
+int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *sched)
+{
+    const int32_t cap = 2 * nl->cap;
+    int32_t *rows = cap > GR_NL_CAP_MAX ? NULL : gr_big_alloc((size_t)n * (size_t)cap * sizeof *rows);
+    if (!rows) {
+        nl->broken = 1;
+        return GR_ERR_NOMEM;
+    }
+    for (int32_t i = 0; i < n; i++)
+        memcpy(rows + (size_t)i * cap, nl->rows + (size_t)i * nl->cap,
+               (size_t)sched[i].nn * sizeof *rows);
+    free(nl->rows);
+    nl->rows = rows;
+    nl->cap = cap;
+    return GR_OK;
+}

@@ -1,0 +1,224 @@
+/* search.h -- the pair searches of the event loop: who could i hit next, among the
+ * adjacent cells (scan_cells), a big particle's block (scan_block) or a neighbour list
+ * (scan_list); and building a neighbour list (link_near).
+ *
+ * Static functions included by edmd.c only: in the loop's translation unit the compiler
+ * inlines them, or clones them for dim = 2 and dim = 3, as it does the loop's own. */
+#ifndef GR_SEARCH_H
+#define GR_SEARCH_H
+
+#include <math.h>
+
+#include "collide.h"
+#include "engine.h"
+
+/* A pair that collided with each other at this very instant cannot approach again in
+ * exact arithmetic (the normal relative velocity became -xi times the old one); any
+ * approach left is rounding, e.g. after xi = 0. */
+static inline int rebound_now(const gr_edmd *s, int32_t i, int32_t j, double t, double dt)
+{
+    return dt == 0.0 && s->sched[i].last == j && s->sched[j].last == i && s->sched[i].t_last == t &&
+           s->sched[j].t_last == t;
+}
+
+/* One candidate j (not i) for i's next pair collision (record p): j seen through an
+ * image shift (NULL: none) or, with `nearest`, through the nearest periodic image.
+ * Keeps the earliest in *best / *partner; `best` is relative to i's clock and is also
+ * the horizon for the early exit in gr_pair_beats.  Every scan calls this with constant
+ * shift and nearest arguments, so each gets its own inlined copy. */
+static GR_ALWAYS_INLINE void try_pair(const gr_edmd *s, int dim, int32_t i, const double *p,
+                                      int32_t j, const double *shift, int nearest,
+                                      double *best, int32_t *partner)
+{
+    const double *q = rec(s, j);
+    double dtj = TIME(p, dim) - TIME(q, dim), dr[3], dv[3];
+    for (int a = 0; a < dim; a++) {
+        dr[a] = q[a] + VEL(q, dim)[a] * dtj - p[a];
+        if (shift) dr[a] += shift[a];
+        if (nearest) dr[a] = nearest_image(dr[a], s->L[a]);
+        dv[a] = VEL(q, dim)[a] - VEL(p, dim)[a];
+    }
+    double dt;
+    if (!gr_pair_beats(dim, dr, dv, RAD(p, dim) + RAD(q, dim), *best, &dt)) return;
+    if (rebound_now(s, i, j, TIME(p, dim), dt)) return;
+    *best = dt;
+    *partner = j;
+    GR_PREFETCH(&s->sched[j]); /* its collision count is read when the scan ends */
+}
+
+/* The earliest pair collision of i found by a scan, if it beats i's prediction. */
+static inline void keep_pair(gr_edmd *s, int dim, int32_t i, double best, int32_t partner)
+{
+    if (partner < 0) return;
+    gr_sched *e = &s->sched[i];
+    e->t_coll = TIME(rec(s, i), dim) + best;
+    e->partner = partner;
+    e->pcount = s->sched[partner].count;
+}
+
+/* Pair collisions of i with the particles of one cell, seen through an image shift. */
+static inline void scan_cell(const gr_edmd *s, int dim, int32_t i, const double *p,
+                             int32_t cell, const double *shift, double *best, int32_t *partner)
+{
+    for (int32_t j = s->cells.head[cell]; j >= 0; j = s->cells.next[j])
+        if (j != i) try_pair(s, dim, i, p, j, shift, 0, best, partner);
+}
+
+/* The pair (i, j), j seen through the nearest periodic image (the one that touches:
+ * contact distances are below half the box), for scans that involve a big particle. */
+static inline void scan_one(const gr_edmd *s, int dim, int32_t i, const double *p, int32_t j,
+                            double *best, int32_t *partner)
+{
+    if (j != i) try_pair(s, dim, i, p, j, NULL, s->cfg.periodic, best, partner);
+}
+
+static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, double *best,
+                       int32_t *partner);
+
+/* Cell mode: pair collisions of i in all adjacent cells (axis < 0) or in the layer newly
+ * adjacent after crossing along `axis` in direction `dir`, and with every big particle;
+ * keep the earliest in i's prediction if it beats the one there. */
+static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
+{
+    const gr_cells *g = &s->cells;
+    const double *p = rec(s, i);
+    const int32_t *c = s->sched[i].c;
+    gr_sched *e = &s->sched[i];
+    double best = e->t_coll - TIME(p, dim);
+    int32_t partner = -1;
+    if (s->big.n && s->big.is_big[i]) {
+        scan_block(s, dim, i, axis, dir, &best, &partner);
+    } else if (cell_interior(g, dim, c)) {
+        const int32_t base = cell_of(g, dim, c);
+        const int32_t *off = axis < 0 ? g->off_all : g->off_layer[2 * axis + (dir > 0)];
+        const int count = axis < 0 ? (dim == 3 ? 27 : 9) : (dim == 3 ? 9 : 3);
+        /* in a grid too large for the cache, the occupied cells' heads first, all at
+         * once: they are misses, and the chained loads of the scan would otherwise wait
+         * for them one by one (in a small grid the loop costs more than it saves: its
+         * length, the number of occupied cells, is a branch mispredicted often) */
+        int32_t full[27];
+        int m = 0;
+        for (int k = 0; k < count; k++) {
+            int32_t cell = base + off[k];
+            full[m] = cell;
+            m += cell_occupied(g, cell);
+        }
+        if (g->prefetch_heads)
+            for (int k = 0; k < m; k++) GR_PREFETCH(&g->head[full[k]]);
+        for (int k = 0; k < m; k++) scan_cell(s, dim, i, p, full[k], NULL, &best, &partner);
+    } else {
+        gr_nbr nb[27];
+        int count = cell_neighbours(g, dim, c, axis, dir, nb);
+        for (int k = 0; k < count; k++)
+            scan_cell(s, dim, i, p, nb[k].cell, nb[k].shift, &best, &partner);
+    }
+    for (int32_t b = 0; b < s->big.n; b++) scan_one(s, dim, i, p, s->big.idx[b], &best, &partner);
+    keep_pair(s, dim, i, best, partner);
+}
+
+/* Cell mode, big particle i: the cells within its reach, the block of R cells each way
+ * (axis < 0), or the layer of it newly reached after crossing along `axis` in direction
+ * `dir`.  gr_big_choose keeps the block narrower than the box, so a periodic block never
+ * meets itself. */
+static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, double *best,
+                       int32_t *partner)
+{
+    const gr_cells *g = &s->cells;
+    const double *p = rec(s, i);
+    const int32_t *c = s->sched[i].c;
+    int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int a = 0; a < dim; a++) {
+        int32_t reach = (int32_t)ceil((RAD(p, dim) + s->big.r_small) / g->w[a]);
+        lo[a] = a == axis ? c[a] + dir * reach : c[a] - reach;
+        hi[a] = a == axis ? lo[a] : c[a] + reach;
+        if (!s->cfg.periodic) {
+            if (lo[a] < 0) lo[a] = 0;
+            if (hi[a] > g->nc[a] - 1) hi[a] = g->nc[a] - 1;
+            if (lo[a] > hi[a]) return; /* the layer lies beyond a wall */
+        }
+    }
+    /* beyond dim, lo = hi = 0 and nc = 1: one pass */
+    int32_t q[3] = {0, 0, 0};
+    for (int32_t k2 = lo[2]; k2 <= hi[2]; k2++) {
+        q[2] = (k2 % g->nc[2] + g->nc[2]) % g->nc[2];
+        for (int32_t k1 = lo[1]; k1 <= hi[1]; k1++) {
+            q[1] = (k1 % g->nc[1] + g->nc[1]) % g->nc[1];
+            for (int32_t k0 = lo[0]; k0 <= hi[0]; k0++) {
+                q[0] = (k0 % g->nc[0] + g->nc[0]) % g->nc[0];
+                int32_t cell = cell_of(g, dim, q);
+                if (!cell_occupied(g, cell)) continue;
+                for (int32_t j = g->head[cell]; j >= 0; j = g->next[j])
+                    scan_one(s, dim, i, p, j, best, partner);
+            }
+        }
+    }
+}
+
+/* List mode: pair collisions of i with its listed neighbours, before its predicted wall
+ * collision and its shell exit (which rebuilds and predicts afresh, so later collisions
+ * need not be found now: most candidates then fail the cheap test). */
+static void scan_list(gr_edmd *s, int dim, int32_t i)
+{
+    const double *p = rec(s, i);
+    gr_sched *e = &s->sched[i];
+    const int32_t *row = nl_row(&s->nl, i);
+    double best = (e->t_coll < e->t_cross ? e->t_coll : e->t_cross) - TIME(p, dim);
+    int32_t partner = -1;
+    for (int k = 0; k < e->nn; k++)
+        try_pair(s, dim, i, p, row[k] >> GR_NL_BITS, s->nl.img[row[k] & GR_NL_CODE_MASK], 0,
+                 &best, &partner);
+    keep_pair(s, dim, i, best, partner);
+}
+
+/* List mode: make i's position (in the box) its list centre and file it in that cell. */
+static inline void set_centre(gr_edmd *s, int dim, int32_t i)
+{
+    const double *p = rec(s, i);
+    double *centre = s->nl.centre + (size_t)i * (dim + 1);
+    centre[dim] = RAD(p, dim);
+    for (int a = 0; a < dim; a++) centre[a] = p[a];
+    cell_coords(&s->cells, dim, p, s->sched[i].c);
+}
+
+/* List mode: list i and every particle whose centre is within r_i + r_j + 2 delta of
+ * i's (only those numbered above i if `above`: building all lists at once). */
+static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
+{
+    const gr_cells *g = &s->cells;
+    const double *ci = s->nl.centre + (size_t)i * (dim + 1);
+    const double reach = ci[dim] + 2.0 * s->nl.shell;
+    gr_nbr nb[27];
+    const int count = cell_neighbours(g, dim, s->sched[i].c, -1, 0, nb);
+    /* first the new neighbours, kept or not without a branch (about one candidate in
+     * six is kept: as good as random) */
+    int32_t m = 0, *near = s->nl.near;
+    for (int k = 0; k < count; k++) {
+        int32_t code = 0;
+        for (int a = dim - 1; a >= 0; a--)
+            code = 3 * code + (nb[k].shift[a] > 0.0) - (nb[k].shift[a] < 0.0) + 1;
+        for (int32_t j = g->head[nb[k].cell]; j >= 0; j = g->next[j]) {
+            const double *cj = s->nl.centre + (size_t)j * (dim + 1);
+            double d2 = 0.0;
+            for (int a = 0; a < dim; a++) {
+                const double d = cj[a] + nb[k].shift[a] - ci[a];
+                d2 += d * d;
+            }
+            const double cut = cj[dim] + reach;
+            near[m] = (j << GR_NL_BITS) | code;
+            m += (d2 < cut * cut) & (j != i) & (!above | (j > i));
+        }
+    }
+    for (int32_t k = 0; k < m; k++) {
+        int status = nl_link(&s->nl, dim, s->n, s->sched, i, near[k] >> GR_NL_BITS,
+                             near[k] & GR_NL_CODE_MASK);
+        if (status != GR_OK) {
+            gr_error_set(err, status, uid(s, i), -1, s->t, (double)s->nl.cap,
+                         "a neighbour list could not grow (out of memory, or past "
+                         GR_XSTR(GR_NL_CAP_MAX) " entries); the system cannot go on");
+            return status;
+        }
+    }
+    return GR_OK;
+}
+
+#endif

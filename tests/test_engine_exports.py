@@ -1,0 +1,73 @@
+"""The engine's rules are owned by the C core and read from it by the Python side
+(issue 14): the big-particle rule and its default, the bytes per particle, and the
+checks of a configuration without building an engine."""
+import math
+
+import numpy as np
+import pytest
+
+import granular
+from granular import _core
+from granular.errors import GranularError
+from granular.scene import BIG_RATIO
+
+
+def _arrays(scene):
+    return (scene.positions, scene.velocities, scene.radii, scene.masses, scene.lower,
+            scene.upper, scene.boundary == "periodic", scene.wall_restitution,
+            scene.restitution, scene.contact_duration)
+
+
+def test_big_rule_and_default_come_from_c():
+    assert BIG_RATIO == _core.BIG_RATIO == 3.0
+    assert _core.BIG_MAX == 16
+    r = np.full(101, 0.01)
+    r[7] = 0.05
+    # the cut is BIG_RATIO times the upper median radius
+    assert _core.big_cut(r, BIG_RATIO) == pytest.approx(0.03)
+    big = _core.big_particles(r, np.array([1.0, 1.0, 1.0]), BIG_RATIO, 1.0)
+    assert big.dtype == bool and np.flatnonzero(big).tolist() == [7]
+    # more than BIG_MAX wide ones: none kept out; none at all with an infinite ratio
+    r[:20] = 0.05
+    assert not _core.big_particles(r, np.array([1.0, 1.0, 1.0]), BIG_RATIO, 1.0).any()
+    assert not _core.big_particles(r, np.array([1.0, 1.0, 1.0]), math.inf, 1.0).any()
+
+
+def test_bytes_per_particle():
+    cells = _core.edmd_bytes_per_particle(3, False)
+    lists = _core.edmd_bytes_per_particle(3, True)
+    assert 200 < cells < lists < 1000
+    assert _core.edmd_bytes_per_particle(2, False) < cells
+
+
+def test_check_agrees_with_the_engine():
+    s = granular.Scene.random(200, 0.02, seed=3)
+    assert _core.edmd_check(*_arrays(s)) is None
+    pos = s.positions.copy()
+    pos[5] = pos[9] + [0.01, 0.0, 0.0]  # overlapping 9
+    pos[5] %= 1.0
+    bad = list(_arrays(s))
+    bad[0] = pos
+    for build in (_core.edmd_check, _core.EDMD):
+        with pytest.raises(GranularError, match="overlap"):
+            build(*bad, 1.0, BIG_RATIO, 0.0)
+    pos = s.positions.copy()
+    pos[3, 1] = 1.5  # outside the box
+    bad[0] = pos
+    for build in (_core.edmd_check, _core.EDMD):
+        with pytest.raises((GranularError, ValueError)):
+            build(*bad, 1.0, BIG_RATIO, 0.0)
+
+
+def test_scene_and_simulation_do_not_import_each_other():
+    """simulation imports scene; scene (and _edmd, which both use) import neither."""
+    import ast
+    import pathlib
+
+    src = pathlib.Path(granular.__file__).parent
+    for name, banned in (("scene", {"simulation"}), ("_edmd", {"scene", "simulation"})):
+        tree = ast.parse((src / f"{name}.py").read_text())
+        imported = {alias.name for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
+                    for alias in node.names} | {node.module for node in ast.walk(tree)
+                                                if isinstance(node, ast.ImportFrom)}
+        assert not imported & banned, name
