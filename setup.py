@@ -2,6 +2,7 @@
 
 Portable flags only: -O3 and C99; no -march=native or -ffast-math (the collision
 arithmetic relies on IEEE rounding being the same on every machine)."""
+
 import glob
 import os
 

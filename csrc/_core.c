@@ -314,16 +314,18 @@ static int check_ready(EDMDObject *self)
     return 1;
 }
 
-/* An output buffer: None, or a writeable C-contiguous array of the given dtype and size. */
+/* An output buffer: None, or a writeable C-contiguous array of the given dtype and size, in
+ * the machine's byte order (the type number alone does not say: ">f8" is NPY_FLOAT64 too). */
 static int out_buffer(PyObject *obj, const char *name, int type, npy_intp size, void **data)
 {
     *data = NULL;
     if (obj == Py_None) return 1;
     if (!PyArray_Check(obj) || PyArray_TYPE((PyArrayObject *)obj) != type ||
+        !PyArray_ISNOTSWAPPED((PyArrayObject *)obj) ||
         !PyArray_IS_C_CONTIGUOUS((PyArrayObject *)obj) ||
         !PyArray_ISWRITEABLE((PyArrayObject *)obj) ||
         PyArray_SIZE((PyArrayObject *)obj) != size) {
-        PyErr_Format(PyExc_ValueError, "%s must be a writeable C-contiguous %s array of %zd elements",
+        PyErr_Format(PyExc_ValueError, "%s must be a writeable C-contiguous native-order %s array of %zd elements",
                      name, type == NPY_FLOAT64 ? "float64" : "int64", (Py_ssize_t)size);
         return 0;
     }
@@ -521,9 +523,12 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     if (!PyArray_Check(ox) || !PyArray_Check(osteps) || !PyArray_Check(olags) ||
         PyArray_TYPE((PyArrayObject *)osteps) != NPY_INT64 ||
         PyArray_TYPE((PyArrayObject *)olags) != NPY_INT64 ||
+        !PyArray_ISNOTSWAPPED((PyArrayObject *)osteps) ||
+        !PyArray_ISNOTSWAPPED((PyArrayObject *)olags) ||
         !PyArray_IS_C_CONTIGUOUS((PyArrayObject *)osteps) ||
         !PyArray_IS_C_CONTIGUOUS((PyArrayObject *)olags)) {
-        PyErr_SetString(PyExc_ValueError, "x must be an array; sample_steps and lags C-contiguous int64 arrays");
+        PyErr_SetString(PyExc_ValueError,
+                        "x must be an array; sample_steps and lags C-contiguous native-order int64 arrays");
         return NULL;
     }
     const npy_intp d = cfg.dim;

@@ -5,6 +5,7 @@ place for Simulation and for Scene.random's lattice melt.
 Imports neither scene nor simulation (both import it), so the two need not import each
 other.  The engine's own rules -- which particles are big, the default big_ratio, what
 it allocates per particle -- are asked of the C core (_core), which owns them."""
+
 from __future__ import annotations
 
 import math
@@ -37,8 +38,10 @@ def check_memory(need, what):
     except (ValueError, OSError, AttributeError):
         return
     if need > 0.5 * total:
-        raise MemoryError(f"{what} needs {need / 2**30:.1f} GiB, more than half of this "
-                          f"machine's {total / 2**30:.1f} GiB")
+        raise MemoryError(
+            f"{what} needs {need / 2**30:.1f} GiB, more than half of this "
+            f"machine's {total / 2**30:.1f} GiB"
+        )
 
 
 def build(scene, cell_factor=1.0, big_ratio=_core.BIG_RATIO, shell="auto"):
@@ -55,13 +58,27 @@ def build(scene, cell_factor=1.0, big_ratio=_core.BIG_RATIO, shell="auto"):
         raise ValueError(
             f"neighbour lists (shell = {shell}) with particles wider than big_ratio = "
             f"{big_ratio} times the median: every list would reach as far as the widest; "
-            "use shell=0 (cells keep the big ones out) or big_ratio=math.inf to insist")
-    check_memory(_core.edmd_bytes_per_particle(scene.dim, shell > 0) * scene.n,
-                 "the event-driven engine's state" + (" with neighbour lists" if shell > 0 else ""))
-    return _core.EDMD(scene.positions, scene.velocities, scene.radii, scene.masses,
-                      scene.lower, scene.upper, scene.boundary == "periodic",
-                      scene.wall_restitution, scene.restitution, scene.contact_duration,
-                      float(cell_factor), float(big_ratio), float(shell))
+            "use shell=0 (cells keep the big ones out) or big_ratio=math.inf to insist"
+        )
+    check_memory(
+        _core.edmd_bytes_per_particle(scene.dim, shell > 0) * scene.n,
+        "the event-driven engine's state" + (" with neighbour lists" if shell > 0 else ""),
+    )
+    return _core.EDMD(
+        scene.positions,
+        scene.velocities,
+        scene.radii,
+        scene.masses,
+        scene.lower,
+        scene.upper,
+        scene.boundary == "periodic",
+        scene.wall_restitution,
+        scene.restitution,
+        scene.contact_duration,
+        float(cell_factor),
+        float(big_ratio),
+        float(shell),
+    )
 
 
 def run_collisions(engine, collisions_per_particle):
@@ -69,7 +86,21 @@ def run_collisions(engine, collisions_per_particle):
     time limit), in chunks so that Ctrl-C is seen; returns the _core.STOP_* reason."""
     no_samples = np.empty(0)
     while True:
-        code, _ = engine.advance(math.inf, float(collisions_per_particle), -1.0, CHUNK,
-                                 no_samples, 0, None, None, None, None, None, None, None, None)
+        code, _ = engine.advance(
+            math.inf,
+            float(collisions_per_particle),
+            -1.0,
+            CHUNK,
+            no_samples,
+            0,
+            None,
+            None,
+            None,
+            None,
+            None,
+            None,
+            None,
+            None,
+        )
         if code != _core.STOP_BUDGET:
             return code

@@ -1,4 +1,5 @@
 """Scenes: the state a simulation starts from, as a validated value object."""
+
 from __future__ import annotations
 
 import itertools
@@ -48,7 +49,8 @@ def _check_range(name, value, lo, hi):
         raise ValueError(
             f"{name} = {value:.3g} is outside {lo:g} .. {hi:g}, the range in which the "
             "collision arithmetic stays within float64: choose units in which diameters, "
-            "masses and speeds are nearer 1 (e.g. a diameter, a mass and the thermal speed)")
+            "masses and speeds are nearer 1 (e.g. a diameter, a mass and the thermal speed)"
+        )
 
 
 @np.errstate(over="ignore", under="ignore")
@@ -65,10 +67,12 @@ def _check_scales(radii, masses, velocities, lower, upper):
     _check_range("the longest box edge", edge, _SCALE_LO, _SCALE_HI)
     _check_range("the smallest mass", m_min, lo2, hi2)
     _check_range("the largest mass", m_max, lo2, hi2)
-    _check_range("the smallest diameter squared times the smallest mass",
-                 sigma_min**2 * m_min, lo2, hi2)
-    _check_range("the largest diameter squared times the largest mass",
-                 sigma_max**2 * m_max, lo2, hi2)
+    _check_range(
+        "the smallest diameter squared times the smallest mass", sigma_min**2 * m_min, lo2, hi2
+    )
+    _check_range(
+        "the largest diameter squared times the largest mass", sigma_max**2 * m_max, lo2, hi2
+    )
     v_max = np.max(np.abs(velocities))
     # Speeds only from above: a gas too slow to resolve a contact in float64 (a diameter
     # times its speeds below _SCALE_LO) is a valid state, e.g. one that inelastic walls
@@ -83,7 +87,8 @@ def _check_scales(radii, masses, velocities, lower, upper):
             f"float64 resolves coordinates near {far:.6g} only to steps of {step:.3g}, not "
             f"far enough below the smallest diameter {sigma_min:.3g} (at most "
             f"{_RESOLUTION:g} of it): particles would pass through each other; move the box "
-            "nearer the origin")
+            "nearer the origin"
+        )
 
 
 def frozen_energy(radii, masses):
@@ -110,8 +115,10 @@ def _box_corners(box, dim):
         lengths = hi - lo
         volume = float(np.prod(lengths))
     if not (np.all(np.isfinite(lengths)) and _SCALE_LO**2 <= volume <= _SCALE_HI**2):
-        raise ValueError(f"the box's volume {volume:.3g} is outside {_SCALE_LO**2:g} .. "
-                         f"{_SCALE_HI**2:g}: choose units nearer the box's size")
+        raise ValueError(
+            f"the box's volume {volume:.3g} is outside {_SCALE_LO**2:g} .. "
+            f"{_SCALE_HI**2:g}: choose units nearer the box's size"
+        )
     return lo, hi
 
 
@@ -164,12 +171,24 @@ class Scene:
     two particles overlapping (``OverlapError`` names the pair).
     """
 
-    def __init__(self, positions, velocities, radii, masses=1.0, *, box=1.0,
-                 boundary="periodic", wall_restitution=1.0, restitution=1.0,
-                 contact_duration=0.0):
+    def __init__(
+        self,
+        positions,
+        velocities,
+        radii,
+        masses=1.0,
+        *,
+        box=1.0,
+        boundary="periodic",
+        wall_restitution=1.0,
+        restitution=1.0,
+        contact_duration=0.0,
+    ):
         pos = _real(positions, "positions")
         if pos.ndim != 2 or pos.shape[1] not in (2, 3) or pos.shape[0] < 1:
-            raise ValueError(f"positions must have shape (N, 2) or (N, 3) with N >= 1, got {pos.shape}")
+            raise ValueError(
+                f"positions must have shape (N, 2) or (N, 3) with N >= 1, got {pos.shape}"
+            )
         n, d = pos.shape
         self.positions = _array(pos, "positions", (n, d))
         self.velocities = _array(velocities, "velocities", (n, d))
@@ -192,7 +211,9 @@ class Scene:
         self.boundary = boundary
         self.wall_restitution = float(wall_restitution)
         if not (self.wall_restitution > 0 and math.isfinite(self.wall_restitution)):
-            raise ValueError(f"wall_restitution must be positive and finite, got {wall_restitution}")
+            raise ValueError(
+                f"wall_restitution must be positive and finite, got {wall_restitution}"
+            )
         self.restitution = float(restitution)
         if not 0.0 <= self.restitution <= 1.0:
             raise ValueError(f"restitution must lie in [0, 1], got {restitution}")
@@ -201,9 +222,18 @@ class Scene:
             raise ValueError(f"contact_duration must be finite and >= 0, got {contact_duration}")
         # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
         # the engine's own rules in O(N) through a cell grid, without building an engine.
-        _core.edmd_check(self.positions, self.velocities, self.radii, self.masses,
-                         self.lower, self.upper, self.boundary == "periodic",
-                         self.wall_restitution, self.restitution, self.contact_duration)
+        _core.edmd_check(
+            self.positions,
+            self.velocities,
+            self.radii,
+            self.masses,
+            self.lower,
+            self.upper,
+            self.boundary == "periodic",
+            self.wall_restitution,
+            self.restitution,
+            self.contact_duration,
+        )
 
     # -- derived quantities ---------------------------------------------------------
     @property
@@ -250,10 +280,17 @@ class Scene:
 
     def replace(self, **changes):
         """A copy with some fields changed, e.g. ``scene.replace(restitution=0.8)``."""
-        fields = dict(positions=self.positions, velocities=self.velocities, radii=self.radii,
-                      masses=self.masses, box=(self.lower, self.upper), boundary=self.boundary,
-                      wall_restitution=self.wall_restitution, restitution=self.restitution,
-                      contact_duration=self.contact_duration)
+        fields = dict(
+            positions=self.positions,
+            velocities=self.velocities,
+            radii=self.radii,
+            masses=self.masses,
+            box=(self.lower, self.upper),
+            boundary=self.boundary,
+            wall_restitution=self.wall_restitution,
+            restitution=self.restitution,
+            contact_duration=self.contact_duration,
+        )
         unknown = set(changes) - set(fields)
         if unknown:
             raise TypeError(f"unknown Scene fields: {sorted(unknown)}")
@@ -264,15 +301,31 @@ class Scene:
         return Scene(positions, velocities, radii, **fields)
 
     def __repr__(self):
-        return (f"Scene(n={self.n}, dim={self.dim}, boundary={self.boundary!r}, "
-                f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
-                f"temperature={self.temperature:.4g})")
+        return (
+            f"Scene(n={self.n}, dim={self.dim}, boundary={self.boundary!r}, "
+            f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
+            f"temperature={self.temperature:.4g})"
+        )
 
     # -- constructors ---------------------------------------------------------------
     @classmethod
-    def random(cls, n, radius, dim=3, box=1.0, boundary="periodic", restitution=1.0, *,
-               speed=None, temperature=None, mass=1.0, wall_restitution=1.0,
-               contact_duration=0.0, remove_drift=True, seed=None):
+    def random(
+        cls,
+        n,
+        radius,
+        dim=3,
+        box=1.0,
+        boundary="periodic",
+        restitution=1.0,
+        *,
+        speed=None,
+        temperature=None,
+        mass=1.0,
+        wall_restitution=1.0,
+        contact_duration=0.0,
+        remove_drift=True,
+        seed=None,
+    ):
         """Particles placed uniformly without overlap, with random velocities.
 
         Positions: random sequential addition (accepting uniform candidates that overlap
@@ -324,8 +377,13 @@ class Scene:
         unit = math.pi * radii**2 if dim == 2 else 4.0 / 3.0 * math.pi * radii**3
         eta = float(unit.sum() / volume)
         periodic = boundary == "periodic"
-        common = dict(box=(lo, hi), boundary=boundary, wall_restitution=wall_restitution,
-                      restitution=restitution, contact_duration=contact_duration)
+        common = dict(
+            box=(lo, hi),
+            boundary=boundary,
+            wall_restitution=wall_restitution,
+            restitution=restitution,
+            contact_duration=contact_duration,
+        )
         velocities = _draw_velocities(rng_vel, n, dim, masses, speed, temperature, remove_drift)
         if eta <= _RSA_LIMIT[dim]:
             positions = _place_rsa(rng_pos, radii, lo, hi, periodic)
@@ -353,15 +411,22 @@ class Scene:
     def seed_brownian_disks(cls, seed=None):
         """The 2D Brownian-motion note's scene: 150 elastic hard disks of radius 0.1 and
         mass 1 between elastic walls at +-3, unit speed in random directions."""
-        return cls.random(150, 0.1, dim=2, box=(-3.0, 3.0), boundary="walls", speed=1.0,
-                          remove_drift=False, seed=seed)
+        return cls.random(
+            150,
+            0.1,
+            dim=2,
+            box=(-3.0, 3.0),
+            boundary="walls",
+            speed=1.0,
+            remove_drift=False,
+            seed=seed,
+        )
 
     @classmethod
     def seed_ideal_gas(cls, n=100, radius=0.01, seed=None):
         """The lecture notes' ideal gas: elastic spheres in the unit box with reflecting
         walls and Maxwell-Boltzmann velocities at T = 1."""
-        return cls.random(n, radius, dim=3, box=1.0, boundary="walls", temperature=1.0,
-                          seed=seed)
+        return cls.random(n, radius, dim=3, box=1.0, boundary="walls", temperature=1.0, seed=seed)
 
 
 def _draw_velocities(rng, n, dim, masses, speed, temperature, remove_drift):
@@ -427,7 +492,7 @@ def _place_rsa(rng, radii, lo, hi, periodic, patience=100, max_rounds=5000):
         for a in np.flatnonzero(cand_big):
             if ok[a]:
                 clash = _distance(cand[a], cand, L, periodic) < r[a] + r
-                clash[:a + 1] = False
+                clash[: a + 1] = False
                 ok &= ~clash
         tree = cKDTree(shift(cand), boxsize=box)
         for a, b in sorted(tree.query_pairs(2 * r_small)):
@@ -464,7 +529,7 @@ def _lattice_order(positions, G):
     million particles at once would take ~300 MB."""
     rho = np.zeros(len(G), dtype=complex)
     for start in range(0, len(positions), 1 << 16):
-        rho += np.exp(1j * positions[start:start + (1 << 16)] @ G.T).sum(axis=0)
+        rho += np.exp(1j * positions[start : start + (1 << 16)] @ G.T).sum(axis=0)
     rho /= len(positions)
     return len(positions) * float(np.mean(np.abs(rho) ** 2))
 
@@ -485,9 +550,13 @@ def _place_lattice(rng, radii, lo, hi, periodic):
         cell = inner / k
         sites = ((grid[:, None, :] + basis[None, :, :]).reshape(-1, 3) + 0.25) * cell
         nearest = cell.min() / math.sqrt(2)
-        hkl = [g for g in itertools.product(range(-2, 3), repeat=3)
-               if sum(x * x for x in g) in (3, 4, 8) and len({x % 2 for x in g}) == 1
-               and g > tuple(-x for x in g)]
+        hkl = [
+            g
+            for g in itertools.product(range(-2, 3), repeat=3)
+            if sum(x * x for x in g) in (3, 4, 8)
+            and len({x % 2 for x in g}) == 1
+            and g > tuple(-x for x in g)
+        ]
         G = 2 * math.pi * np.array(hkl, dtype=float) / cell
     else:
         # rows of kx sites, every other row shifted by half a spacing; ky even so the
@@ -513,7 +582,11 @@ def _place_lattice(rng, radii, lo, hi, periodic):
         raise ValueError(
             f"{n} particles of radius {radii.max():g} do not fit in this box even on a "
             f"{'face-centred cubic' if dim == 3 else 'triangular'} lattice"
-            + (" spaced for the largest of them (random sequential addition jammed first)"
-               if radii.min() < radii.max() else ""))
+            + (
+                " spaced for the largest of them (random sequential addition jammed first)"
+                if radii.min() < radii.max()
+                else ""
+            )
+        )
     pick = rng.choice(len(sites), size=n, replace=False)
     return lo + (0.0 if periodic else sigma / 2) + sites[pick], G

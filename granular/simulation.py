@@ -1,4 +1,5 @@
 """Simulation: the event-driven engine (EDMD) behind a small Python API."""
+
 from __future__ import annotations
 
 import math
@@ -7,9 +8,14 @@ import threading
 import numpy as np
 
 from . import _core, _edmd
-from .errors import (FrozenGasError, GranularError, HeatedWallsError, InelasticCollapseError,
-                     NoProgressError)
 from ._edmd import check_memory as _check_memory
+from .errors import (
+    FrozenGasError,
+    GranularError,
+    HeatedWallsError,
+    InelasticCollapseError,
+    NoProgressError,
+)
 from .scene import BIG_RATIO, Scene, frozen_energy
 from .trajectory import Trajectory, _pressure_volume
 
@@ -60,7 +66,8 @@ class Simulation:
             "a Simulation cannot be copied or pickled: its state lives in the C engine, "
             "which would be shared, not copied.  For an independent simulation from the "
             "current state use Simulation(sim.scene) (it starts its counters, stats and "
-            "time from zero)")
+            "time from zero)"
+        )
 
     __copy__ = __deepcopy__ = __reduce_ex__ = __reduce__ = _no_copy
 
@@ -87,8 +94,9 @@ class Simulation:
         s = self._initial
         if c["time"] > 0:
             volume = _pressure_volume(s.lower, s.upper, s.radii, s.boundary)
-            c["pressure"] = ((2.0 * c["kinetic_time_integral"] + c["virial"]) / c["time"]
-                             / (s.dim * volume))
+            c["pressure"] = (
+                (2.0 * c["kinetic_time_integral"] + c["virial"]) / c["time"] / (s.dim * volume)
+            )
         else:
             c["pressure"] = float("nan")
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
@@ -99,9 +107,17 @@ class Simulation:
         """The current state as a new Scene (positions wrapped into a periodic box)."""
         pos, vel, _ = self._engine.state()
         s = self._initial
-        return Scene(pos, vel, s.radii, s.masses, box=(s.lower, s.upper), boundary=s.boundary,
-                     wall_restitution=s.wall_restitution, restitution=s.restitution,
-                     contact_duration=s.contact_duration)
+        return Scene(
+            pos,
+            vel,
+            s.radii,
+            s.masses,
+            box=(s.lower, s.upper),
+            boundary=s.boundary,
+            wall_restitution=s.wall_restitution,
+            restitution=s.restitution,
+            contact_duration=s.contact_duration,
+        )
 
     @property
     def unwrapped_positions(self):
@@ -110,8 +126,7 @@ class Simulation:
         return pos + img * (self._initial.upper - self._initial.lower)
 
     # -- running --------------------------------------------------------------------
-    def run(self, t_stop=None, *, sample_times=None, stop_when=None, store=_STORE,
-            progress=False):
+    def run(self, t_stop=None, *, sample_times=None, stop_when=None, store=_STORE, progress=False):
         """Advance until ``t_stop`` (absolute time) or a ``stop_when`` criterion, whichever
         comes first, and return the samples as a Trajectory.
 
@@ -145,7 +160,8 @@ class Simulation:
         if not self._running.acquire(blocking=False):
             raise RuntimeError(
                 "another thread is running this Simulation; a Simulation runs one run at a "
-                "time (wait for it, or give each thread its own Simulation(scene))")
+                "time (wait for it, or give each thread its own Simulation(scene))"
+            )
         try:
             return self._run(t_stop, sample_times, stop_when, store, progress)
         finally:
@@ -174,7 +190,8 @@ class Simulation:
             raise ValueError(
                 f"stop_when kinetic_energy = {kin:g} is not above {frozen / self._initial.n:.3g},"
                 " the mean kinetic energy below which float64 cannot resolve this gas' "
-                "collisions (a cooling gas only approaches 0): give a larger target")
+                "collisions (a cooling gas only approaches 0): give a larger target"
+            )
         budget = crit.get("events")
         if budget is not None and (isinstance(budget, bool) or int(budget) != budget or budget < 0):
             raise ValueError(f"stop_when['events'] must be a whole number >= 0, got {budget!r}")
@@ -195,7 +212,9 @@ class Simulation:
             if not np.all(np.isfinite(times)):
                 raise ValueError("sample_times must be finite")
             if len(times) and times[0] < t_now:
-                raise ValueError(f"sample_times start at {times[0]}, before the current time {t_now}")
+                raise ValueError(
+                    f"sample_times start at {times[0]}, before the current time {t_now}"
+                )
             if np.any(np.diff(times) <= 0):
                 raise ValueError("sample_times must be strictly increasing")
             if len(times) and times[-1] > t_end:
@@ -205,13 +224,15 @@ class Simulation:
                 # sample so that every sample is taken at the time asked for
                 t_end = float(times[-1])
         count = len(times) + final_sample
-        _check_memory(8.0 * count * self._initial.n * self._initial.dim * len(store),
-                      f"storing {count} samples of {' and '.join(store)} (sample less often, "
-                      f"or run with store=() and keep only the statistics)")
+        _check_memory(
+            8.0 * count * self._initial.n * self._initial.dim * len(store),
+            f"storing {count} samples of {' and '.join(store)} (sample less often, "
+            f"or run with store=() and keep only the statistics)",
+        )
         buf = self._buffers(count, store)
 
         # the C loop fills the first len(times) samples; a final one may follow
-        views = {k: (None if v is None else v[:len(times)]) for k, v in buf.items()}
+        views = {k: (None if v is None else v[: len(times)]) for k, v in buf.items()}
         reason, nxt, done = "events", 0, 0
         bar = _progress_bar(progress, t_now, t_end, cpp)
         stall = _StallGuard(self, dissipative_only=cpp == math.inf) if unbounded else None
@@ -262,8 +283,12 @@ class Simulation:
         """The error to raise instead of ``exc`` when heated walls blew the gas up, else
         None (the engine reports the unresolvable event times as a collapse)."""
         s = self._initial
-        if not (isinstance(exc, InelasticCollapseError) and s.boundary == "walls"
-                and s.wall_restitution > 1.0 and energy0 > 0):
+        if not (
+            isinstance(exc, InelasticCollapseError)
+            and s.boundary == "walls"
+            and s.wall_restitution > 1.0
+            and energy0 > 0
+        ):
             return None
         c = self._engine.counters()
         ratio = c["kinetic_energy"] / energy0
@@ -274,7 +299,10 @@ class Simulation:
             f"energy up by a factor {ratio:.3g} by t = {c['time']:.6g}: the particles are so fast "
             "that the event times can no longer be resolved in float64.  Lower "
             "wall_restitution, or stop earlier (t_stop, or stop_when with kinetic_energy or "
-            "collisions_per_particle)", time=c["time"], value=ratio)
+            "collisions_per_particle)",
+            time=c["time"],
+            value=ratio,
+        )
 
     @staticmethod
     def _check_not_frozen(c, frozen, moving):
@@ -288,7 +316,9 @@ class Simulation:
                 "the speeds times the smallest diameter are under 1e-140 and float64 can no "
                 "longer resolve when two particles touch.  Stop earlier (t_stop, or "
                 "stop_when kinetic_energy), or rescale the velocities (scene.replace)",
-                time=c["time"], value=energy)
+                time=c["time"],
+                value=energy,
+            )
 
     def _check_energy_reachable(self, target):
         """Refuse a kinetic-energy stop that can never come, before running forever: the
@@ -299,13 +329,15 @@ class Simulation:
         walls_lose = s.boundary == "walls" and s.wall_restitution < 1.0
         mean = self._engine.counters()["kinetic_energy"] / s.n
         if not (pairs_lose or walls_lose) and target < mean:
-            why = ("a single particle has no partner to collide with" if s.n == 1
-                   else "restitution 1")
+            why = (
+                "a single particle has no partner to collide with" if s.n == 1 else "restitution 1"
+            )
             walls = "" if s.boundary == "periodic" else ", walls that do not absorb"
             raise ValueError(
                 f"stop_when kinetic_energy = {target} can never be reached: the mean kinetic "
                 f"energy is {mean:.6g} and this scene does not lose energy ({why}{walls}); "
-                "give t_stop")
+                "give t_stop"
+            )
 
     def _sample_now(self, buf, k):
         """Write the current state as sample k (reads the state, processes no event)."""
@@ -328,22 +360,43 @@ class Simulation:
         return dict(
             positions=np.zeros((count, n, d)) if "positions" in store else None,
             velocities=np.zeros((count, n, d)) if "velocities" in store else None,
-            kinetic=np.zeros(count), momentum=np.zeros((count, d)),
-            pair=np.zeros(count, dtype=np.int64), wall=np.zeros(count, dtype=np.int64),
-            virial=np.zeros(count), wall_impulse=np.zeros(count))
+            kinetic=np.zeros(count),
+            momentum=np.zeros((count, d)),
+            pair=np.zeros(count, dtype=np.int64),
+            wall=np.zeros(count, dtype=np.int64),
+            virial=np.zeros(count),
+            wall_impulse=np.zeros(count),
+        )
 
     def _trajectory(self, times, buf, k, reason):
         s = self._initial
         cut = {name: (None if a is None else a[:k].copy()) for name, a in buf.items()}
-        return Trajectory(times.copy(), cut["positions"], cut["velocities"], cut["kinetic"],
-                          cut["momentum"], cut["pair"], cut["wall"], cut["virial"],
-                          cut["wall_impulse"], masses=s.masses, radii=s.radii, lower=s.lower,
-                          upper=s.upper, boundary=s.boundary, stop_reason=reason)
+        return Trajectory(
+            times.copy(),
+            cut["positions"],
+            cut["velocities"],
+            cut["kinetic"],
+            cut["momentum"],
+            cut["pair"],
+            cut["wall"],
+            cut["virial"],
+            cut["wall_impulse"],
+            masses=s.masses,
+            radii=s.radii,
+            lower=s.lower,
+            upper=s.upper,
+            boundary=s.boundary,
+            stop_reason=reason,
+        )
 
 
-_REASONS = {_core.STOP_TIME: "time", _core.STOP_COLLISIONS: "collisions",
-            _core.STOP_ENERGY: "kinetic_energy", _core.STOP_IDLE: "idle",
-            _core.STOP_BUDGET: "events"}
+_REASONS = {
+    _core.STOP_TIME: "time",
+    _core.STOP_COLLISIONS: "collisions",
+    _core.STOP_ENERGY: "kinetic_energy",
+    _core.STOP_IDLE: "idle",
+    _core.STOP_BUDGET: "events",
+}
 
 
 class _StallGuard:
@@ -388,7 +441,8 @@ class _StallGuard:
             raise NoProgressError(
                 f"no {what} in {c['events'] - self.events} events (t = {c['time']:.6g}): the "
                 f"stop criteria {criteria} may never be met; give t_stop or stop_when['events']",
-                time=c["time"])
+                time=c["time"],
+            )
 
 
 class _ProgressBar:
@@ -398,8 +452,12 @@ class _ProgressBar:
         from tqdm.auto import tqdm
 
         self.start, self.by_time = start, by_time
-        self.bar = tqdm(total=end - start, unit="time" if by_time else "collisions/particle",
-                        unit_scale=True, leave=False)
+        self.bar = tqdm(
+            total=end - start,
+            unit="time" if by_time else "collisions/particle",
+            unit_scale=True,
+            leave=False,
+        )
 
     def update(self, sim):
         now = sim.time if self.by_time else sim.stats["collisions_per_particle"]

@@ -1,4 +1,5 @@
 """Trajectory: what a run recorded, with the physics that follows from it."""
+
 from __future__ import annotations
 
 from typing import Any
@@ -34,13 +35,25 @@ class Trajectory:
     masses, radii, lower, upper, boundary : copied from the scene
     """
 
-    def __init__(self, times: NDArray[np.float64], positions: NDArray[np.float64] | None,
-                 velocities: NDArray[np.float64] | None, kinetic_energy: NDArray[np.float64],
-                 momentum: NDArray[np.float64], pair_collisions: NDArray[np.int64],
-                 wall_collisions: NDArray[np.int64], virial: NDArray[np.float64],
-                 wall_impulse: NDArray[np.float64], *, masses: NDArray[np.float64],
-                 radii: NDArray[np.float64], lower: NDArray[np.float64],
-                 upper: NDArray[np.float64], boundary: str, stop_reason: str) -> None:
+    def __init__(
+        self,
+        times: NDArray[np.float64],
+        positions: NDArray[np.float64] | None,
+        velocities: NDArray[np.float64] | None,
+        kinetic_energy: NDArray[np.float64],
+        momentum: NDArray[np.float64],
+        pair_collisions: NDArray[np.int64],
+        wall_collisions: NDArray[np.int64],
+        virial: NDArray[np.float64],
+        wall_impulse: NDArray[np.float64],
+        *,
+        masses: NDArray[np.float64],
+        radii: NDArray[np.float64],
+        lower: NDArray[np.float64],
+        upper: NDArray[np.float64],
+        boundary: str,
+        stop_reason: str,
+    ) -> None:
         self.times = times
         self.positions = positions
         self.velocities = velocities
@@ -83,7 +96,9 @@ class Trajectory:
     def _need(self, name: str) -> Any:
         value = getattr(self, name)
         if value is None:
-            raise ValueError(f"this trajectory did not store {name}; run with store including {name!r}")
+            raise ValueError(
+                f"this trajectory did not store {name}; run with store including {name!r}"
+            )
         return value
 
     def pressure(self) -> float:
@@ -122,8 +137,9 @@ class Trajectory:
         area = 2.0 * sum(np.prod(np.delete(reach, a)) for a in range(self.dim))
         return float((self.wall_impulse[-1] - self.wall_impulse[0]) / ((t[-1] - t[0]) * area))
 
-    def msd(self, per_dimension: bool = False,
-            particles: ArrayLike | None = None) -> NDArray[np.float64]:
+    def msd(
+        self, per_dimension: bool = False, particles: ArrayLike | None = None
+    ) -> NDArray[np.float64]:
         """Ensemble mean squared displacement from the first sample, at every sample:
         (T,) summed over dimensions, or (T, d) with ``per_dimension=True``; see
         ``granular.analysis.msd``.  The same call as ``LangevinResult.msd`` and
@@ -138,9 +154,15 @@ class Trajectory:
 
         return analysis.msd(positions, per_dimension=per_dimension, particles=particles)
 
-    def tamsd(self, lags: ArrayLike | None = None, *, lag_samples: ArrayLike | None = None,
-              particles: ArrayLike | None = None, per_particle: bool = False,
-              method: str = "auto") -> NDArray[np.float64]:
+    def tamsd(
+        self,
+        lags: ArrayLike | None = None,
+        *,
+        lag_samples: ArrayLike | None = None,
+        particles: ArrayLike | None = None,
+        per_particle: bool = False,
+        method: str = "auto",
+    ) -> NDArray[np.float64]:
         """Time-averaged MSD, (L,) averaged over particles or (N, L) with
         ``per_particle=True``; see ``granular.analysis.tamsd``.  The same call as
         ``LangevinResult.tamsd`` and ``EnsembleResult.tamsd``, except that a trajectory
@@ -163,8 +185,15 @@ class Trajectory:
         positions = self._need("positions")
         from . import analysis
 
-        return analysis.tamsd(positions, lags, times=self.times, lag_samples=lag_samples,
-                              method=method, per_particle=per_particle, particles=particles)
+        return analysis.tamsd(
+            positions,
+            lags,
+            times=self.times,
+            lag_samples=lag_samples,
+            method=method,
+            per_particle=per_particle,
+            particles=particles,
+        )
 
     def to_universe(self) -> Any:
         """An MDAnalysis Universe of the particles (see ``granular.interop.to_universe``)."""
@@ -179,5 +208,7 @@ class Trajectory:
 
     def __repr__(self) -> str:
         span = f"t = {self.times[0]:.4g} .. {self.times[-1]:.4g}" if len(self.times) else "empty"
-        return (f"Trajectory({len(self.times)} samples, {span}, n={self.n}, dim={self.dim}, "
-                f"stop_reason={self.stop_reason!r})")
+        return (
+            f"Trajectory({len(self.times)} samples, {span}, n={self.n}, dim={self.dim}, "
+            f"stop_reason={self.stop_reason!r})"
+        )

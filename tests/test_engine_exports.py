@@ -1,6 +1,7 @@
 """The engine's rules are owned by the C core and read from it by the Python side
 (issue 14): the big-particle rule and its default, the bytes per particle, and the
 checks of a configuration without building an engine."""
+
 import math
 
 import numpy as np
@@ -13,9 +14,18 @@ from granular.scene import BIG_RATIO
 
 
 def _arrays(scene):
-    return (scene.positions, scene.velocities, scene.radii, scene.masses, scene.lower,
-            scene.upper, scene.boundary == "periodic", scene.wall_restitution,
-            scene.restitution, scene.contact_duration)
+    return (
+        scene.positions,
+        scene.velocities,
+        scene.radii,
+        scene.masses,
+        scene.lower,
+        scene.upper,
+        scene.boundary == "periodic",
+        scene.wall_restitution,
+        scene.restitution,
+        scene.contact_duration,
+    )
 
 
 def test_big_rule_and_default_come_from_c():
@@ -67,7 +77,10 @@ def test_scene_and_simulation_do_not_import_each_other():
     src = pathlib.Path(granular.__file__).parent
     for name, banned in (("scene", {"simulation"}), ("_edmd", {"scene", "simulation"})):
         tree = ast.parse((src / f"{name}.py").read_text())
-        imported = {alias.name for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)
-                    for alias in node.names} | {node.module for node in ast.walk(tree)
-                                                if isinstance(node, ast.ImportFrom)}
+        imported = {
+            alias.name
+            for node in ast.walk(tree)
+            if isinstance(node, ast.ImportFrom)
+            for alias in node.names
+        } | {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
         assert not imported & banned, name

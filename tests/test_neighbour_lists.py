@@ -2,14 +2,15 @@
 cell-crossing mode and as the slow reference, conservation and no overlaps where lists
 matter (dense 3D), lists that grow, periodic wrapping at rebuilds, and the automatic
 choice."""
+
 import math
 
 import numpy as np
 import pytest
 
+import granular
 from granular import Scene, Simulation
 
-import granular
 from helpers import reference_edmd
 from helpers.scenes import min_distance_ratio, reference_scene, three_in_line, tracer_scene
 
@@ -25,9 +26,17 @@ def _lists(scene, shell=0.25, **kw):
     return sim
 
 
-@pytest.mark.parametrize("dim,boundary,xi,mixture", [(2, "walls", 1.0, False), (2, "periodic", 0.7, False),
-                                                     (3, "periodic", 1.0, False), (3, "walls", 0.8, False),
-                                                     (2, "periodic", 0.9, True), (3, "periodic", 1.0, True)])
+@pytest.mark.parametrize(
+    "dim,boundary,xi,mixture",
+    [
+        (2, "walls", 1.0, False),
+        (2, "periodic", 0.7, False),
+        (3, "periodic", 1.0, False),
+        (3, "walls", 0.8, False),
+        (2, "periodic", 0.9, True),
+        (3, "periodic", 1.0, True),
+    ],
+)
 @pytest.mark.parametrize("shell", [0.02, 0.25])
 def test_agrees_with_slow_reference(dim, boundary, xi, mixture, shell):
     """As test_simulation's reference test (same tolerance, same reasoning: ~10
@@ -44,9 +53,19 @@ def test_agrees_with_slow_reference(dim, boundary, xi, mixture, shell):
     tr = sim.run(t_stop=1.0, sample_times=times)
     assert sim.stats["pair_collisions"] >= n
     assert sim.stats["shell_exits"] >= n and sim.stats["cell_crossings"] == 0  # lists rebuilt
-    rx, rv = reference_edmd.run(np.array(s.positions), np.array(s.velocities), s.radii,
-                                s.masses, s.lower, s.upper, boundary == "periodic", xi,
-                                1.0, times, wall_e=s.wall_restitution)
+    rx, rv = reference_edmd.run(
+        np.array(s.positions),
+        np.array(s.velocities),
+        s.radii,
+        s.masses,
+        s.lower,
+        s.upper,
+        boundary == "periodic",
+        xi,
+        1.0,
+        times,
+        wall_e=s.wall_restitution,
+    )
     atol = 1e-7 if (shell, dim, mixture) == (0.02, 2, True) else 1e-8
     np.testing.assert_allclose(tr.positions, rx, rtol=0, atol=atol)
     np.testing.assert_allclose(tr.velocities, rv, rtol=0, atol=atol)

@@ -3,6 +3,7 @@
 Tolerances: statistical ones come from the sample sizes (stated at each assert); where an
 approximate theory is the reference (Carnahan-Starling, Henderson, Enskog), its own
 accuracy at that density is the tolerance."""
+
 import functools
 import math
 
@@ -11,6 +12,7 @@ import pytest
 from scipy import stats
 
 from granular import Scene, Simulation, theory
+
 from helpers.margins import diffusion_margin, haff_margin
 
 
@@ -41,15 +43,18 @@ def test_fixed_speeds_relax_to_maxwell_boltzmann(dim):
     assert abs(k0 - 3.0) > 1.0
 
 
-@pytest.mark.parametrize("dim,eta,accuracy", [
-    # Carnahan-Starling Z = (1 + eta + eta^2 - eta^3) / (1 - eta)^3: within 0.3% of
-    # simulation data up to eta = 0.45
-    (3, 0.065, 0.01),
-    (3, 0.30, 0.01),
-    (3, 0.45, 0.015),
-    # Henderson Z = (1 + eta^2 / 8) / (1 - eta)^2: within 0.5% up to eta = 0.5
-    (2, 0.30, 0.01),
-])
+@pytest.mark.parametrize(
+    "dim,eta,accuracy",
+    [
+        # Carnahan-Starling Z = (1 + eta + eta^2 - eta^3) / (1 - eta)^3: within 0.3% of
+        # simulation data up to eta = 0.45
+        (3, 0.065, 0.01),
+        (3, 0.30, 0.01),
+        (3, 0.45, 0.015),
+        # Henderson Z = (1 + eta^2 / 8) / (1 - eta)^2: within 0.5% up to eta = 0.5
+        (2, 0.30, 0.01),
+    ],
+)
 def test_pressure_from_collision_virial_follows_the_equation_of_state(dim, eta, accuracy):
     """Compressibility factor Z = P / (n T) from the collision virial against the hard-sphere
     (hard-disk) equation of state.  Statistical error of the virial over ~1e5 collisions is
@@ -149,7 +154,8 @@ RUNS = 8
 K_SIGMA = float(stats.t.ppf(0.999, RUNS - 1))
 THESIS_N, THESIS_R = 1000, 0.025
 
-@functools.lru_cache(maxsize=None)
+
+@functools.cache
 def thesis_gas(k):
     """Run k of the thesis' standard gas, equilibrated as a molecular gas (20 collisions
     per particle from fixed speeds sqrt(2): T0 = 2/3).  Scenes are immutable, so the Haff
@@ -169,7 +175,8 @@ def assert_within_theory(ratios, margin):
     assert not np.any(bad), (
         f"ours/theory = {np.round(np.atleast_1d(mean)[np.atleast_1d(bad)], 4)} +- "
         f"{np.round(np.atleast_1d(se)[np.atleast_1d(bad)], 4)} (SE over {RUNS} runs), "
-        f"margin {np.round(np.broadcast_to(margin, np.shape(mean))[bad], 4)}, K = {K_SIGMA:.2f}")
+        f"margin {np.round(np.broadcast_to(margin, np.shape(mean))[bad], 4)}, K = {K_SIGMA:.2f}"
+    )
 
 
 @pytest.mark.parametrize("xi", [0.9, 0.8, 0.5])
@@ -201,8 +208,9 @@ def msd_margin(times, c, xi):
 
     h = 1e-6
     base = np.log(theory.msd_granular(times, c.D0, c.gamma0, c.tau0))
-    s_d = (np.log(theory.msd_granular(times, c.D0 * (1 + h), c.gamma0 / (1 + h), c.tau0))
-           - base) / h
+    s_d = (
+        np.log(theory.msd_granular(times, c.D0 * (1 + h), c.gamma0 / (1 + h), c.tau0)) - base
+    ) / h
     margin = np.abs(s_d) * diffusion_margin(xi)
     if xi < 1:  # D0 and tau0 are separate approximations: their errors add, as a bound
         s_tau = (np.log(theory.msd_granular(times, c.D0, c.gamma0, c.tau0 * (1 + h))) - base) / h

@@ -1,4 +1,5 @@
 """Scenes: construction, random placement and velocities, and every bad input."""
+
 import itertools
 import math
 
@@ -8,6 +9,7 @@ from scipy import stats
 
 import granular
 from granular import Scene, Simulation
+
 from helpers.scenes import three_in_line
 
 
@@ -49,18 +51,24 @@ def _fcc_order(positions, n):
     S(|G|) times an Exp(1) variable (central limit theorem), so Q ~ S Gamma(13) / 13.
     """
     k = math.ceil((n / 4) ** (1 / 3))
-    stars = [g for g in itertools.product(range(-2, 3), repeat=3)
-             if sum(x * x for x in g) in (3, 4, 8) and len({x % 2 for x in g}) == 1]
+    stars = [
+        g
+        for g in itertools.product(range(-2, 3), repeat=3)
+        if sum(x * x for x in g) in (3, 4, 8) and len({x % 2 for x in g}) == 1
+    ]
     half = [g for g in stars if g > tuple(-x for x in g)]  # one of each +-G pair
     G = 2 * math.pi * k * np.array(half, dtype=float)
     rho = np.exp(1j * positions @ G.T).mean(axis=0)
     return len(positions) * float(np.mean(np.abs(rho) ** 2)), len(half)
 
 
-@pytest.mark.parametrize("eta", [
-    0.33,  # above the 3D random-addition limit (0.28): placed on the lattice, then melted
-    0.45,  # dense, below freezing (0.494): needs hundreds of collisions per particle
-])
+@pytest.mark.parametrize(
+    "eta",
+    [
+        0.33,  # above the 3D random-addition limit (0.28): placed on the lattice, then melted
+        0.45,  # dense, below freezing (0.494): needs hundreds of collisions per particle
+    ],
+)
 def test_dense_random_scene_melts_a_lattice(eta):
     """A dense scene starts on an FCC lattice (scene._place_lattice) and must come out a
     fluid.  Order measure: Q of ``_fcc_order`` -- N for the unmelted lattice, S(G) times
@@ -76,8 +84,9 @@ def test_dense_random_scene_melts_a_lattice(eta):
     n = 2000
     r = (eta / (n * 4 / 3 * math.pi)) ** (1 / 3)
     assert eta > _RSA_LIMIT[3]  # the lattice route is taken
-    lattice, _ = _place_lattice(np.random.default_rng(2), np.full(n, r), np.zeros(3),
-                                np.ones(3), True)
+    lattice, _ = _place_lattice(
+        np.random.default_rng(2), np.full(n, r), np.zeros(3), np.ones(3), True
+    )
     q_lattice, m = _fcc_order(lattice, n)
     assert m == 13
     assert q_lattice == pytest.approx(n, rel=1e-9)  # the measure sees the lattice
@@ -85,8 +94,9 @@ def test_dense_random_scene_melts_a_lattice(eta):
     assert s.packing_fraction == pytest.approx(eta)
     bound = 2.85 * stats.gamma.isf(1e-6, m) / m
     q_melted, _ = _fcc_order(s.positions, n)
-    assert q_melted < bound, (f"lattice order left: Q = {q_melted:.1f} "
-                              f"(fluid: < {bound:.1f}, lattice: {n})")
+    assert q_melted < bound, (
+        f"lattice order left: Q = {q_melted:.1f} (fluid: < {bound:.1f}, lattice: {n})"
+    )
 
 
 def test_too_dense_random_scene_is_refused():
@@ -95,8 +105,9 @@ def test_too_dense_random_scene_is_refused():
         Scene.random(n, (0.8 / (n * 4 / 3 * math.pi)) ** (1 / 3), seed=2)
 
 
-@pytest.mark.parametrize("dim,boundary", [(2, "periodic"), (2, "walls"), (3, "periodic"),
-                                          (3, "walls")])
+@pytest.mark.parametrize(
+    "dim,boundary", [(2, "periodic"), (2, "walls"), (3, "periodic"), (3, "walls")]
+)
 def test_random_mixtures_keep_each_particle_its_radius(dim, boundary):
     """Two and three species, size ratios up to 3, packing up to the RSA limit, many seeds:
     each particle gets the radius asked for at its index (the scene validates, so no
@@ -157,30 +168,41 @@ def make(**changes):
     return Scene(p, v, r, **kw)
 
 
-@pytest.mark.parametrize("changes,error,match", [
-    (dict(positions=[[0.2, 0.2], [0.3, 0.2]]), granular.OverlapError, "particles 0 and 1 overlap"),
-    (dict(positions=[[0.2, 0.2], [1.6, 0.6]]), granular.OutsideBoxError, "particle 1"),
-    (dict(positions=[[0.05, 0.2], [0.6, 0.6]], boundary="walls"), granular.OutsideBoxError, "crosses a wall"),
-    (dict(positions=[[np.nan, 0.2], [0.6, 0.6]]), ValueError, "NaN"),
-    (dict(velocities=[[np.inf, 0], [0, 1]]), ValueError, "NaN or infinity"),
-    (dict(radii=[0.1, -0.1]), ValueError, "radii must be positive"),
-    (dict(radii=[0.1, 0.0]), ValueError, "radii must be positive"),
-    (dict(masses=[1.0, 0.0]), ValueError, "masses must be positive"),
-    (dict(restitution=1.5), ValueError, "restitution must lie in"),
-    (dict(restitution=-0.1), ValueError, "restitution must lie in"),
-    (dict(wall_restitution=0.0), ValueError, "wall_restitution"),
-    (dict(contact_duration=-1.0), ValueError, "contact_duration"),
-    (dict(velocities=[[1, 0, 0], [0, 1, 0]]), ValueError, "velocities must have shape"),
-    (dict(positions=[[0.2], [0.6]]), ValueError, "shape"),
-    (dict(positions=[[0.2, 0.2, 0.2, 0.2]]), ValueError, "shape"),
-    (dict(positions=np.zeros((0, 2)), velocities=np.zeros((0, 2))), ValueError, "N >= 1"),
-    (dict(radii=[0.1, 0.1, 0.1]), ValueError, "radii must have shape"),
-    (dict(boundary="open"), ValueError, "boundary must be one of"),
-    (dict(box=(1.0, 0.0)), ValueError, "lower < upper"),
-    (dict(radii=0.3, positions=[[0.3, 0.3], [0.9, 0.9]]), ValueError, "two largest diameters"),
-    (dict(positions="abc"), TypeError, "positions must be numbers"),
-    (dict(velocities=[[1j, 0], [0, 1]]), TypeError, "velocities must be real numbers"),
-])
+@pytest.mark.parametrize(
+    "changes,error,match",
+    [
+        (
+            dict(positions=[[0.2, 0.2], [0.3, 0.2]]),
+            granular.OverlapError,
+            "particles 0 and 1 overlap",
+        ),
+        (dict(positions=[[0.2, 0.2], [1.6, 0.6]]), granular.OutsideBoxError, "particle 1"),
+        (
+            dict(positions=[[0.05, 0.2], [0.6, 0.6]], boundary="walls"),
+            granular.OutsideBoxError,
+            "crosses a wall",
+        ),
+        (dict(positions=[[np.nan, 0.2], [0.6, 0.6]]), ValueError, "NaN"),
+        (dict(velocities=[[np.inf, 0], [0, 1]]), ValueError, "NaN or infinity"),
+        (dict(radii=[0.1, -0.1]), ValueError, "radii must be positive"),
+        (dict(radii=[0.1, 0.0]), ValueError, "radii must be positive"),
+        (dict(masses=[1.0, 0.0]), ValueError, "masses must be positive"),
+        (dict(restitution=1.5), ValueError, "restitution must lie in"),
+        (dict(restitution=-0.1), ValueError, "restitution must lie in"),
+        (dict(wall_restitution=0.0), ValueError, "wall_restitution"),
+        (dict(contact_duration=-1.0), ValueError, "contact_duration"),
+        (dict(velocities=[[1, 0, 0], [0, 1, 0]]), ValueError, "velocities must have shape"),
+        (dict(positions=[[0.2], [0.6]]), ValueError, "shape"),
+        (dict(positions=[[0.2, 0.2, 0.2, 0.2]]), ValueError, "shape"),
+        (dict(positions=np.zeros((0, 2)), velocities=np.zeros((0, 2))), ValueError, "N >= 1"),
+        (dict(radii=[0.1, 0.1, 0.1]), ValueError, "radii must have shape"),
+        (dict(boundary="open"), ValueError, "boundary must be one of"),
+        (dict(box=(1.0, 0.0)), ValueError, "lower < upper"),
+        (dict(radii=0.3, positions=[[0.3, 0.3], [0.9, 0.9]]), ValueError, "two largest diameters"),
+        (dict(positions="abc"), TypeError, "positions must be numbers"),
+        (dict(velocities=[[1j, 0], [0, 1]]), TypeError, "velocities must be real numbers"),
+    ],
+)
 def test_bad_scenes_raise_clear_errors(changes, error, match):
     with pytest.raises(error, match=match):
         make(**changes)
@@ -212,7 +234,7 @@ def test_bad_run_arguments():
         sim.run(t_stop=0.5)
     with pytest.raises(ValueError, match="before the current time"):
         sim.run(t_stop=2.0, sample_times=[0.5, 1.5])
-    with pytest.raises(TypeError, match="needs a granular.Scene"):
+    with pytest.raises(TypeError, match=r"needs a granular\.Scene"):
         Simulation("scene")
     with pytest.raises(ValueError, match="cell_factor"):
         Simulation(Scene.random(20, 0.05, seed=1), cell_factor=0.5)
@@ -227,6 +249,7 @@ def test_heated_walls_report_non_finite_velocities():
 
 
 # -- inelastic collapse ------------------------------------------------------------------
+
 
 def test_collapse_of_three_disks_is_detected():
     """Three disks in a line collapse for xi < 7 - 4 sqrt 3 = 0.0718 (thesis 2.3): the
@@ -269,12 +292,18 @@ def test_si_units_work():
     assert s.temperature == pytest.approx(kT, rel=0.3)  # 200 Maxwellian particles
 
 
-@pytest.mark.parametrize("change,match", [
-    (dict(masses=1e-310), "smallest mass"),
-    (dict(masses=1e308), "mass = 1e\\+308"),
-    (dict(masses=np.where(np.arange(8) % 2, 1e-279, 1.0)), "diameter squared times the smallest mass"),
-    (dict(velocities=np.full((8, 3), 1e154)), "largest speed"),
-])
+@pytest.mark.parametrize(
+    "change,match",
+    [
+        (dict(masses=1e-310), "smallest mass"),
+        (dict(masses=1e308), "mass = 1e\\+308"),
+        (
+            dict(masses=np.where(np.arange(8) % 2, 1e-279, 1.0)),
+            "diameter squared times the smallest mass",
+        ),
+        (dict(velocities=np.full((8, 3), 1e154)), "largest speed"),
+    ],
+)
 def test_scales_outside_float64s_reach_are_refused(change, match):
     """Masses 1e-310 or 1e308, speeds 1e154 gave NaN positions, pairs passing through each
     other or collisions without impulse; now the scene names the scale that is out of range."""
@@ -295,7 +324,7 @@ def test_a_box_far_from_the_origin_must_still_resolve_a_diameter(offset, ok):
     if ok:
         make()
     else:
-        with pytest.raises(ValueError, match="resolves coordinates near .* move the box"):
+        with pytest.raises(ValueError, match=r"resolves coordinates near .* move the box"):
             make()
 
 

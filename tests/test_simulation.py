@@ -1,4 +1,5 @@
 """The event-driven engine: exact cases, conservation laws, a slow reference, determinism."""
+
 import copy
 import math
 import pickle
@@ -20,11 +21,11 @@ def two_disks(v1, v2, xi=1.0, dim=2, boundary="walls", m=(1.0, 1.0), y2=0.5):
     pos = np.array([[0.3, 0.5], [0.7, y2]])
     if dim == 3:
         pos = np.hstack([pos, [[0.5], [0.5]]])
-    return Scene(pos, [v1, v2], 0.05, masses=list(m), box=1.0, boundary=boundary,
-                 restitution=xi)
+    return Scene(pos, [v1, v2], 0.05, masses=list(m), box=1.0, boundary=boundary, restitution=xi)
 
 
 # -- exact cases ------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("xi", [1.0, 0.8, 0.0])
 def test_head_on_collision(xi):
@@ -93,8 +94,9 @@ def test_momentum_conserved_and_restitution_holds_for_mixtures(masses):
     s = two_disks([1.0, 0.3], [-0.4, 0.0], xi=xi, m=masses, y2=0.54)
     tr = Simulation(s).run(t_stop=0.4, sample_times=[0.0, 0.4])
     m = np.array(masses)[:, None]
-    np.testing.assert_allclose((m * tr.velocities[1]).sum(0), (m * tr.velocities[0]).sum(0),
-                               atol=1e-15)
+    np.testing.assert_allclose(
+        (m * tr.velocities[1]).sum(0), (m * tr.velocities[0]).sum(0), atol=1e-15
+    )
     # normal direction at contact from the post-collision state traced back
     x, v0, v1 = s.positions, tr.velocities[0], tr.velocities[1]
     dx, dv = x[1] - x[0], v0[1] - v0[0]
@@ -106,7 +108,10 @@ def test_momentum_conserved_and_restitution_holds_for_mixtures(masses):
 
 # -- conservation over many collisions ---------------------------------------------------
 
-@pytest.mark.parametrize("dim,boundary", [(3, "periodic"), (2, "periodic"), (3, "walls"), (2, "walls")])
+
+@pytest.mark.parametrize(
+    "dim,boundary", [(3, "periodic"), (2, "periodic"), (3, "walls"), (2, "walls")]
+)
 def test_energy_and_momentum_conserved_over_a_million_collisions(dim, boundary):
     """xi = 1: kinetic energy constant to 1e-13 relative over >= 1e6 pair collisions; total
     momentum (periodic) constant to 1e-13 of sum m|v|.  Rounding alone: each collision
@@ -117,8 +122,7 @@ def test_energy_and_momentum_conserved_over_a_million_collisions(dim, boundary):
     s = Scene.random(n, radius, dim=dim, boundary=boundary, seed=11)
     sim = Simulation(s)
     # 2 * 1e6 pair collisions / N = 1000 per particle, plus room for wall collisions
-    tr = sim.run(stop_when={"collisions_per_particle": 1300.0}, store=(),
-                 sample_times=None)
+    tr = sim.run(stop_when={"collisions_per_particle": 1300.0}, store=(), sample_times=None)
     assert sim.stats["pair_collisions"] >= 1_000_000
     e0, e1 = tr.kinetic_energy[0], tr.kinetic_energy[-1]
     assert abs(e1 / e0 - 1) <= 1e-13
@@ -136,10 +140,10 @@ def test_no_overlaps_at_any_sample_dense(dim, boundary):
     n = 1000
     eta = 0.4 if dim == 3 else 0.6
     r = (eta / (n * 4 / 3 * math.pi)) ** (1 / 3) if dim == 3 else math.sqrt(eta / (n * math.pi))
-    s = Scene.random(n, r, dim=dim, boundary=boundary, restitution=0.9,
-                     contact_duration=1e-6, seed=5)
-    tr = Simulation(s).run(t_stop=0.5, sample_times=np.linspace(0, 0.5, 26),
-                           store=("positions",))
+    s = Scene.random(
+        n, r, dim=dim, boundary=boundary, restitution=0.9, contact_duration=1e-6, seed=5
+    )
+    tr = Simulation(s).run(t_stop=0.5, sample_times=np.linspace(0, 0.5, 26), store=("positions",))
     for x in tr.positions:
         assert min_distance_ratio(s, x) >= 1 - 1e-10
 
@@ -173,9 +177,18 @@ def test_centre_of_mass_moves_with_total_momentum(n):
 
 # -- against the slow reference ------------------------------------------------------------
 
-@pytest.mark.parametrize("dim,boundary,xi,mixture", [(2, "walls", 1.0, False), (2, "periodic", 0.7, False),
-                                                     (3, "periodic", 1.0, False), (3, "walls", 0.8, False),
-                                                     (2, "periodic", 0.9, True), (3, "walls", 1.0, True)])
+
+@pytest.mark.parametrize(
+    "dim,boundary,xi,mixture",
+    [
+        (2, "walls", 1.0, False),
+        (2, "periodic", 0.7, False),
+        (3, "periodic", 1.0, False),
+        (3, "walls", 0.8, False),
+        (2, "periodic", 0.9, True),
+        (3, "walls", 1.0, True),
+    ],
+)
 def test_agrees_with_slow_reference(dim, boundary, xi, mixture):
     """Same events as an O(N^2)-per-event NumPy EDMD, sample by sample, for a short time
     (chaos amplifies rounding differences by ~e per collision, so the comparison stays
@@ -188,14 +201,25 @@ def test_agrees_with_slow_reference(dim, boundary, xi, mixture):
     sim = Simulation(s)
     tr = sim.run(t_stop=t_stop, sample_times=times)
     assert sim.stats["pair_collisions"] >= n
-    rx, rv = reference_edmd.run(np.array(s.positions), np.array(s.velocities), s.radii,
-                                s.masses, s.lower, s.upper, boundary == "periodic", xi,
-                                t_stop, times, wall_e=s.wall_restitution)
+    rx, rv = reference_edmd.run(
+        np.array(s.positions),
+        np.array(s.velocities),
+        s.radii,
+        s.masses,
+        s.lower,
+        s.upper,
+        boundary == "periodic",
+        xi,
+        t_stop,
+        times,
+        wall_e=s.wall_restitution,
+    )
     np.testing.assert_allclose(tr.positions, rx, rtol=0, atol=1e-8)
     np.testing.assert_allclose(tr.velocities, rv, rtol=0, atol=1e-8)
 
 
 # -- runs: continuation, stop criteria, sampling, determinism ------------------------------
+
 
 @pytest.mark.parametrize("n", [300, 5000])
 def test_continued_run_equals_one_run(n):
@@ -316,14 +340,19 @@ def test_progress_bar_and_memory_guard(capsys):
     Simulation(s).run(t_stop=0.5, progress=True)
     Simulation(s).run(stop_when={"collisions_per_particle": 3}, progress=True)
     with pytest.raises(MemoryError, match="store=\\(\\)"):
-        Simulation(s).run(t_stop=1.0, sample_times=np.linspace(0, 1, 10**7))  # 10^7 x 200 x 3 x 2 doubles = 96 GB
+        Simulation(s).run(
+            t_stop=1.0, sample_times=np.linspace(0, 1, 10**7)
+        )  # 10^7 x 200 x 3 x 2 doubles = 96 GB
 
 
-@pytest.mark.skipif("libasan" in __import__("os").environ.get("LD_PRELOAD", ""),
-                    reason="AddressSanitizer quarantines freed memory, so RSS grows anyway")
+@pytest.mark.skipif(
+    "libasan" in __import__("os").environ.get("LD_PRELOAD", ""),
+    reason="AddressSanitizer quarantines freed memory, so RSS grows anyway",
+)
 def test_repeated_simulations_do_not_leak():
     """Build and run many engines: resident memory must not grow with the count (each
     engine holds ~0.5 MB, so a leak of it would add ~100 MB over 200 rounds)."""
+
     def rss():
         with open("/proc/self/statm") as f:
             return int(f.read().split()[1]) * 4096
@@ -391,8 +420,13 @@ def test_stats_pressure_is_the_time_average(xi):
 def test_collapse_keeps_the_samples_taken_before_it():
     """The error carries the trajectory up to the collapse: three disks in a line with
     xi below 7 - 4 sqrt 3 collapse at t = 0.1 (tests/test_scene.py)."""
-    s = Scene([[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]], [[1, 0], [0, 0], [-1, 0]], 0.05,
-              boundary="walls", restitution=0.05)
+    s = Scene(
+        [[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]],
+        [[1, 0], [0, 0], [-1, 0]],
+        0.05,
+        boundary="walls",
+        restitution=0.05,
+    )
     times = np.linspace(0.0, 10.0, 1001)
     with pytest.raises(granular.InelasticCollapseError) as info:
         Simulation(s).run(t_stop=10.0, sample_times=times)
@@ -404,7 +438,10 @@ def test_collapse_keeps_the_samples_taken_before_it():
 
 # -- a large tracer among small particles ---------------------------------------------------
 
-@pytest.mark.parametrize("dim,boundary", [(2, "periodic"), (2, "walls"), (3, "periodic"), (3, "walls")])
+
+@pytest.mark.parametrize(
+    "dim,boundary", [(2, "periodic"), (2, "walls"), (3, "periodic"), (3, "walls")]
+)
 def test_large_tracer_agrees_with_slow_reference(dim, boundary):
     """A tracer five times wider than the rest stays out of the cell grid (cells sized by
     the small particles, as the cell count shows); its collisions must be exactly those
@@ -417,9 +454,18 @@ def test_large_tracer_agrees_with_slow_reference(dim, boundary):
     tr = sim.run(t_stop=0.5, sample_times=times)
     assert min(sim.stats["cells"][:dim]) > 1.0 / (2 * big)  # finer than the tracer
     assert sim.stats["pair_collisions"] >= n // 3
-    rx, rv = reference_edmd.run(np.array(s.positions), np.array(s.velocities), s.radii,
-                                s.masses, s.lower, s.upper, boundary == "periodic", 0.9, 0.5,
-                                times)
+    rx, rv = reference_edmd.run(
+        np.array(s.positions),
+        np.array(s.velocities),
+        s.radii,
+        s.masses,
+        s.lower,
+        s.upper,
+        boundary == "periodic",
+        0.9,
+        0.5,
+        times,
+    )
     np.testing.assert_allclose(tr.positions, rx, rtol=0, atol=1e-8)
     np.testing.assert_allclose(tr.velocities, rv, rtol=0, atol=1e-8)
 
@@ -448,11 +494,12 @@ def test_large_tracer_long_run_conserves_and_never_overlaps(dim):
 
 # -- issue 13: unreachable energy targets, rounding past t_stop, heated walls, threads ------
 
+
 def test_energy_target_without_a_dissipative_channel_is_refused():
     """A lone particle cannot collide with anyone, and elastic walls take no energy: the
     energy never falls, so the target is refused at once (this used to run forever)."""
     lone = Scene.random(1, 0.05, boundary="walls", restitution=0.9, seed=3)
-    with pytest.raises(ValueError, match="can never be reached.*single particle"):
+    with pytest.raises(ValueError, match=r"can never be reached.*single particle"):
         Simulation(lone).run(stop_when={"kinetic_energy": 0.1})
     # absorbing walls do take energy: the same target is reached
     sim = Simulation(lone.replace(wall_restitution=0.5))
@@ -465,8 +512,14 @@ def test_stall_guard_counts_only_progress_towards_the_criterion(monkeypatch):
     dissipative collisions and raises after its limit (lowered here to 1e5 events to keep
     the test fast); under a collision target the wall hits are progress and it ends."""
     monkeypatch.setattr(granular.simulation._StallGuard, "MIN_LIMIT", 10**5)
-    s = Scene([[0.3, 0.25], [0.6, 0.75]], [[1.0, 0.0], [-1.0, 0.0]], 0.05, box=1.0,
-              boundary="walls", restitution=0.9)
+    s = Scene(
+        [[0.3, 0.25], [0.6, 0.75]],
+        [[1.0, 0.0], [-1.0, 0.0]],
+        0.05,
+        box=1.0,
+        boundary="walls",
+        restitution=0.9,
+    )
     sim = Simulation(s)
     with pytest.raises(granular.NoProgressError, match="no dissipative collision"):
         sim.run(stop_when={"kinetic_energy": 0.1})
@@ -499,15 +552,22 @@ def test_heated_walls_blowing_up_are_not_called_a_collapse():
     (three disks in a line, xi = 0.05 < 7 - 4 sqrt 3, at t = 0.1, long before any wall
     hit) in a box with heated walls stays an InelasticCollapseError."""
     s = Scene.random(4, 0.05, dim=3, boundary="walls", wall_restitution=1.5, seed=3)
-    with pytest.raises(granular.HeatedWallsError,
-                       match=r"wall_restitution = 1.5 > 1\) pumped .* float64") as info:
+    with pytest.raises(
+        granular.HeatedWallsError, match=r"wall_restitution = 1.5 > 1\) pumped .* float64"
+    ) as info:
         Simulation(s).run(10.0)
     assert isinstance(info.value, granular.GranularError) and isinstance(info.value, RuntimeError)
     assert not isinstance(info.value, granular.InelasticCollapseError)
     assert info.value.value > 1e6 and 0 < info.value.time < 10.0
     assert info.value.trajectory.stop_reason == "error"
-    line = Scene([[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]], [[1, 0], [0, 0], [-1, 0]], 0.05,
-                 boundary="walls", restitution=0.05, wall_restitution=1.01)
+    line = Scene(
+        [[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]],
+        [[1, 0], [0, 0], [-1, 0]],
+        0.05,
+        boundary="walls",
+        restitution=0.05,
+        wall_restitution=1.01,
+    )
     with pytest.raises(granular.InelasticCollapseError):
         Simulation(line).run(10.0)
 
@@ -558,14 +618,16 @@ def test_copying_or_pickling_a_simulation_is_refused():
 def test_plot_and_interop_are_attributes_imported_lazily():
     """The README writes granular.plot.msd after `import granular`; importing granular
     alone must not pull in matplotlib or MDAnalysis (fresh interpreter)."""
-    code = ("import sys, granular\n"
-            "assert 'matplotlib' not in sys.modules and 'MDAnalysis' not in sys.modules\n"
-            "assert callable(granular.plot.msd)\n"
-            "assert callable(granular.interop.to_universe)\n"
-            "assert 'plot' in dir(granular)\n")
+    code = (
+        "import sys, granular\n"
+        "assert 'matplotlib' not in sys.modules and 'MDAnalysis' not in sys.modules\n"
+        "assert callable(granular.plot.msd)\n"
+        "assert callable(granular.interop.to_universe)\n"
+        "assert 'plot' in dir(granular)\n"
+    )
     subprocess.run([sys.executable, "-c", code], check=True)
     with pytest.raises(AttributeError, match="no attribute 'nonesuch'"):
-        granular.nonesuch
+        _ = granular.nonesuch
 
 
 def test_trajectory_msd_and_tamsd_select_particles_and_take_lags_in_samples():
@@ -576,11 +638,13 @@ def test_trajectory_msd_and_tamsd_select_particles_and_take_lags_in_samples():
     d = tr.positions - tr.positions[0]
     np.testing.assert_allclose(tr.msd(particles=[7]), (d[:, 7] ** 2).sum(axis=1), rtol=1e-14)
     mask = np.arange(60) < 10
-    np.testing.assert_allclose(tr.msd(particles=mask), (d[:, :10] ** 2).sum(axis=2).mean(axis=1),
-                               rtol=1e-14)
+    np.testing.assert_allclose(
+        tr.msd(particles=mask), (d[:, :10] ** 2).sum(axis=2).mean(axis=1), rtol=1e-14
+    )
     lags = np.array([0.1, 0.5, 1.0])
-    np.testing.assert_allclose(tr.tamsd(lag_samples=[1, 5, 10], particles=[7]),
-                               tr.tamsd(lags, particles=[7]), rtol=1e-12)
+    np.testing.assert_allclose(
+        tr.tamsd(lag_samples=[1, 5, 10], particles=[7]), tr.tamsd(lags, particles=[7]), rtol=1e-12
+    )
     per = tr.tamsd(lags, per_particle=True)
     np.testing.assert_allclose(tr.tamsd(lags, particles=[7]), per[7], rtol=1e-12)
 
@@ -592,7 +656,7 @@ def test_a_gas_too_slow_for_float64_is_not_advanced():
     FrozenGasError instead of returning overlapping particles.  A gas at rest runs."""
     pos = np.array([[0.2, 0.5], [0.5, 0.5], [0.8, 0.5]])
     slow = Scene(pos, np.full((3, 2), 1e-150), 0.05, boundary="walls")
-    with pytest.raises(granular.FrozenGasError, match="below .* float64 can no longer"):
+    with pytest.raises(granular.FrozenGasError, match=r"below .* float64 can no longer"):
         Simulation(slow).run(t_stop=1e200)
     rest = Scene(pos, np.zeros((3, 2)), 0.05, boundary="walls")
     assert Simulation(rest).run(t_stop=1e200).stop_reason == "time"
@@ -606,5 +670,5 @@ def test_a_gas_too_slow_for_float64_is_not_advanced():
 def test_an_energy_target_float64_cannot_reach_is_refused(target):
     """A cooling gas only approaches zero energy: a target of 0 used to run forever."""
     s = Scene.random(20, 0.05, dim=3, restitution=0.9, seed=2)
-    with pytest.raises(ValueError, match="kinetic_energy .* is not above"):
+    with pytest.raises(ValueError, match=r"kinetic_energy .* is not above"):
         Simulation(s).run(stop_when={"kinetic_energy": target})

@@ -2,6 +2,7 @@
 against.  Every step computes every pair's collision time over all 3^d periodic images
 (or every wall time), moves all particles to the earliest event and applies the thesis'
 collision rule (2.10-2.11) or wall rule (2.22).  O(N^2) per event: tests only."""
+
 import itertools
 
 import numpy as np
@@ -9,8 +10,11 @@ import numpy as np
 
 def pair_times(x, v, r, L, periodic):
     n, d = x.shape
-    shifts = (np.array(list(itertools.product((-1, 0, 1), repeat=d))) * L
-              if periodic else np.zeros((1, d)))
+    shifts = (
+        np.array(list(itertools.product((-1, 0, 1), repeat=d))) * L
+        if periodic
+        else np.zeros((1, d))
+    )
     best = np.full((n, n), np.inf)
     for s in shifts:
         dr = x[None, :, :] + s - x[:, None, :]  # dr[i, j] = x_j + s - x_i

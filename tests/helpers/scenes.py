@@ -1,4 +1,5 @@
 """Small scenes and measures that several test modules share."""
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -6,8 +7,14 @@ from granular import Scene
 
 
 def three_in_line(xi, tc=0.0):
-    return Scene([[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]], [[1, 0], [0, 0], [-1, 0]], 0.05,
-                 boundary="walls", restitution=xi, contact_duration=tc)
+    return Scene(
+        [[0.3, 0.5], [0.5, 0.5], [0.7, 0.5]],
+        [[1, 0], [0, 0], [-1, 0]],
+        0.05,
+        boundary="walls",
+        restitution=xi,
+        contact_duration=tc,
+    )
 
 
 def min_distance_ratio(scene, positions):
@@ -32,13 +39,21 @@ def reference_scene(dim, boundary, xi, mixture, n=12):
     radius = 0.08 if dim == 2 else 0.1
     if mixture:
         radius = radius * np.linspace(0.6, 1.2, n)
-    return Scene.random(n, radius, dim=dim, boundary=boundary, restitution=xi,
-                        mass=(np.asarray(radius) / 0.1) ** dim if mixture else 1.0,
-                        wall_restitution=0.9 if boundary == "walls" and xi < 1 else 1.0, seed=7)
+    return Scene.random(
+        n,
+        radius,
+        dim=dim,
+        boundary=boundary,
+        restitution=xi,
+        mass=(np.asarray(radius) / 0.1) ** dim if mixture else 1.0,
+        wall_restitution=0.9 if boundary == "walls" and xi < 1 else 1.0,
+        seed=7,
+    )
 
 
 def tracer_scene(n, r, big, dim, boundary, xi, seed):
     """One particle of radius `big` among n of radius r, masses proportional to volume."""
     radii = np.r_[big, np.full(n, r)]
-    return Scene.random(n + 1, radii, dim=dim, boundary=boundary, restitution=xi,
-                        mass=(radii / r) ** dim, seed=seed)
+    return Scene.random(
+        n + 1, radii, dim=dim, boundary=boundary, restitution=xi, mass=(radii / r) ** dim, seed=seed
+    )
