@@ -337,7 +337,8 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
 {
     static char *names[] = {"t_stop", "collisions_per_particle", "kinetic_energy",
                             "max_events", "sample_times", "next", "positions", "velocities",
-                            "kinetic", "momentum", "pair", "wall", "virial", "wall_impulse",
+                            "kinetic_energy", "momentum", "pair_collisions", "wall_collisions",
+                            "virial", "wall_impulse",
                             NULL};
     gr_edmd_stop stop;
     long long max_events, next;
@@ -379,10 +380,10 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
     }
     if (!out_buffer(opos, "positions", NPY_FLOAT64, nd, (void **)&smp.pos) ||
         !out_buffer(ovel, "velocities", NPY_FLOAT64, nd, (void **)&smp.vel) ||
-        !out_buffer(okin, "kinetic", NPY_FLOAT64, T, (void **)&smp.kinetic) ||
+        !out_buffer(okin, "kinetic_energy", NPY_FLOAT64, T, (void **)&smp.kinetic) ||
         !out_buffer(omom, "momentum", NPY_FLOAT64, td, (void **)&smp.momentum) ||
-        !out_buffer(opair, "pair", NPY_INT64, T, (void **)&smp.pair) ||
-        !out_buffer(owall, "wall", NPY_INT64, T, (void **)&smp.wall) ||
+        !out_buffer(opair, "pair_collisions", NPY_INT64, T, (void **)&smp.pair) ||
+        !out_buffer(owall, "wall_collisions", NPY_INT64, T, (void **)&smp.wall) ||
         !out_buffer(ovir, "virial", NPY_FLOAT64, T, (void **)&smp.virial) ||
         !out_buffer(oimp, "wall_impulse", NPY_FLOAT64, T, (void **)&smp.wall_impulse)) {
         Py_DECREF(times);

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import itertools
 import math
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _edmd
 
@@ -29,7 +31,7 @@ _MELTED_ORDER = 3.0
 # are kept out of neighbour searches sized for the others: in the engine's cell grid
 # (Simulation's big_ratio) and in random placement.  The rule and its default belong to
 # the engine (csrc/big.c); both ask it through _core.
-BIG_RATIO = _core.BIG_RATIO
+BIG_RATIO: float = _core.BIG_RATIO
 
 
 # float64 holds magnitudes from 2.2e-308 to 1.8e308.  The collision arithmetic
@@ -173,17 +175,17 @@ class Scene:
 
     def __init__(
         self,
-        positions,
-        velocities,
-        radii,
-        masses=1.0,
+        positions: ArrayLike,
+        velocities: ArrayLike,
+        radii: ArrayLike,
+        masses: ArrayLike = 1.0,
         *,
-        box=1.0,
-        boundary="periodic",
-        wall_restitution=1.0,
-        restitution=1.0,
-        contact_duration=0.0,
-    ):
+        box: float | ArrayLike = 1.0,
+        boundary: str = "periodic",
+        wall_restitution: float = 1.0,
+        restitution: float = 1.0,
+        contact_duration: float = 0.0,
+    ) -> None:
         pos = _real(positions, "positions")
         if pos.ndim != 2 or pos.shape[1] not in (2, 3) or pos.shape[0] < 1:
             raise ValueError(
@@ -237,48 +239,48 @@ class Scene:
 
     # -- derived quantities ---------------------------------------------------------
     @property
-    def n(self):
+    def n(self) -> int:
         """Number of particles."""
         return self.positions.shape[0]
 
     @property
-    def dim(self):
+    def dim(self) -> int:
         """Dimension, 2 or 3."""
         return self.positions.shape[1]
 
     @property
-    def lengths(self):
+    def lengths(self) -> NDArray[np.float64]:
         """Box edge lengths, shape (d,)."""
         return self.upper - self.lower
 
     @property
-    def volume(self):
+    def volume(self) -> float:
         """Box volume (area in 2D)."""
         return float(np.prod(self.lengths))
 
     @property
-    def density(self):
+    def density(self) -> float:
         """Number density N / V."""
         return self.n / self.volume
 
     @property
-    def packing_fraction(self):
+    def packing_fraction(self) -> float:
         """Fraction of the box covered by particles (eta, thesis 2.44)."""
         r = self.radii
         unit = math.pi * r**2 if self.dim == 2 else 4.0 / 3.0 * math.pi * r**3
         return float(unit.sum() / self.volume)
 
     @property
-    def kinetic_energy(self):
+    def kinetic_energy(self) -> float:
         """Total kinetic energy."""
         return float(0.5 * np.sum(self.masses[:, None] * self.velocities**2))
 
     @property
-    def temperature(self):
+    def temperature(self) -> float:
         """Granular temperature T = 2 <E_kin> / d per particle (k_B = 1)."""
         return 2.0 * self.kinetic_energy / (self.dim * self.n)
 
-    def replace(self, **changes):
+    def replace(self, **changes: Any) -> Scene:
         """A copy with some fields changed, e.g. ``scene.replace(restitution=0.8)``."""
         fields = dict(
             positions=self.positions,
@@ -311,21 +313,21 @@ class Scene:
     @classmethod
     def random(
         cls,
-        n,
-        radius,
-        dim=3,
-        box=1.0,
-        boundary="periodic",
-        restitution=1.0,
+        n: int,
+        radius: float | ArrayLike,
+        dim: int = 3,
+        box: float | ArrayLike = 1.0,
+        boundary: str = "periodic",
+        restitution: float = 1.0,
         *,
-        speed=None,
-        temperature=None,
-        mass=1.0,
-        wall_restitution=1.0,
-        contact_duration=0.0,
-        remove_drift=True,
-        seed=None,
-    ):
+        speed: float | None = None,
+        temperature: float | None = None,
+        mass: float | ArrayLike = 1.0,
+        wall_restitution: float = 1.0,
+        contact_duration: float = 0.0,
+        remove_drift: bool = True,
+        seed: Any = None,
+    ) -> Scene:
         """Particles placed uniformly without overlap, with random velocities.
 
         Positions: random sequential addition (accepting uniform candidates that overlap
@@ -377,7 +379,7 @@ class Scene:
         unit = math.pi * radii**2 if dim == 2 else 4.0 / 3.0 * math.pi * radii**3
         eta = float(unit.sum() / volume)
         periodic = boundary == "periodic"
-        common = dict(
+        common: dict[str, Any] = dict(
             box=(lo, hi),
             boundary=boundary,
             wall_restitution=wall_restitution,
@@ -408,7 +410,7 @@ class Scene:
         return cls(engine.state()[0], velocities, radii, masses, **common)
 
     @classmethod
-    def seed_brownian_disks(cls, seed=None):
+    def seed_brownian_disks(cls, seed: Any = None) -> Scene:
         """The 2D Brownian-motion note's scene: 150 elastic hard disks of radius 0.1 and
         mass 1 between elastic walls at +-3, unit speed in random directions."""
         return cls.random(
@@ -423,7 +425,7 @@ class Scene:
         )
 
     @classmethod
-    def seed_ideal_gas(cls, n=100, radius=0.01, seed=None):
+    def seed_ideal_gas(cls, n: int = 100, radius: float = 0.01, seed: Any = None) -> Scene:
         """The lecture notes' ideal gas: elastic spheres in the unit box with reflecting
         walls and Maxwell-Boltzmann velocities at T = 1."""
         return cls.random(n, radius, dim=3, box=1.0, boundary="walls", temperature=1.0, seed=seed)

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import math
 import threading
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _edmd
 from ._edmd import check_memory as _check_memory
@@ -22,6 +24,16 @@ from .trajectory import Trajectory, _pressure_volume
 _STOP_KEYS = ("collisions_per_particle", "kinetic_energy", "events")
 _CHUNK = _edmd.CHUNK
 _STORE = ("positions", "velocities")
+# What a sample records besides positions, velocities and momentum: the engine's counters
+# at that instant.  One name each, shared by the engine's counters, the binding's sample
+# buffers and Trajectory's attributes.
+_COUNTED = (
+    ("kinetic_energy", np.float64),
+    ("pair_collisions", np.int64),
+    ("wall_collisions", np.int64),
+    ("virial", np.float64),
+    ("wall_impulse", np.float64),
+)
 _LIST_SHELL = _edmd.LIST_SHELL  # see _edmd
 
 
@@ -52,7 +64,14 @@ class Simulation:
         ran.
     """
 
-    def __init__(self, scene, *, cell_factor=1.0, big_ratio=BIG_RATIO, shell="auto"):
+    def __init__(
+        self,
+        scene: Scene,
+        *,
+        cell_factor: float = 1.0,
+        big_ratio: float = BIG_RATIO,
+        shell: str | float = "auto",
+    ) -> None:
         if not isinstance(scene, Scene):
             raise TypeError(f"Simulation needs a granular.Scene, got {type(scene).__name__}")
         self._initial = scene
@@ -73,12 +92,12 @@ class Simulation:
 
     # -- state ----------------------------------------------------------------------
     @property
-    def time(self):
+    def time(self) -> float:
         """Current simulation time."""
         return self._engine.counters()["time"]
 
     @property
-    def stats(self):
+    def stats(self) -> dict[str, Any]:
         """Counters since the start: events, pair_collisions, wall_collisions,
         cell_crossings (cell mode), shell_exits (neighbour lists: each rebuilds one
         list), stale_events,
@@ -103,7 +122,7 @@ class Simulation:
         return c
 
     @property
-    def scene(self):
+    def scene(self) -> Scene:
         """The current state as a new Scene (positions wrapped into a periodic box)."""
         pos, vel, _ = self._engine.state()
         s = self._initial
@@ -120,13 +139,21 @@ class Simulation:
         )
 
     @property
-    def unwrapped_positions(self):
+    def unwrapped_positions(self) -> NDArray[np.float64]:
         """(N, d) positions at the current time with periodic images undone."""
         pos, _, img = self._engine.state()
         return pos + img * (self._initial.upper - self._initial.lower)
 
     # -- running --------------------------------------------------------------------
-    def run(self, t_stop=None, *, sample_times=None, stop_when=None, store=_STORE, progress=False):
+    def run(
+        self,
+        t_stop: float | None = None,
+        *,
+        sample_times: ArrayLike | None = None,
+        stop_when: dict[str, float] | None = None,
+        store: tuple[str, ...] | list[str] = _STORE,
+        progress: bool = False,
+    ) -> Trajectory:
         """Advance until ``t_stop`` (absolute time) or a ``stop_when`` criterion, whichever
         comes first, and return the samples as a Trajectory.
 
@@ -348,24 +375,17 @@ class Simulation:
             buf["positions"][k] = self.unwrapped_positions
         if buf["velocities"] is not None:
             buf["velocities"][k] = vel
-        buf["kinetic"][k] = c["kinetic_energy"]
         buf["momentum"][k] = (m * vel).sum(axis=0)
-        buf["pair"][k] = c["pair_collisions"]
-        buf["wall"][k] = c["wall_collisions"]
-        buf["virial"][k] = c["virial"]
-        buf["wall_impulse"][k] = c["wall_impulse"]
+        for name, _ in _COUNTED:
+            buf[name][k] = c[name]
 
     def _buffers(self, count, store):
         n, d = self._initial.n, self._initial.dim
         return dict(
             positions=np.zeros((count, n, d)) if "positions" in store else None,
             velocities=np.zeros((count, n, d)) if "velocities" in store else None,
-            kinetic=np.zeros(count),
             momentum=np.zeros((count, d)),
-            pair=np.zeros(count, dtype=np.int64),
-            wall=np.zeros(count, dtype=np.int64),
-            virial=np.zeros(count),
-            wall_impulse=np.zeros(count),
+            **{name: np.zeros(count, dtype=dtype) for name, dtype in _COUNTED},
         )
 
     def _trajectory(self, times, buf, k, reason):
@@ -373,14 +393,7 @@ class Simulation:
         cut = {name: (None if a is None else a[:k].copy()) for name, a in buf.items()}
         return Trajectory(
             times.copy(),
-            cut["positions"],
-            cut["velocities"],
-            cut["kinetic"],
-            cut["momentum"],
-            cut["pair"],
-            cut["wall"],
-            cut["virial"],
-            cut["wall_impulse"],
+            **cut,
             masses=s.masses,
             radii=s.radii,
             lower=s.lower,
