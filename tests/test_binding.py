@@ -14,7 +14,7 @@ import pytest
 import granular
 from granular import _core, analysis, langevin
 
-import sde_reference
+from helpers import sde_reference
 
 
 def _strided(a):

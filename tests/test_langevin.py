@@ -19,7 +19,7 @@ import pytest
 import granular
 from granular import langevin, theory
 
-import sde_reference  # tests/ is on sys.path (conftest.py)
+from helpers import sde_reference
 
 G0, D0 = 9.26, 0.072  # the thesis' standard gas, xi = 0.8 (theory.langevin_coefficients)
 TAU0 = 0.972
@@ -480,7 +480,7 @@ def test_bad_input(kwargs, match):
 
 # -- the engine against a slow NumPy reference fed the same random numbers ------------------
 #
-# tests/sde_reference.py redraws csrc/rng.h's stream in Python and integrates from the
+# tests/helpers/sde_reference.py redraws csrc/rng.h's stream in Python and integrates from the
 # equations (its own formulas and order of operations).  Tolerance: 1e-12 of the largest
 # magnitude.  The two differ by a few ulps a step (other rounding); velocities forget such
 # differences (they contract by exp(-gamma dt) a step), positions add them up, so after
