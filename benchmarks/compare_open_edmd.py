@@ -5,7 +5,9 @@ The fastest open event-driven code we know is F. Smallenburg's (github.com/FSmal
 `Cell/` keeps cell lists, `Single/` neighbour lists.  Its numbers depend on the machine as
 much as ours, so the only fair comparison is both codes on the same machine at the same
 time.  This script does that: for each workload it runs a prepared copy of the other code,
-then granular on the same number of pair collisions, and repeats, interleaved.
+and granular on the same number of pair collisions, and repeats, interleaved, the order
+alternating from round to round; every round is printed with the load average, then the
+median and range per workload and code.
 
 The other code is not shipped here; prepare one directory per workload:
   1. clone the repository; copy `Cell/` (dilute workloads) or `Single/` (packing 0.45),
@@ -96,6 +98,10 @@ def run_other(directory, eta):
     return c1 - c0, t1 - t0
 
 
+# pair collisions the other code ran per workload, for granular's next run of it
+PAIRS = {}
+
+
 def run_granular(name, pairs):
     n, eta, _ = WORKLOADS[name]
     r = edmd_workload(name, 3, n, eta, 2.0 * pairs / n, windows=1)
@@ -157,19 +163,40 @@ def main():
     names = [name for name in WORKLOADS if name in others]
     rows = []  # (workload, code, pair collisions per second)
 
-    def report(name, code, pairs, seconds):
+    def report(round_, name, code, pairs, seconds):
         rows.append((name, code, pairs / seconds))
         print(
-            f"{name:14s} {code:12s} {pairs:16d} {seconds:8.2f} {pairs / seconds / 1e6:7.3f}",
+            f"{round_:5d} {name:14s} {code:12s} {pairs:16d} {seconds:8.2f} "
+            f"{pairs / seconds / 1e6:7.3f} {os.getloadavg()[0]:6.2f}",
             flush=True,
         )
 
-    print(f"{'workload':14s} {'code':12s} {'pair collisions':>16s} {'seconds':>8s} {'M/s':>7s}")
-    for _ in range(args.repeats):
+    print(
+        f"{'round':>5s} {'workload':14s} {'code':12s} {'pair collisions':>16s} {'seconds':>8s} "
+        f"{'M/s':>7s} {'load':>6s}"
+    )
+    for round_ in range(args.repeats):
         for name in names:
-            pairs, seconds = run_other(others[name], WORKLOADS[name][1])
-            report(name, "Smallenburg", pairs, seconds)
-            report(name, "granular", *run_granular(name, pairs))
+            # the order alternates from round to round, so a machine whose load drifts
+            # during a round favours neither code; granular runs the other's pair count
+            if round_ % 2 == 0:
+                pairs, seconds = run_other(others[name], WORKLOADS[name][1])
+                report(round_, name, "Smallenburg", pairs, seconds)
+                report(round_, name, "granular", *run_granular(name, pairs))
+            else:
+                pairs = PAIRS.get(name) or 2_000_000
+                mine = run_granular(name, pairs)
+                other = run_other(others[name], WORKLOADS[name][1])
+                report(round_, name, "granular", *mine)
+                report(round_, name, "Smallenburg", *other)
+            PAIRS[name] = pairs
+    print("\nmedian (smallest-largest) over the rounds, M pair collisions/s:")
+    for name in names:
+        line = []
+        for code in ("granular", "Smallenburg"):
+            r = sorted(rate for w, c, rate in rows if w == name and c == code)
+            line.append(f"{code} {np.median(r) / 1e6:.3f} ({r[0] / 1e6:.3f}-{r[-1] / 1e6:.3f})")
+        print(f"{name:14s} " + ", ".join(line))
     if args.plot:
         plot(rows, args.plot)
 
