@@ -22,6 +22,7 @@ from .errors import (
     ProcessBackendError,
     UnstableStepError,
 )
+from .gsd_io import read
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
@@ -78,5 +79,6 @@ __all__ = [
     "ensemble",
     "errors",
     "langevin",
+    "read",
     "theory",
 ]

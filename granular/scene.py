@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 from typing import Any
 
 import numpy as np
@@ -310,6 +311,17 @@ class Scene:
         )
 
     # -- constructors ---------------------------------------------------------------
+    @classmethod
+    def from_gsd(cls, path: str | os.PathLike, frame: int = -1, **params: Any) -> Scene:
+        """The scene at one frame (default the last) of a GSD file: exact float64 positions
+        (wrapped into the box), velocities, radii, masses and box when granular wrote it
+        (``Trajectory.write``), else from the float32 HOOMD fields.  ``params`` are the
+        other Scene keywords (restitution, wall_restitution, contact_duration), which a
+        trajectory does not record."""
+        from . import gsd_io
+
+        return gsd_io.scene_from_gsd(path, frame, **params)
+
     @classmethod
     def random(
         cls,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
 import numpy as np
@@ -202,6 +203,17 @@ class Trajectory:
 
         box = (self.upper - self.lower) if self.boundary == "periodic" else None
         return interop.to_universe(self.times, positions, box=box, radii=self.radii)
+
+    def write(self, path: str | os.PathLike) -> None:
+        """Write the samples to a GSD file (``path`` ending in .gsd), which OVITO, freud,
+        HOOMD and MDAnalysis read and ``granular.read`` reads back exactly: the standard
+        particle fields are float32 (HOOMD's schema), the exact float64 positions,
+        velocities, times and counters go in its log section (see ``granular.gsd_io``).
+        Other formats (XYZ, TRR, ...): MDAnalysis' writers on ``to_universe()``.  Needs
+        the positions stored."""
+        from . import gsd_io
+
+        gsd_io.write(self, path)
 
     def __len__(self) -> int:
         return len(self.times)
