@@ -22,6 +22,9 @@ The exact float64 (and int64) values granular reads back live in the log section
 - frame 0: the scene's ``lower``, ``upper``, ``radii``, ``masses`` (float64), ``boundary`` and
   ``stop_reason`` (as UTF-8 bytes), and ``format`` (this layout's version)
 
+(gsd >= 4 can write the HOOMD fields in float64, but OVITO and older gsd and HOOMD read
+float32 ones: the standard fields stay float32 and the exact values go in the log.)
+
 So ``granular.read`` gives back a Trajectory equal, array for array, to the one written.  For
 other formats (extended XYZ, TRR, DCD, ...) go through MDAnalysis: ``Trajectory.to_universe()``
 and its writers.
@@ -122,6 +125,7 @@ def write(traj: Any, path: str | os.PathLike) -> None:
     centre = 0.5 * (lower + upper)
     box, dimensions = _box(lower, upper)
     periodic = traj.boundary == "periodic"
+    half = (0.5 * (upper - lower)).astype(np.float32)
     n = traj.n
     with hoomd.open(name=str(path), mode="w") as f:
         for k in range(len(traj.times)):
@@ -134,7 +138,14 @@ def write(traj: Any, path: str | os.PathLike) -> None:
             frame.particles.typeid = np.zeros(n, dtype=np.uint32)
             x = traj.positions[k]
             wrapped, images = _wrap(x, lower, upper, periodic)
-            frame.particles.position = _pad3(wrapped - centre)
+            position = (wrapped - centre).astype(np.float32)
+            if periodic:
+                # a centre just under the upper face can round to +L/2 in float32, outside
+                # HOOMD's [-L/2, L/2): move it to -L/2 and count the image
+                high = position >= half
+                position = np.where(high, -half, position)
+                images = images + high
+            frame.particles.position = _pad3(position)
             frame.particles.image = _pad3(images, np.int32)
             frame.particles.diameter = np.asarray(2.0 * traj.radii, dtype=np.float32)
             frame.particles.mass = np.asarray(traj.masses, dtype=np.float32)

@@ -83,7 +83,8 @@ def test_gsd_reads_wrapped_float32_positions_and_image_flags(written):
             assert x.dtype == np.float32
             if d == 2:
                 assert np.all(x[:, 2] == 0)
-            assert np.all(np.abs(x[:, :d]) <= L / 2 * (1 + 1e-6))
+            half = (L / 2).astype(np.float32)  # HOOMD's box: [-L/2, L/2)
+            assert np.all(x[:, :d] >= -half) and np.all(x[:, :d] < half)
             img = frame.particles.image[:, :d]
             if tr.boundary == "walls":
                 assert np.all(img == 0)
@@ -167,3 +168,44 @@ def test_a_foreign_gsd_file_gives_a_scene_but_not_a_trajectory(tmp_path):
     np.testing.assert_array_equal(s.lower, [-0.5] * 3)
     with pytest.raises(ValueError, match="not written by granular"):
         granular.read(path)
+
+
+def test_a_centre_that_rounds_onto_the_upper_face_stays_in_the_box(tmp_path):
+    # float64 just inside [0, 1), float32 of (x - 1/2) rounds to +1/2: GSD wants [-L/2, L/2)
+    x = np.array([[[1.0 - 1e-12, 0.5, 0.5], [0.25, 0.25, 0.25]]])
+    tr = granular.Trajectory(
+        np.array([0.0]),
+        x,
+        np.zeros_like(x),
+        np.zeros(1),
+        np.zeros((1, 3)),
+        np.zeros(1, dtype=np.int64),
+        np.zeros(1, dtype=np.int64),
+        np.zeros(1),
+        np.zeros(1),
+        masses=np.ones(2),
+        radii=np.full(2, 0.1),
+        lower=np.zeros(3),
+        upper=np.ones(3),
+        boundary="periodic",
+        stop_reason="time",
+    )
+    path = tmp_path / "edge.gsd"
+    tr.write(path)
+    with gsd.hoomd.open(str(path), "r") as f:
+        p, img = f[0].particles.position, f[0].particles.image
+    assert np.all(p >= -0.5) and np.all(p < 0.5)
+    assert p[0, 0] == -0.5 and img[0, 0] == 1
+    np.testing.assert_allclose(p[:, :3] + img + 0.5, x[0], atol=1e-7)
+    np.testing.assert_array_equal(granular.read(path).positions, x)
+
+
+def test_positions_without_velocities_round_trip(tmp_path):
+    tr = Simulation(Scene.random(20, 0.05, seed=4)).run(
+        t_stop=1.0, sample_times=[0.0, 0.5, 1.0], store=("positions",)
+    )
+    tr.write(tmp_path / "p.gsd")
+    back = granular.read(tmp_path / "p.gsd")
+    assert back.velocities is None
+    np.testing.assert_array_equal(back.positions, tr.positions)
+    np.testing.assert_array_equal(back.times, tr.times)
