@@ -53,7 +53,7 @@ _INT_COUNTERS = ("pair_collisions", "wall_collisions")
 def _gsd_hoomd():
     try:
         import gsd.hoomd
-    except ImportError as exc:  # pragma: no cover - exercised only without gsd
+    except ImportError as exc:
         raise ImportError(
             "GSD files need the gsd package: pip install gsd (or pip install 'granular[gsd]')"
         ) from exc

@@ -1,6 +1,8 @@
 """GSD files (issue 17): Trajectory.write, granular.read and Scene.from_gsd round trip
 exactly; the file is a valid HOOMD GSD file for gsd itself and for MDAnalysis."""
 
+import sys
+
 import gsd.hoomd
 import numpy as np
 import pytest
@@ -209,3 +211,12 @@ def test_positions_without_velocities_round_trip(tmp_path):
     assert back.velocities is None
     np.testing.assert_array_equal(back.positions, tr.positions)
     np.testing.assert_array_equal(back.times, tr.times)
+
+
+def test_without_gsd_the_error_names_the_extra(tmp_path, monkeypatch):
+    _, tr = run_2d_walled()
+    # hidden the way Python reports a missing module
+    monkeypatch.setitem(sys.modules, "gsd", None)
+    monkeypatch.setitem(sys.modules, "gsd.hoomd", None)
+    with pytest.raises(ImportError, match=r"pip install 'granular\[gsd\]'"):
+        tr.write(tmp_path / "run.gsd")
