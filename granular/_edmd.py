@@ -65,16 +65,7 @@ def build(scene, cell_factor=1.0, big_ratio=_core.BIG_RATIO, shell="auto"):
         "the event-driven engine's state" + (" with neighbour lists" if shell > 0 else ""),
     )
     return _core.EDMD(
-        scene.positions,
-        scene.velocities,
-        scene.radii,
-        scene.masses,
-        scene.lower,
-        scene.upper,
-        scene.boundary == "periodic",
-        scene.wall_restitution,
-        scene.restitution,
-        scene.contact_duration,
+        *scene._engine_args(),
         float(cell_factor),
         float(big_ratio),
         float(shell),

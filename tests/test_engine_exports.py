@@ -13,21 +13,6 @@ from granular.errors import GranularError
 from granular.scene import BIG_RATIO
 
 
-def _arrays(scene):
-    return (
-        scene.positions,
-        scene.velocities,
-        scene.radii,
-        scene.masses,
-        scene.lower,
-        scene.upper,
-        scene.boundary == "periodic",
-        scene.wall_restitution,
-        scene.restitution,
-        scene.contact_duration,
-    )
-
-
 def test_big_rule_and_default_come_from_c():
     assert BIG_RATIO == _core.BIG_RATIO == 3.0
     assert _core.BIG_MAX == 16
@@ -52,11 +37,11 @@ def test_bytes_per_particle():
 
 def test_check_agrees_with_the_engine():
     s = granular.Scene.random(200, 0.02, seed=3)
-    assert _core.edmd_check(*_arrays(s)) is None
+    assert _core.edmd_check(*s._engine_args()) is None
     pos = s.positions.copy()
     pos[5] = pos[9] + [0.01, 0.0, 0.0]  # overlapping 9
     pos[5] %= 1.0
-    bad = list(_arrays(s))
+    bad = list(s._engine_args())
     bad[0] = pos
     for build in (_core.edmd_check, _core.EDMD):
         with pytest.raises(GranularError, match="overlap"):

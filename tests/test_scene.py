@@ -70,7 +70,7 @@ def _fcc_order(positions, n):
     ],
 )
 def test_dense_random_scene_melts_a_lattice(eta):
-    """A dense scene starts on an FCC lattice (scene._place_lattice) and must come out a
+    """A dense scene starts on an FCC lattice (placement.place_lattice) and must come out a
     fluid.  Order measure: Q of ``_fcc_order`` -- N for the unmelted lattice, S(G) times
     Gamma(13)/13 in a fluid.  Bound: the structure factor of the hard-sphere fluid stays
     below 2.85 up to freezing (Hansen-Verlet criterion, S(k_max) = 2.85 at eta = 0.494),
@@ -79,12 +79,13 @@ def test_dense_random_scene_melts_a_lattice(eta):
     vibrating crystal keeps the Debye-Waller fraction exp(-G^2 <u^2> / 3) of that (Q ~ 700
     at eta = 0.5), residual order of a few percent in rho_G (Q ~ 10 at eta = 0.4) fails
     too; a fluid measures Q ~ 1."""
-    from granular.scene import _RSA_LIMIT, _place_lattice
+    from granular.placement import place_lattice
+    from granular.scene import _RSA_LIMIT
 
     n = 2000
     r = (eta / (n * 4 / 3 * math.pi)) ** (1 / 3)
     assert eta > _RSA_LIMIT[3]  # the lattice route is taken
-    lattice, _ = _place_lattice(
+    lattice, _ = place_lattice(
         np.random.default_rng(2), np.full(n, r), np.zeros(3), np.ones(3), True
     )
     q_lattice, m = _fcc_order(lattice, n)

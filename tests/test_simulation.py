@@ -201,19 +201,7 @@ def test_agrees_with_slow_reference(dim, boundary, xi, mixture):
     sim = Simulation(s)
     tr = sim.run(t_stop=t_stop, sample_times=times)
     assert sim.stats["pair_collisions"] >= n
-    rx, rv = reference_edmd.run(
-        np.array(s.positions),
-        np.array(s.velocities),
-        s.radii,
-        s.masses,
-        s.lower,
-        s.upper,
-        boundary == "periodic",
-        xi,
-        t_stop,
-        times,
-        wall_e=s.wall_restitution,
-    )
+    rx, rv = reference_edmd.run_scene(s, t_stop, times)
     np.testing.assert_allclose(tr.positions, rx, rtol=0, atol=1e-8)
     np.testing.assert_allclose(tr.velocities, rv, rtol=0, atol=1e-8)
 
@@ -454,18 +442,7 @@ def test_large_tracer_agrees_with_slow_reference(dim, boundary):
     tr = sim.run(t_stop=0.5, sample_times=times)
     assert min(sim.stats["cells"][:dim]) > 1.0 / (2 * big)  # finer than the tracer
     assert sim.stats["pair_collisions"] >= n // 3
-    rx, rv = reference_edmd.run(
-        np.array(s.positions),
-        np.array(s.velocities),
-        s.radii,
-        s.masses,
-        s.lower,
-        s.upper,
-        boundary == "periodic",
-        0.9,
-        0.5,
-        times,
-    )
+    rx, rv = reference_edmd.run_scene(s, 0.5, times)
     np.testing.assert_allclose(tr.positions, rx, rtol=0, atol=1e-8)
     np.testing.assert_allclose(tr.velocities, rv, rtol=0, atol=1e-8)
 

@@ -32,6 +32,23 @@ def pair_times(x, v, r, L, periodic):
     return best
 
 
+def run_scene(scene, t_stop, sample_times):
+    """``run`` for a granular.Scene: its state, box, restitution and wall restitution."""
+    return run(
+        np.array(scene.positions),
+        np.array(scene.velocities),
+        scene.radii,
+        scene.masses,
+        scene.lower,
+        scene.upper,
+        scene.boundary == "periodic",
+        scene.restitution,
+        t_stop,
+        sample_times,
+        wall_e=scene.wall_restitution,
+    )
+
+
 def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0):
     """Positions (unwrapped) and velocities at sample_times."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
