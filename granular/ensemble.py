@@ -566,6 +566,7 @@ def ensemble(
           are the quantities (``run_kwargs`` must then be empty);
         - a list or tuple of P such models, the points of a sweep: all P x ``runs`` runs
           are scheduled together, so the backend's workers stay busy across points.
+
         Functions must be picklable (module level, or partials of such) for the process
         and Dask backends.
     runs : int

@@ -215,6 +215,10 @@ class LangevinResult:
         """``msd(per_dimension=False, particles=None)``: the ensemble MSD at the sample
         times, (T,) summed over dimensions or (T, d) per dimension.
 
+        Parameters
+        ----------
+        per_dimension : bool
+            Return (T, d), one column per axis, instead of the sum over axes.
         particles : array_like of int or bool, optional
             Average over these particles only (indices, or a boolean mask over all N);
             needs the positions (``run(store_positions=True)``), since the engine
@@ -250,6 +254,11 @@ class LangevinResult:
         (``tamsd_lags``) and only there: by default all of them; ``lags`` (in time) or
         ``lag_samples`` (in steps, the engine's samples of the path) pick some of them,
         and any other lag is refused.
+
+        Parameters
+        ----------
+        lags, lag_samples : array_like, optional
+            The lags to return, in time or in the engine's steps (at most one of the two).
         particles : array_like of int or bool, optional
             Average over these particles only (indices, or a boolean mask over all N).
         per_particle : bool
