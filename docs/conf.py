@@ -5,18 +5,14 @@ GitHub shows; the API reference is generated from the numpydoc docstrings (api.m
 """
 
 import os
-import sys
-from pathlib import Path
 
 import granular
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-os.environ.setdefault("MPLBACKEND", "Agg")
+os.environ.setdefault("MPLBACKEND", "Agg")  # autodoc imports granular.plot
 
 project = "granular"
-author = "the granular authors"
-copyright = "2026, the granular authors"  # noqa: A001 (Sphinx's name)
+author = "the granular developers"
+copyright = "2026, the granular developers"
 release = granular.__version__
 version = release
 
@@ -33,15 +29,14 @@ extensions = [
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
-exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["_build"]
 templates_path = ["_templates"]
 
 # --- MyST: $...$ and $$...$$ math, ::: fences, headings as link targets --------------------
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_heading_anchors = 3
-# the README sits outside docs/ (Sphinx never reads it): engine.md's link to it stays a plain
-# file link for GitHub readers, and Sphinx is told where it lives on the site
-myst_url_schemes = ["http", "https", "mailto"]
+# every cross-reference must resolve (a renamed function breaks the build, not a link)
+nitpicky = True
 
 # --- API reference -------------------------------------------------------------------------
 autosummary_generate = True
