@@ -593,10 +593,10 @@ def ensemble(
 
     Returns
     -------
-    EnsembleResult, or for a sweep a list of them, one per point in order.
-
-    Failed runs (e.g. inelastic collapse) are listed in their point's ``.failures`` with
-    their seeds and do not lose the others.
+    EnsembleResult or list of EnsembleResult
+        One result, or for a sweep a list of them, one per point in order.  Failed runs
+        (e.g. inelastic collapse) are listed in their point's ``.failures`` with their seeds
+        and do not lose the others.
     """
     runs = int(runs)
     if runs < 1:

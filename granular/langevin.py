@@ -224,7 +224,9 @@ class LangevinResult:
             needs the positions (``run(store_positions=True)``), since the engine
             accumulates the MSD of all particles only.
 
-        (Used as an array, ``result.msd`` is still the (T,) MSD, deprecated.)"""
+        Notes
+        -----
+        Used as an array, ``result.msd`` is still the (T,) MSD, deprecated."""
         return _ArrayAndMethod(self.msd_total, self._msd, "msd")
 
     def _msd(
@@ -264,7 +266,9 @@ class LangevinResult:
         per_particle : bool
             Return (N, L) (or one row per chosen particle) instead of the mean.
 
-        (Used as an array, ``result.tamsd`` is still the (L,) TAMSD, deprecated.)"""
+        Notes
+        -----
+        Used as an array, ``result.tamsd`` is still the (L,) TAMSD, deprecated."""
         return _ArrayAndMethod(self.tamsd_mean, self._tamsd, "tamsd")
 
     def _tamsd(
