@@ -3,12 +3,13 @@
 #   make test   -- set up .venv and run the whole test suite (CI)
 #   make test-quick -- the same without the tests marked slow, for daily work
 #   make lint   -- ruff check and ruff format --check (CI runs it before the tests)
+#   make docs   -- the documentation site into build/docs/html, failing on any warning
 # and for the C core: make test-asan (the suite against an ASan + UBSan build, in its own venv)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 
-.PHONY: setup demo test test-quick lint test-asan test-asan-ci bench clean
+.PHONY: setup demo test test-quick lint docs test-asan test-asan-ci bench clean
 
 $(VENV)/.installed: pyproject.toml setup.py $(wildcard csrc/*.c csrc/*.h)
 	$(PYTHON) -m venv $(VENV)
@@ -31,6 +32,13 @@ test-quick: setup
 # lint and formatting; the configuration is pyproject.toml's [tool.ruff*]
 lint: setup
 	$(PY) -m ruff check . && $(PY) -m ruff format --check .
+
+# The docs extra comes with the test extra (setup). -E: a fresh environment every time, so a
+# warning in a page that did not change is not hidden by the cache; -W --keep-going: every
+# warning is reported, and any fails the build. API stubs are generated into docs/generated/.
+docs: setup
+	$(PY) -m sphinx -b html -E -W --keep-going docs build/docs/html
+	@echo "open build/docs/html/index.html"
 
 bench: setup
 	$(PY) -m granular bench --json bench.json
@@ -76,4 +84,4 @@ test-asan-ci:
 	$(MAKE) test-asan ASAN_TESTS="$(ASAN_CI_TESTS)"
 
 clean:
-	rm -rf build $(VENV) granular/*.so *.egg-info
+	rm -rf build $(VENV) granular/*.so *.egg-info docs/generated

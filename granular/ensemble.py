@@ -566,6 +566,7 @@ def ensemble(
           are the quantities (``run_kwargs`` must then be empty);
         - a list or tuple of P such models, the points of a sweep: all P x ``runs`` runs
           are scheduled together, so the backend's workers stay busy across points.
+
         Functions must be picklable (module level, or partials of such) for the process
         and Dask backends.
     runs : int
@@ -592,10 +593,10 @@ def ensemble(
 
     Returns
     -------
-    EnsembleResult, or for a sweep a list of them, one per point in order.
-
-    Failed runs (e.g. inelastic collapse) are listed in their point's ``.failures`` with
-    their seeds and do not lose the others.
+    EnsembleResult or list of EnsembleResult
+        One result, or for a sweep a list of them, one per point in order.  Failed runs
+        (e.g. inelastic collapse) are listed in their point's ``.failures`` with their seeds
+        and do not lose the others.
     """
     runs = int(runs)
     if runs < 1:

@@ -215,12 +215,18 @@ class LangevinResult:
         """``msd(per_dimension=False, particles=None)``: the ensemble MSD at the sample
         times, (T,) summed over dimensions or (T, d) per dimension.
 
+        Parameters
+        ----------
+        per_dimension : bool
+            Return (T, d), one column per axis, instead of the sum over axes.
         particles : array_like of int or bool, optional
             Average over these particles only (indices, or a boolean mask over all N);
             needs the positions (``run(store_positions=True)``), since the engine
             accumulates the MSD of all particles only.
 
-        (Used as an array, ``result.msd`` is still the (T,) MSD, deprecated.)"""
+        Notes
+        -----
+        Used as an array, ``result.msd`` is still the (T,) MSD, deprecated."""
         return _ArrayAndMethod(self.msd_total, self._msd, "msd")
 
     def _msd(
@@ -250,12 +256,19 @@ class LangevinResult:
         (``tamsd_lags``) and only there: by default all of them; ``lags`` (in time) or
         ``lag_samples`` (in steps, the engine's samples of the path) pick some of them,
         and any other lag is refused.
+
+        Parameters
+        ----------
+        lags, lag_samples : array_like, optional
+            The lags to return, in time or in the engine's steps (at most one of the two).
         particles : array_like of int or bool, optional
             Average over these particles only (indices, or a boolean mask over all N).
         per_particle : bool
             Return (N, L) (or one row per chosen particle) instead of the mean.
 
-        (Used as an array, ``result.tamsd`` is still the (L,) TAMSD, deprecated.)"""
+        Notes
+        -----
+        Used as an array, ``result.tamsd`` is still the (L,) TAMSD, deprecated."""
         return _ArrayAndMethod(self.tamsd_mean, self._tamsd, "tamsd")
 
     def _tamsd(

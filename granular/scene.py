@@ -169,6 +169,8 @@ class Scene:
         TC model t_c (thesis 3.6): a collision within t_c of a particle's previous one is
         elastic, which prevents inelastic collapse.  0 turns it off.
 
+    Notes
+    -----
     A Scene is immutable (its arrays are read-only) and is checked on construction:
     shapes, finite numbers, positive radii and masses, particles inside the box, and no
     two particles overlapping (``OverlapError`` names the pair).

@@ -146,6 +146,10 @@ class Trajectory:
         ``granular.analysis.msd``.  The same call as ``LangevinResult.msd`` and
         ``EnsembleResult.msd``.
 
+        Parameters
+        ----------
+        per_dimension : bool
+            Return (T, d), one column per axis, instead of the sum over axes.
         particles : array_like of int or bool, optional
             Average over these particles only (indices, or a boolean mask over all N),
             e.g. a tracer; by default over all.
@@ -170,6 +174,8 @@ class Trajectory:
         has no lags of its own (it can compute any): give exactly one of ``lags`` and
         ``lag_samples``.
 
+        Parameters
+        ----------
         lags : array_like of float, optional
             Lags in time, each a difference of sample times (with uniform sampling, a
             multiple of the spacing).
