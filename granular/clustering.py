@@ -78,7 +78,9 @@ def _fourier(x, kvecs, weights=None):
     """sum_j w_j exp(i k.r_j) for each sample and wave vector: (T, K) or, with weights of
     shape (T, N, c), (T, K, c).  Chunked over samples to bound memory."""
     t_count, n = x.shape[:2]
-    out_shape = (t_count, len(kvecs)) + (() if weights is None else (weights.shape[2],))
+    out_shape = (
+        (t_count, len(kvecs)) if weights is None else (t_count, len(kvecs), weights.shape[2])
+    )
     out = np.empty(out_shape, dtype=np.complex128)
     step = max(1, _CHUNK_ELEMENTS // max(1, n * len(kvecs)))
     for a in range(0, t_count, step):
@@ -93,7 +95,7 @@ def _fourier(x, kvecs, weights=None):
 def _shell_mean(values, shell_index, n_shells):
     """Average (T, K) values over the wave vectors of each shell: (T, S)."""
     counts = np.bincount(shell_index, minlength=n_shells)
-    sums = np.zeros(values.shape[:1] + (n_shells,))
+    sums = np.zeros((values.shape[0], n_shells))
     for s in range(n_shells):
         sums[:, s] = values[:, shell_index == s].sum(axis=1)
     return sums / counts

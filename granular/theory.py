@@ -439,7 +439,9 @@ def shear_viscosity(
     zeta = (d + 2) / (4 * d) * chi * (1 - xi**2)
     eta_k = (1 - 2 ** (d - 2) / (d + 2) * (1 + xi) * (1 - 3 * xi) * phi * chi) / (nu - zeta / 2)
     gamma = 2 ** (2 * d + 1) / (math.pi * (d + 2)) * phi**2 * chi * (1 + xi)
-    return eta0 * (eta_k * (1 + 2 ** (d - 1) / (d + 2) * phi * chi * (1 + xi)) + d / (d + 2) * gamma)
+    return eta0 * (
+        eta_k * (1 + 2 ** (d - 1) / (d + 2) * phi * chi * (1 + xi)) + d / (d + 2) * gamma
+    )
 
 
 def critical_box_size(
