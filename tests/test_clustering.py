@@ -335,3 +335,28 @@ def test_flow_stays_at_noise_level_below_the_critical_size():
         excess.append(fe.excess[late].mean())
         noise_std = fe.noise_std[0]
     assert abs(np.mean(excess)) < 3 * noise_std / 2
+
+
+def test_clustering_plots_render(tmp_path):
+    """plot.structure_factor and plot.flow_energy draw clustering results onto given axes,
+    with units (or 'dimensionless') on every axis."""
+    pytest.importorskip("matplotlib")
+    import matplotlib.pyplot as plt
+
+    from granular import plot
+
+    t = np.linspace(0, 1, 6)
+    x = RNG.uniform(0, 1, (6, 200, 2))
+    v = RNG.normal(size=(6, 200, 2))
+    sf = clustering.structure_factor(x, [1, 1])
+    cc = clustering.current_correlations(x, v, 1.0, [1, 1])
+    fe = clustering.flow_energy(x, v, 1.0, [0, 0], [1, 1], cells=3)
+    _, (a, b) = plt.subplots(1, 2)
+    assert plot.structure_factor(t, sf, ax=a, transverse=cc) is a
+    assert plot.flow_energy(t, fe, ax=b, label="run", threshold=0.03) is b
+    for ax in (a, b, plot.structure_factor(t, sf)):
+        for label in (ax.get_xlabel(), ax.get_ylabel()):
+            assert "[" in label or "dimensionless" in label, label
+    a.figure.savefig(tmp_path / "c.png")
+    assert (tmp_path / "c.png").stat().st_size > 1000
+    plt.close("all")
