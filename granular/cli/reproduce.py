@@ -727,8 +727,8 @@ def _sentence(row):
     runs = f" ({row['runs']} runs)" if row["runs"] else ""
     parts = [p for p in (_compare(row, "theory"), _compare(row, "thesis")) if p]
     return (
-        f"- `{row['id']}`, {row['quantity']}: ours {_fmt(row['ours'], row['ours_error'])}{runs}; "
-        + "; ".join(parts)
+        f"- `{row['id']}`, {row['quantity']}: ours {_fmt(row['ours'], row['ours_error'])}{runs}"
+        + "".join("; " + p for p in parts)
         + "."
     )
 
