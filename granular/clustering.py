@@ -339,8 +339,21 @@ def flow_energy(
 
 
 def onset(times: ArrayLike, excess: ArrayLike, threshold: float) -> float:
-    """First time at which ``excess`` reaches ``threshold`` (linear interpolation between the
-    samples around the crossing), or nan if it never does."""
+    """First time at which ``excess`` reaches ``threshold``.
+
+    Parameters
+    ----------
+    times : array_like, (T,)
+    excess : array_like, (T,)
+        E.g. ``FlowEnergy.excess``.
+    threshold : float
+
+    Returns
+    -------
+    float
+        The crossing time, linearly interpolated between the samples around it; the first
+        time if it starts above; nan if it never reaches the threshold.
+    """
     t = np.asarray(times, dtype=np.float64)
     e = np.asarray(excess, dtype=np.float64)
     above = np.nonzero(e >= threshold)[0]
@@ -369,7 +382,22 @@ def unstable_box_message(scene) -> str | None:
     share of the kinetic energy, M / (d N) with M = 2 d (d - 1) real components, to 5% of it
     (``theory.shear_mode_growth``), in time and in collisions per particle,
     ``omega0 tau0 ln(1 + t*/tau0)``.  For mixtures the mean radius stands in for the
-    radius (the theory is for equal spheres)."""
+    radius (the theory is for equal spheres).
+
+    Parameters
+    ----------
+    scene : granular.Scene
+
+    Returns
+    -------
+    str or None
+        The warning's text, or None.
+
+    References
+    ----------
+    Goldhirsch & Zanetti 1993, Phys. Rev. Lett. 70, 1619; Garzo 2005, Phys. Rev. E 72,
+    021106 (see ``theory.critical_box_size``).
+    """
     import numbers
 
     from . import theory

@@ -332,6 +332,12 @@ def test_flow_stays_at_noise_level_below_the_critical_size():
         )
         late = tr.collisions_per_particle > 5
         fe = tr.flow_energy(cells=2)
+        if seed == 0:  # the Trajectory methods are the module's functions on its samples
+            box = tr.upper - tr.lower
+            sf = clustering.structure_factor(tr.positions, box)
+            assert np.array_equal(tr.structure_factor().values, sf.values)
+            cc = clustering.current_correlations(tr.positions, tr.velocities, 1.0, box)
+            assert np.array_equal(tr.current_correlations().transverse, cc.transverse)
         excess.append(fe.excess[late].mean())
         noise_std = fe.noise_std[0]
     assert abs(np.mean(excess)) < 3 * noise_std / 2
