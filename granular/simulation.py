@@ -192,7 +192,7 @@ class Simulation:
             On the first run of a granular gas (constant xi < 1) in a periodic box beyond
             the critical size of the shear instability (``granular.clustering``).
         """
-        if not self._clustering_checked:
+        if not getattr(self, "_clustering_checked", False):  # also for restored Simulations
             self._clustering_checked = True
             from .clustering import unstable_box_message
 
