@@ -381,8 +381,8 @@ def unstable_box_message(scene) -> str | None:
     linear theory, the slowest shear modes (k = 2 pi / L) grow from their equipartition
     share of the kinetic energy, M / (d N) with M = 2 d (d - 1) real components, to 5% of it
     (``theory.shear_mode_growth``), in time and in collisions per particle,
-    ``omega0 tau0 ln(1 + t*/tau0)``.  For mixtures the mean radius stands in for the
-    radius (the theory is for equal spheres).
+    ``omega0 tau0 ln(1 + t*/tau0)``.  For mixtures the median radius (the bulk, which a big
+    tracer does not move) stands in for the radius (the theory is for equal spheres).
 
     Parameters
     ----------
@@ -407,7 +407,7 @@ def unstable_box_message(scene) -> str | None:
         return None
     lengths = scene.upper - scene.lower
     big = float(np.max(lengths))
-    radius = float(np.mean(scene.radii))
+    radius = float(np.median(scene.radii))
     density = scene.n / scene.volume
     eta = scene.packing_fraction
     if not 0 < eta < 1:
