@@ -506,3 +506,16 @@ def shear_mode_growth(
     t = np.asarray(t, dtype=np.float64)
     q2 = (np.asarray(critical, dtype=np.float64) / box) ** 2
     return (1.0 + t / tau0) ** (2.0 * (1.0 - q2))
+
+
+def shear_mode_level(box: FloatOrArray, critical: FloatOrArray) -> FloatOrArray:
+    """Level at which the transverse current correlation of the slowest shear mode
+    (k = 2 pi / box, 1 for an uncorrelated gas) settles in the homogeneous cooling state of
+    a box below the critical size: ``1 / (1 - (L / L_c)^2)`` -- linear fluctuating
+    hydrodynamics with the elastic noise amplitude (van Noije, Ernst, Brito & Orza 1997,
+    Phys. Rev. Lett. 79, 411), where the mode's relaxation rate in Haff's time
+    ``(zeta/2)(k^2/k_c^2 - 1)`` balances the noise.  Infinite at and above L_c."""
+    x2 = (np.asarray(box, dtype=np.float64) / critical) ** 2
+    with np.errstate(divide="ignore"):
+        level = np.where(x2 < 1, 1.0 / (1.0 - np.minimum(x2, 1.0)), np.inf)
+    return level[()] if level.ndim == 0 else level

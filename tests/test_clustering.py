@@ -254,6 +254,9 @@ def test_critical_box_size_limits_and_consistency():
     growth = theory.shear_mode_growth(np.array([0.0, 3.0]), 1.0, 2.0, 1.0)
     assert growth[0] == 1.0 and growth[1] == pytest.approx(4.0**1.5)
     assert theory.shear_mode_growth(3.0, 1.0, 1.0, 2.0) < 1  # below L_c: decays
+    # the level the slowest shear mode settles at below L_c: 1 / (1 - 0.25) at L = L_c / 2
+    assert theory.shear_mode_level(0.5, 1.0) == pytest.approx(4 / 3)
+    assert np.all(np.isinf(theory.shear_mode_level(np.array([1.0, 1.5]), 1.0)))
 
 
 # -- the warning --------------------------------------------------------------------------------

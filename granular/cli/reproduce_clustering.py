@@ -176,7 +176,7 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
             s_k = np.mean([p["s_k"] for p in per], axis=0)
             ax2.plot(s, s_k[1:], ":", color=colour)
             if r["L"] < r["lc"]:
-                ax2.axhline(1 / (1 - (r["L"] / r["lc"]) ** 2), color=colour, ls="--", lw=1)
+                ax2.axhline(theory.shear_mode_level(r["L"], r["lc"]), color=colour, ls="--", lw=1)
         ax = axes[k]
         ax.axhline(ONSET, color="0.5", lw=0.8)
         ax.set_xscale("log")
