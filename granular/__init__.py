@@ -8,9 +8,10 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 
-from . import analysis, errors, langevin, theory
+from . import analysis, clustering, errors, langevin, theory
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
+    ClusteringWarning,
     FrozenGasError,
     GranularError,
     HeatedWallsError,
@@ -61,6 +62,7 @@ def __dir__():
 
 
 __all__ = [
+    "ClusteringWarning",
     "EnsembleResult",
     "FrozenGasError",
     "GranularError",
@@ -76,6 +78,7 @@ __all__ = [
     "Trajectory",
     "UnstableStepError",
     "analysis",
+    "clustering",
     "ensemble",
     "errors",
     "langevin",

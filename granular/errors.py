@@ -72,3 +72,9 @@ class ProcessBackendError(GranularError, RuntimeError):
 class NoProgressError(GranularError, RuntimeError):
     """A run without a time limit made no progress towards its stop criterion (no
     collision in a great many events), so it would never end."""
+
+
+class ClusteringWarning(UserWarning):
+    """A granular gas in a periodic box beyond the critical size of the shear instability
+    (``granular.theory.critical_box_size``): its homogeneous cooling will end (vortices,
+    then clusters) and Haff's law will fail.  Issued once per Simulation, by ``run``."""

@@ -259,3 +259,70 @@ def snapshot(
     ax.set_xlabel(POSITION.format("x"))
     ax.set_ylabel(POSITION.format("y"))
     return ax
+
+
+# -- clustering: where homogeneous cooling ends (granular.clustering) -----------------------
+
+STRUCTURE_FACTOR = r"$S(k, t)$ (dimensionless; 1 for an ideal gas)"
+FLOW_RATIO = r"$E_{flow} / E_{thermal}$ (dimensionless)"
+
+
+def structure_factor(
+    times: ArrayLike,
+    result,
+    ax: Axes | None = None,
+    shells: int = 2,
+    transverse=None,
+) -> Axes:
+    """S(k, t) of the smallest |k| shells against time (a ``clustering.structure_factor``
+    result), and, if given, the transverse current correlation of a
+    ``clustering.current_correlations`` result (vortices) dashed in the same colours; both
+    are 1 for a homogeneous gas without correlations."""
+    ax = _axes(ax)
+    t = np.asarray(times, dtype=np.float64)
+    keep = t > 0
+    for s in range(min(shells, len(result.k))):
+        (line,) = ax.plot(t[keep], result.values[keep, s], label=rf"$S$, $|n| = {result.n[s]:.3g}$")
+        if transverse is not None:
+            ax.plot(
+                t[keep],
+                transverse.transverse[keep, s],
+                "--",
+                color=line.get_color(),
+                label=rf"transverse current, $|n| = {result.n[s]:.3g}$",
+            )
+    ax.axhline(1.0, color="0.6", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(TIME)
+    ax.set_ylabel(STRUCTURE_FACTOR if transverse is None else "correlation (dimensionless)")
+    ax.legend(fontsize="small")
+    return ax
+
+
+def flow_energy(
+    times: ArrayLike,
+    result,
+    ax: Axes | None = None,
+    label: str | None = None,
+    threshold: float | None = None,
+) -> Axes:
+    """The coarse-grained flow's energy over the thermal energy against time (a
+    ``clustering.flow_energy`` result, or a mean of them), with the level pure noise gives
+    (dotted, shaded by its standard deviation) and an optional onset threshold above it."""
+    ax = _axes(ax)
+    t = np.asarray(times, dtype=np.float64)
+    keep = t > 0
+    (line,) = ax.plot(t[keep], result.ratio[keep], label=label)
+    noise = np.asarray(result.noise)[keep]
+    std = np.asarray(result.noise_std)[keep]
+    ax.plot(t[keep], noise, ":", color=line.get_color())
+    ax.fill_between(t[keep], noise - std, noise + std, color=line.get_color(), alpha=0.15)
+    if threshold is not None:
+        ax.plot(t[keep], noise + threshold, "--", color=line.get_color(), lw=0.8)
+    ax.set_xscale("log")
+    ax.set_xlabel(TIME)
+    ax.set_ylabel(FLOW_RATIO)
+    if label:
+        ax.legend(fontsize="small")
+    return ax

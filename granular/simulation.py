@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core, _edmd
 from ._edmd import check_memory as _check_memory
 from .errors import (
+    ClusteringWarning,
     FrozenGasError,
     GranularError,
     HeatedWallsError,
@@ -79,6 +80,7 @@ class Simulation:
         # held for a whole run: the engine's own busy flag covers one C call only, and two
         # interleaved runs would write each other's samples
         self._running = threading.Lock()
+        self._clustering_checked = False  # ClusteringWarning: once per Simulation
 
     def _no_copy(self, *args):
         raise TypeError(
@@ -183,7 +185,22 @@ class Simulation:
         HeatedWallsError
             If heated walls (``wall_restitution > 1``) pumped the energy up beyond what
             float64 event times can resolve.
+
+        Warns
+        -----
+        ClusteringWarning
+            On the first run of a granular gas (constant xi < 1) in a periodic box beyond
+            the critical size of the shear instability (``granular.clustering``).
         """
+        if not getattr(self, "_clustering_checked", False):  # also for restored Simulations
+            self._clustering_checked = True
+            from .clustering import unstable_box_message
+
+            message = unstable_box_message(self._initial)
+            if message:
+                import warnings
+
+                warnings.warn(message, ClusteringWarning, stacklevel=2)
         if not self._running.acquire(blocking=False):
             raise RuntimeError(
                 "another thread is running this Simulation; a Simulation runs one run at a "

@@ -202,6 +202,41 @@ class Trajectory:
             particles=particles,
         )
 
+    def structure_factor(self, n_max: float = 2.0) -> Any:
+        """Density structure factor S(k, t) at the box's smallest wave vectors, per |k|
+        shell; see ``granular.clustering.structure_factor``."""
+        from . import clustering
+
+        return clustering.structure_factor(self._need("positions"), self.upper - self.lower, n_max)
+
+    def current_correlations(self, n_max: float = 2.0) -> Any:
+        """Transverse (vortices) and longitudinal momentum-current correlations at the box's
+        smallest wave vectors; see ``granular.clustering.current_correlations``."""
+        from . import clustering
+
+        return clustering.current_correlations(
+            self._need("positions"),
+            self._need("velocities"),
+            self.masses,
+            self.upper - self.lower,
+            n_max,
+        )
+
+    def flow_energy(self, cells: int = 4) -> Any:
+        """Kinetic energy of the coarse-grained flow field (cells per side) against the
+        thermal energy, with the finite-sample noise level; see
+        ``granular.clustering.flow_energy``."""
+        from . import clustering
+
+        return clustering.flow_energy(
+            self._need("positions"),
+            self._need("velocities"),
+            self.masses,
+            self.lower,
+            self.upper,
+            cells,
+        )
+
     def to_universe(self) -> Any:
         """An MDAnalysis Universe of the particles (see ``granular.interop.to_universe``)."""
         positions = self._need("positions")

@@ -92,12 +92,23 @@ REPRODUCE_MARGINS = {
     # slopes over t (xi = 1) or ln t (xi = 0.8): sensitivities to D0 and tau0 at most 1
     "msd.slope.xi1": msd_margin_bound(1.0),
     "msd.slope.xi0.8": msd_margin_bound(0.8),
+    # L_c read off the slowest shear mode, L / sqrt(1 - 1 / S_perp), assumes the elastic noise
+    # amplitude of fluctuating hydrodynamics; the cooling state's is some 25-30% larger
+    # (S_perp of the small box against 1 / (1 - (L/L_c)^2), measured at xi = 0.5 and 0.3),
+    # which lowers the inferred L_c by 2-3% in the thesis' box; the Sonine a2 corrections
+    # left out of theory's zeta and nu move L_c by another 1-2% at xi = 0.3
+    "cluster.lc.": 0.05,
+    "cluster.haff.small.xi0.5": haff_margin(0.5),
+    "cluster.haff.small.xi0.3": haff_margin(0.3),
     "sde.": _euler_maruyama_margin(),
     "ergodicity.": _euler_maruyama_margin(),
 }
 # <v^2> is not a comparison: the theory row is the runs' own temperature, so they agree to
 # rounding (checked as such)
 BY_CONSTRUCTION = ("table4.1.2d.mean_sq", "table4.1.3d.mean_sq")
+# measurements with nothing to agree with: the onset of flow (no theory) and the thesis' box
+# side against L_c (a statement about the box, no error)
+NOT_COMPARED = ("cluster.onset.xi0.3", "cluster.box.xi0.3")
 
 
 def test_demo_quick(tmp_path):
@@ -187,18 +198,21 @@ def test_reproduce_quick(tmp_path):
         ]
         + [f"table4.1.{d}.{k}" for d in ("2d", "3d") for k in ("mean", "mean_sq", "std")]
         + [f"haff.tau0.xi{x}" for x in ("0.99", "0.5", "0.3")]
+        + ["cluster.lc.xi0.5", "cluster.lc.xi0.3", "cluster.haff.small.xi0.3", *NOT_COMPARED]
     )
     assert set(required) <= set(rows)
     for r in rows.values():
         assert set(r) == {"id", "quantity", "ours", "ours_error", "runs", "thesis", "theory"}
-        assert r["theory"] is not None
+        assert r["theory"] is not None or r["id"] in NOT_COMPARED
     # rounding of ~1e-16 per collision, a random walk over the quick run's ~3e3 collisions:
     # ~5e-15 (measured 2.3e-15); bound 1e-13
     assert rows["energy.drift.xi1"]["ours"] < 1e-13
     for key in BY_CONSTRUCTION:
         assert rows[key]["ours"] == pytest.approx(rows[key]["theory"], rel=1e-12)
     statistical = [
-        r for r in rows.values() if r["id"] not in ("energy.drift.xi1", *BY_CONSTRUCTION)
+        r
+        for r in rows.values()
+        if r["id"] not in ("energy.drift.xi1", *BY_CONSTRUCTION, *NOT_COMPARED)
     ]
     for r in statistical:
         assert r["runs"] >= 10, r["id"]
@@ -213,7 +227,10 @@ def test_reproduce_quick(tmp_path):
         verdict = "agrees within" if abs(z) <= reproduce.SIGMA else "differs by"
         assert f"theory {r['theory']:.4g}: {verdict}" in sentence, sentence
     pngs = {p.name for p in (tmp_path / "rep").glob("*.png")}
-    assert len(pngs) >= 24 and "fig4_23_ergodicity_udsbm_tstop.png" in pngs
+    assert len(pngs) >= 27 and "fig4_23_ergodicity_udsbm_tstop.png" in pngs
+    assert {"cluster_haff_and_flow.png", "cluster_tau0_vs_box.png"} <= pngs
+    onset = rows["cluster.onset.xi0.3"]
+    assert onset["runs"] >= 10 and 0 < onset["ours"] < 40  # within the run's ~37 collisions
     assert (
         math.isfinite(rows["ergodicity.udsbm"]["theory"]) and rows["ergodicity.udsbm"]["theory"] < 1
     )

@@ -4,7 +4,8 @@ Public entry points
 -------------------
 ``FIGURES``
     The experiments in the thesis' order, by name: ``"4.1"``, ``"4.2-4.4"``, ``"4.5-4.7"``,
-    ``"4.8+4.10"``, ``"4.9"``, ``"4.11-4.16+F"``, ``"4.17-4.23"``.
+    ``"4.8+4.10"``, ``"4.9"``, ``"4.11-4.16+F"``, ``"4.17-4.23"``, then ``"clustering"``
+    (where the homogeneous cooling of Fig. 4.10 ends; ``reproduce_clustering``).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -611,6 +612,29 @@ def _fig_4_17_to_4_23(cfg, out):
     return names, rows
 
 
+def _fig_clustering(cfg, out):
+    """Where homogeneous cooling ends (issue 15): see ``reproduce_clustering``."""
+    import warnings
+
+    from ..errors import ClusteringWarning
+    from . import reproduce_clustering
+
+    # its big box lies beyond L_c on purpose: silence the warning, which needs the runs in
+    # this process (threads; the C core releases the GIL, and results do not depend on the
+    # backend)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ClusteringWarning)
+        return reproduce_clustering._fig_clustering(
+            cfg,
+            out,
+            ensemble=functools.partial(_checked_ensemble, backend="threads"),
+            save=_save,
+            fig=_fig,
+            row=_row,
+            mean_row=_mean_row,
+        )
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -619,6 +643,7 @@ FIGURES = {
     "4.9": _fig_4_9,
     "4.11-4.16+F": _fig_4_11_to_4_16_and_F,
     "4.17-4.23": _fig_4_17_to_4_23,
+    "clustering": _fig_clustering,
 }
 
 
@@ -702,8 +727,8 @@ def _sentence(row):
     runs = f" ({row['runs']} runs)" if row["runs"] else ""
     parts = [p for p in (_compare(row, "theory"), _compare(row, "thesis")) if p]
     return (
-        f"- `{row['id']}`, {row['quantity']}: ours {_fmt(row['ours'], row['ours_error'])}{runs}; "
-        + "; ".join(parts)
+        f"- `{row['id']}`, {row['quantity']}: ours {_fmt(row['ours'], row['ours_error'])}{runs}"
+        + "".join("; " + p for p in parts)
         + "."
     )
 
@@ -834,7 +859,14 @@ def _notes(cfg, by_id):
         ("Long-time MSD slopes (App. F)", "msd.slope.", slopes),
         ("Langevin and UDSBM (Figs 4.17-4.20)", "sde.", sde),
         ("Ergodicity (Figs 4.21-4.23)", "ergodicity.", ergodicity),
+        ("Where homogeneous cooling ends (clustering)", "cluster.", _clustering_notes(by_id)),
     ]
+
+
+def _clustering_notes(by_id):
+    from . import reproduce_clustering
+
+    return reproduce_clustering.notes(by_id)
 
 
 def _report(rows, cfg, names, seconds):
