@@ -9,7 +9,7 @@ velocities, normalised so that an uncorrelated gas (positions uniform, velocitie
 independent of each other and of the positions) gives a known value:
 
 ``structure_factor``
-    S(k) = |sum_j exp(i k.r_j)|^2 / N at the box's smallest wave vectors: 1 for an ideal
+    ``S(k) = |sum_j exp(i k.r_j)|^2 / N`` at the box's smallest wave vectors: 1 for an ideal
     gas, grows where density clusters form.
 ``current_correlations``
     The same for the momentum current j(k) = sum_j m_j v_j exp(i k.r_j), split into its
@@ -37,13 +37,13 @@ _CHUNK_ELEMENTS = 4_000_000
 def wave_vectors(
     box_lengths: ArrayLike, n_max: float = 2.0
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
-    """The box's wave vectors ``k = 2 pi n / L`` with integer n, 0 < |n| <= n_max, one of each
+    """The box's wave vectors ``k = 2 pi n / L`` with integer n, ``0 < |n| <= n_max``, one of each
     pair +-n (S(k) = S(-k) for real positions).
 
     Returns
     -------
     kvecs : (K, d) the wave vectors
-    shells : (S,) the distinct |k| (rounded to 1e-9 relative), increasing
+    shells : (S,) the distinct ``|k|`` (rounded to 1e-9 relative), increasing
     shell_index : (K,) which shell each wave vector belongs to
     """
     lengths = np.asarray(box_lengths, dtype=np.float64)
@@ -102,10 +102,10 @@ def _shell_mean(values, shell_index, n_shells):
 
 
 class StructureFactor(NamedTuple):
-    """S(k, t) averaged over the wave vectors of each |k| shell.
+    """S(k, t) averaged over the wave vectors of each ``|k|`` shell.
 
-    k : (S,) the shells' |k|
-    n : (S,) |k| L_max / (2 pi): |n| in a cubic box
+    k : (S,) the shells' ``|k|``
+    n : (S,) ``|k| L_max / (2 pi)``: ``|n|`` in a cubic box
     values : (T, S) S(k) at each sample
     vectors : (S,) how many wave vectors (one of each +-k) each shell averages
     """
@@ -120,14 +120,14 @@ def structure_factor(
     positions: ArrayLike, box_lengths: ArrayLike, n_max: float = 2.0
 ) -> StructureFactor:
     """Density structure factor ``S(k) = |sum_j exp(i k.r_j)|^2 / N`` at the smallest wave
-    vectors of a periodic box, ``k = 2 pi n / L`` with integer n, 0 < |n| <= n_max, averaged
-    over the vectors of equal |k| (the equivalent directions).
+    vectors of a periodic box, ``k = 2 pi n / L`` with integer n, ``0 < |n| <= n_max``, averaged
+    over the vectors of equal ``|k|`` (the equivalent directions).
 
     For an ideal gas (independent uniform positions) each S(k) has mean exactly 1 (the
     N (N - 1) cross terms average to zero at these k) and variance 1 - 1/N: a sum of N
-    random unit phasors, |.|^2 / N close to exponentially distributed; a shell average
+    random unit phasors, ``|.|^2 / N`` close to exponentially distributed; a shell average
     over m wave vectors has spread about 1/sqrt(m).  A simple cubic (square) lattice of
-    n^d particles filling the box gives 0 at every |n| < n and N where n divides every
+    n^d particles filling the box gives 0 at every ``|n| < n`` and N where n divides every
     component of the integer vector.  Density clusters at the box
     scale make S(k_min) grow to order N.
 
@@ -138,12 +138,12 @@ def structure_factor(
     box_lengths : array_like, (d,)
         The box's side lengths.
     n_max : float
-        Largest |n| included.
+        Largest ``|n|`` included.
 
     Returns
     -------
     StructureFactor
-        ``k``, ``n`` = |k| L_max / (2 pi), ``values`` (T, S) and ``vectors`` per shell.
+        ``k``, ``n = |k| L_max / (2 pi)``, ``values`` (T, S) and ``vectors`` per shell.
     """
     x = _as_samples(positions)
     kvecs, shells, idx = wave_vectors(box_lengths, n_max)
@@ -157,12 +157,12 @@ def structure_factor(
 
 
 class CurrentCorrelations(NamedTuple):
-    """Transverse and longitudinal momentum-current correlations per |k| shell, each 1 for an
+    """Transverse and longitudinal momentum-current correlations per ``|k|`` shell, each 1 for an
     uncorrelated gas.
 
-    k : (S,) the shells' |k|
-    transverse : (T, S) |j_perp(k)|^2 / ((d-1)/d sum_j m_j^2 |v_j|^2)
-    longitudinal : (T, S) |j_par(k)|^2 / ((1/d) sum_j m_j^2 |v_j|^2)
+    k : (S,) the shells' ``|k|``
+    transverse : (T, S) ``|j_perp(k)|^2 / ((d-1)/d sum_j m_j^2 |v_j|^2)``
+    longitudinal : (T, S) ``|j_par(k)|^2 / ((1/d) sum_j m_j^2 |v_j|^2)``
     vectors : (S,) wave vectors per shell
     """
 
@@ -216,7 +216,7 @@ def current_correlations(
     masses : array_like, (N,) or scalar
     box_lengths : array_like, (d,)
     n_max : float
-        Largest |n| included, as in ``structure_factor``.
+        Largest ``|n|`` included, as in ``structure_factor``.
 
     Returns
     -------
@@ -245,14 +245,23 @@ def current_correlations(
 class FlowEnergy(NamedTuple):
     """Kinetic energy of the coarse-grained flow field and of the motion about it.
 
-    flow : (T,) E_flow = sum_c |P_c|^2 / (2 M_c) over the cells, relative to the centre of mass
-    thermal : (T,) E_kin - E_flow, E_kin relative to the centre of mass
-    ratio : (T,) flow / thermal
-    noise : (T,) the ratio an uncorrelated gas gives on average: (C - 1) / (N - C) with C the
-        occupied cells (see ``flow_energy``)
-    noise_std : (T,) its standard deviation, noise * sqrt(2 / (d (C - 1))) (chi-squared)
-    excess : (T,) ratio - noise: the flow that is not finite-sample noise
-    cells : (T,) occupied cells C
+    Attributes
+    ----------
+    flow : (T,) array
+        ``E_flow = sum_c |P_c|^2 / (2 M_c)`` over the cells, relative to the centre of mass.
+    thermal : (T,) array
+        E_kin - E_flow, E_kin relative to the centre of mass.
+    ratio : (T,) array
+        flow / thermal.
+    noise : (T,) array
+        The ratio an uncorrelated gas gives on average: (C - 1) / (N - C) with C the occupied
+        cells (see ``flow_energy``).
+    noise_std : (T,) array
+        Its standard deviation, noise * sqrt(2 / (d (C - 1))) (chi-squared).
+    excess : (T,) array
+        ratio - noise: the flow that is not finite-sample noise.
+    cells : (T,) array
+        Occupied cells C.
     """
 
     flow: NDArray[np.float64]

@@ -274,7 +274,7 @@ def structure_factor(
     shells: int = 2,
     transverse=None,
 ) -> Axes:
-    """S(k, t) of the smallest |k| shells against time (a ``clustering.structure_factor``
+    """S(k, t) of the smallest ``|k|`` shells against time (a ``clustering.structure_factor``
     result), and, if given, the transverse current correlation of a
     ``clustering.current_correlations`` result (vortices) dashed in the same colours; both
     are 1 for a homogeneous gas without correlations."""

@@ -203,7 +203,7 @@ class Trajectory:
         )
 
     def structure_factor(self, n_max: float = 2.0) -> Any:
-        """Density structure factor S(k, t) at the box's smallest wave vectors, per |k|
+        """Density structure factor S(k, t) at the box's smallest wave vectors, per ``|k|``
         shell; see ``granular.clustering.structure_factor``."""
         from . import clustering
 
