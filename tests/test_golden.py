@@ -120,6 +120,9 @@ def _recorded():
     return json.loads(GOLDEN.read_text()) if GOLDEN.exists() else {}
 
 
+# the granular cases' boxes sit just above the shear-instability size (L/L_c ~ 1.01): the
+# warning is right, and beside the point of a test of bits
+@pytest.mark.filterwarnings("ignore::granular.ClusteringWarning")
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_fixed_seed_runs_give_the_recorded_bits(name):
     got = CASES[name]()
