@@ -8,7 +8,7 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 
-from . import analysis, errors, langevin, theory
+from . import analysis, errors, langevin, restitution, theory
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
     FrozenGasError,
@@ -23,6 +23,7 @@ from .errors import (
     UnstableStepError,
 )
 from .gsd_io import read
+from .restitution import ConstantRestitution, TabulatedRestitution, Viscoelastic
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
@@ -61,6 +62,7 @@ def __dir__():
 
 
 __all__ = [
+    "ConstantRestitution",
     "EnsembleResult",
     "FrozenGasError",
     "GranularError",
@@ -73,12 +75,15 @@ __all__ = [
     "ProcessBackendError",
     "Scene",
     "Simulation",
+    "TabulatedRestitution",
     "Trajectory",
     "UnstableStepError",
+    "Viscoelastic",
     "analysis",
     "ensemble",
     "errors",
     "langevin",
     "read",
+    "restitution",
     "theory",
 ]
