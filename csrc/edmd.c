@@ -43,10 +43,16 @@
 
 static void set_clock(gr_edmd *s, double t);
 static double next_sample(const gr_edmd_samples *smp);
-static int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j, double t, gr_error *err);
-static int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall, double t, gr_error *err);
-static void do_cross(gr_edmd *s, int dim, int32_t i, double t);
-static int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t, gr_error *err);
+/* The events are inlined into each of the four loops (as GCC did by itself for the two
+ * loops before laws came): each loop then holds its own copy, compiled for its dim and
+ * laws, and the constant-restitution loops execute exactly the instructions they did. */
+static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
+                                    double t, gr_error *err);
+static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall,
+                                    double t, gr_error *err);
+static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t);
+static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t,
+                                          gr_error *err);
 static void predict(gr_edmd *s, int dim, int32_t i);
 
 /* The loop, for dimension dim and for laws = 0 (constant restitution) or 1 (a
@@ -224,7 +230,8 @@ static double pair_law(gr_edmd *s, int dim, const double *dr, const double *vi, 
     return gr_law_eval(&s->cfg.law, vn, &s->law_clamped);
 }
 
-static int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j, double t, gr_error *err)
+static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
+                                    double t, gr_error *err)
 {
     double *p = rec(s, i), *q = rec(s, j);
     move(dim, p, t);
@@ -272,7 +279,8 @@ static int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j, double t
     return GR_OK;
 }
 
-static int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall, double t, gr_error *err)
+static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall,
+                                    double t, gr_error *err)
 {
     double *p = rec(s, i), *v = VEL(p, dim);
     const int a = wall >> 1, up = wall & 1;
@@ -314,7 +322,7 @@ static void predict_cross(gr_edmd *s, int dim, int32_t i);
 static void schedule(gr_edmd *s, int32_t i);
 
 /* Cell mode: i moves into the next cell, wrapping around a periodic box. */
-static void do_cross(gr_edmd *s, int dim, int32_t i, double t)
+static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 {
     double *p = rec(s, i);
     gr_sched *e = &s->sched[i];
@@ -347,7 +355,8 @@ static void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 /* List mode: i (clock at t) has left its shell.  Its list is rebuilt about its present
  * position, which is first brought back into a periodic box (between rebuilds a
  * particle may stray up to delta beyond the box: pair tests take the nearest image). */
-static int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t, gr_error *err)
+static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t,
+                                          gr_error *err)
 {
     double *p = rec(s, i);
     gr_sched *e = &s->sched[i];

@@ -215,7 +215,7 @@ class Viscoelastic(RestitutionLaw):
         Parameters
         ----------
         restitution : float
-            eps at that speed, in [eps(delta = 0.25), 1) = [0.7616, 1).
+            eps at that speed, in [eps(delta = 0.25), 1) = [0.7615, 1).
         speed : float
             > 0.
 

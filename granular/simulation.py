@@ -298,7 +298,9 @@ class Simulation:
         finally:
             if bar is not None:
                 bar.close()
-        clamped = self._engine.counters()["law_clamped_collisions"] - start["law_clamped_collisions"]
+        clamped = (
+            self._engine.counters()["law_clamped_collisions"] - start["law_clamped_collisions"]
+        )
         if clamped:
             _warn_clamped(clamped, self._initial)
         if final_sample and (nxt == 0 or self.time > times[0]):
