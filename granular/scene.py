@@ -10,8 +10,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _edmd
-from .restitution import ConstantRestitution, RestitutionLaw, engine_law
 from .placement import draw_velocities, lattice_order, place_lattice, place_rsa
+from .restitution import ConstantRestitution, RestitutionLaw, engine_law
 
 BOUNDARIES = ("periodic", "walls")
 
