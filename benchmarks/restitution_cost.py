@@ -71,7 +71,7 @@ def main():
         import matplotlib.pyplot as plt
 
         fig, ax = plt.subplots(figsize=(6, 3))
-        for k, (name, c) in enumerate(cost.items()):
+        for k, c in enumerate(cost.values()):
             c = np.array(c) * 1e6
             ax.plot(np.full(c.size, k), c, "o", color="0.6", ms=4)
             ax.plot([k - 0.25, k + 0.25], [np.median(c)] * 2, "k-", lw=2)
