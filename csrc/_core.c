@@ -149,6 +149,36 @@ static void EDMD_dealloc(EDMDObject *self)
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
+/* A restitution law from None (constant: *law zeroed) or a tuple (kind, scale, v_max,
+ * speeds, values) as granular/restitution.py builds it; the table arrays are returned in
+ * *x, *y (new references, or NULL) and must outlive the use of *law.  Returns 0, or -1
+ * with an exception set.  The engine checks the values (validate.c). */
+static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject **x,
+                     PyArrayObject **y)
+{
+    memset(law, 0, sizeof *law);
+    *x = *y = NULL;
+    if (obj == Py_None) return 0;
+    PyObject *ox, *oy;
+    if (!PyTuple_Check(obj) ||
+        !PyArg_ParseTuple(obj, "iddOO", &law->kind, &law->scale, &law->v_max, &ox, &oy)) {
+        PyErr_Format(PyExc_TypeError, "%s must be None or (kind, scale, v_max, speeds, values)",
+                     name);
+        return -1;
+    }
+    npy_intp any[1] = {-1};
+    if (!(*x = as_f64(ox, "a law's speeds", 1, any))) return -1;
+    npy_intp shape[1] = {PyArray_DIM(*x, 0)};
+    if (!(*y = as_f64(oy, "a law's values", 1, shape))) {
+        Py_CLEAR(*x);
+        return -1;
+    }
+    law->count = (int64_t)shape[0];
+    law->speeds = shape[0] ? PyArray_DATA(*x) : NULL;
+    law->values = shape[0] ? PyArray_DATA(*y) : NULL;
+    return 0;
+}
+
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
  * exception set. */
@@ -157,21 +187,30 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
 {
     static char *names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                             "periodic", "wall_restitution", "restitution",
-                            "contact_duration", "cell_factor", "big_ratio", "shell", NULL};
-    PyObject *opos, *ovel, *orad, *omass, *olo, *ohi;
+                            "contact_duration", "cell_factor", "big_ratio", "shell",
+                            "law", "wall_law", NULL};
+    PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None;
     int periodic;
     double wall_e, xi, tc, cell_factor = 1.0, big_ratio = GR_BIG_RATIO, shell = 0.0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpddd|ddd", names, &opos, &ovel, &orad,
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpddd|dddOO", names, &opos, &ovel, &orad,
                                      &omass, &olo, &ohi, &periodic, &wall_e, &xi, &tc,
-                                     &cell_factor, &big_ratio, &shell))
+                                     &cell_factor, &big_ratio, &shell, &olaw, &owall))
         return -1;
+    gr_law law, wall_law;
+    PyArrayObject *law_x = NULL, *law_y = NULL, *wall_x = NULL, *wall_y = NULL;
+    if (parse_law(olaw, "law", &law, &law_x, &law_y) < 0) return -1;
+    if (parse_law(owall, "wall_law", &wall_law, &wall_x, &wall_y) < 0) {
+        Py_XDECREF(law_x);
+        Py_XDECREF(law_y);
+        return -1;
+    }
     npy_intp any2[2] = {-1, -1};
     PyArrayObject *pos = as_f64(opos, "positions", 2, any2);
-    if (!pos) return -1;
-    npy_intp n = PyArray_DIM(pos, 0), d = PyArray_DIM(pos, 1);
+    npy_intp n = pos ? PyArray_DIM(pos, 0) : 0, d = pos ? PyArray_DIM(pos, 1) : 0;
     npy_intp shp[2] = {n, d}, shn[1] = {n}, shd[1] = {d};
     PyArrayObject *vel = NULL, *rad = NULL, *mass = NULL, *lo = NULL, *hi = NULL;
     int ok = 0;
+    if (!pos) goto done;
     if (d != 2 && d != 3) {
         PyErr_Format(PyExc_ValueError, "positions must have shape (N, 2) or (N, 3), got (N, %zd)",
                      (Py_ssize_t)d);
@@ -196,6 +235,8 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
     cfg.cell_factor = cell_factor;
     cfg.big_ratio = big_ratio;
     cfg.shell = shell;
+    cfg.law = law;
+    cfg.wall_law = wall_law;
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
     int status;
     Py_BEGIN_ALLOW_THREADS
@@ -220,6 +261,10 @@ done:
     Py_XDECREF(mass);
     Py_XDECREF(lo);
     Py_XDECREF(hi);
+    Py_XDECREF(law_x);
+    Py_XDECREF(law_y);
+    Py_XDECREF(wall_x);
+    Py_XDECREF(wall_y);
     return ok ? 0 : -1;
 }
 
@@ -424,12 +469,13 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     if (!check_ready(self)) return NULL;
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
-    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d}", "time", c.t,
+    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d}", "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
                          (long long)c.crossings, "shell_exits", (long long)c.shell_exits,
                          "stale_events", (long long)c.invalid,
-                         "tc_elastic_collisions", (long long)c.elastic_tc, "virial", c.virial,
+                         "tc_elastic_collisions", (long long)c.elastic_tc,
+                         "law_clamped_collisions", (long long)c.law_clamped, "virial", c.virial,
                          "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic,
                          "kinetic_time_integral", c.kinetic_time, "cells",
                          c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell);

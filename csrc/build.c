@@ -18,6 +18,10 @@ void gr_edmd_free(gr_edmd *s)
     free(s->order.id_of);
     free(s->order.scratch);
     free(s->big.is_big);
+    free((void *)s->cfg.law.speeds); /* the engine's own copies (copy_law) */
+    free((void *)s->cfg.law.values);
+    free((void *)s->cfg.wall_law.speeds);
+    free((void *)s->cfg.wall_law.values);
     gr_cq_free(&s->queue);
     gr_cells_free(&s->cells);
     gr_nlist_free(&s->nl);
@@ -30,6 +34,27 @@ static size_t scratch_per_particle(int dim)
 {
     const size_t record = (size_t)(2 * dim + 2) * sizeof(double);
     return record > sizeof(gr_sched) ? record : sizeof(gr_sched);
+}
+
+/* Replace a table law's pointers (the caller's arrays) by copies the engine owns; on
+ * failure the pointers are NULL (gr_edmd_free then frees what was copied). */
+static int copy_law(gr_law *law)
+{
+    const double *x = law->speeds, *y = law->values;
+    law->speeds = law->values = NULL;
+    if (law->kind != GR_LAW_TABLE) return GR_OK;
+    size_t bytes = (size_t)law->count * sizeof(double);
+    double *cx = malloc(bytes), *cy = malloc(bytes);
+    if (!cx || !cy) {
+        free(cx);
+        free(cy);
+        return GR_ERR_NOMEM;
+    }
+    memcpy(cx, x, bytes);
+    memcpy(cy, y, bytes);
+    law->speeds = cx;
+    law->values = cy;
+    return GR_OK;
 }
 
 size_t gr_edmd_bytes_per_particle(int dim, int lists)
@@ -68,6 +93,9 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     gr_edmd *s = calloc(1, sizeof *s);
     if (!s) return GR_ERR_NOMEM;
     s->cfg = *cfg;
+    status = copy_law(&s->cfg.law);
+    int wall_status = copy_law(&s->cfg.wall_law); /* always: it drops the caller's pointers */
+    if (status == GR_OK) status = wall_status;
     s->dim = d;
     s->stride = 2 * d + 2;
     s->n = n;

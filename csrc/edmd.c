@@ -43,15 +43,25 @@
 
 static void set_clock(gr_edmd *s, double t);
 static double next_sample(const gr_edmd_samples *smp);
-static int do_pair(gr_edmd *s, int dim, int32_t i, int32_t j, double t, gr_error *err);
-static int do_wall(gr_edmd *s, int dim, int32_t i, int wall, double t, gr_error *err);
-static void do_cross(gr_edmd *s, int dim, int32_t i, double t);
-static int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t, gr_error *err);
+/* The events are inlined into each of the four loops (as GCC did by itself for the two
+ * loops before laws came): each loop then holds its own copy, compiled for its dim and
+ * laws, and the constant-restitution loops execute exactly the instructions they did. */
+static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
+                                    double t, gr_error *err);
+static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall,
+                                    double t, gr_error *err);
+static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t);
+static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t,
+                                          gr_error *err);
 static void predict(gr_edmd *s, int dim, int32_t i);
 
-/* The loop, for dimension dim (a constant in each of advance_2d and advance_3d). */
-static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const gr_edmd_stop *stop,
-                                    gr_edmd_samples *smp, gr_error *err)
+/* The loop, for dimension dim and for laws = 0 (constant restitution) or 1 (a
+ * restitution law, restitution.h), constants in each of the four advance_* below: a
+ * constant-xi run executes the loop compiled without any law code, not a test per
+ * collision. */
+static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
+                                    const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                                    gr_error *err)
 {
     const double t_stop = stop->t_stop;
     const int64_t n = s->n;
@@ -121,10 +131,10 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const gr_edmd_sto
                 predict(s, dim, i);
                 continue;
             }
-            status = do_pair(s, dim, i, e->partner, te, err);
+            status = do_pair(s, dim, laws, i, e->partner, te, err);
             check = 1;
         } else {
-            status = do_wall(s, dim, i, -2 - e->partner, te, err);
+            status = do_wall(s, dim, laws, i, -2 - e->partner, te, err);
             check = 1;
         }
         if (status != GR_OK) return status;
@@ -138,12 +148,24 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const gr_edmd_sto
 
 static int advance_2d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
-    return advance(s, 2, stop, smp, err);
+    return advance(s, 2, 0, stop, smp, err);
 }
 
 static int advance_3d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
-    return advance(s, 3, stop, smp, err);
+    return advance(s, 3, 0, stop, smp, err);
+}
+
+static int advance_2d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, 2, 1, stop, smp, err);
+}
+
+static int advance_3d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, 3, 1, stop, smp, err);
 }
 
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
@@ -153,6 +175,8 @@ int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, 
                      "a neighbour list could not grow earlier; the system cannot go on");
         return GR_ERR_NOMEM;
     }
+    if (s->cfg.law.kind != GR_LAW_CONSTANT || s->cfg.wall_law.kind != GR_LAW_CONSTANT)
+        return s->dim == 2 ? advance_2d_law(s, stop, smp, err) : advance_3d_law(s, stop, smp, err);
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
 }
 
@@ -193,7 +217,21 @@ static inline int streak(gr_edmd *s, int32_t i, double t)
     return e->streak > GR_COLLAPSE_STREAK;
 }
 
-static int do_pair(gr_edmd *s, int dim, int32_t i, int32_t j, double t, gr_error *err)
+/* The restitution law's eps for a pair at contact: its normal approach speed
+ * |dv . dr| / |dr| (0 for a pair that does not approach: gr_pair_collide refuses it). */
+static double pair_law(gr_edmd *s, int dim, const double *dr, const double *vi, const double *vj)
+{
+    double b = 0.0, dr2 = 0.0;
+    for (int a = 0; a < dim; a++) {
+        b += dr[a] * (vj[a] - vi[a]);
+        dr2 += dr[a] * dr[a];
+    }
+    double vn = b < 0.0 && dr2 > 0.0 ? -b / sqrt(dr2) : 0.0;
+    return gr_law_eval(&s->cfg.law, vn, &s->law_clamped);
+}
+
+static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
+                                    double t, gr_error *err)
 {
     double *p = rec(s, i), *q = rec(s, j);
     move(dim, p, t);
@@ -205,6 +243,7 @@ static int do_pair(gr_edmd *s, int dim, int32_t i, int32_t j, double t, gr_error
         if (s->cfg.periodic) dr[a] = nearest_image(dr[a], s->L[a]);
     }
     double xi = s->cfg.restitution;
+    if (laws && s->cfg.law.kind != GR_LAW_CONSTANT) xi = pair_law(s, dim, dr, VEL(p, dim), VEL(q, dim));
     if (s->cfg.contact_duration > 0.0 && xi < 1.0 &&
         (t - s->sched[i].t_last < s->cfg.contact_duration ||
          t - s->sched[j].t_last < s->cfg.contact_duration)) {
@@ -240,13 +279,17 @@ static int do_pair(gr_edmd *s, int dim, int32_t i, int32_t j, double t, gr_error
     return GR_OK;
 }
 
-static int do_wall(gr_edmd *s, int dim, int32_t i, int wall, double t, gr_error *err)
+static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall,
+                                    double t, gr_error *err)
 {
     double *p = rec(s, i), *v = VEL(p, dim);
     const int a = wall >> 1, up = wall & 1;
     move(dim, p, t);
     double before = kinetic_of(s, dim, i), vn = v[a];
     double ew = s->cfg.wall_restitution;
+    /* a law gives e_w of the same rule (2.22) from the normal impact speed |v_a| */
+    if (laws && s->cfg.wall_law.kind != GR_LAW_CONSTANT)
+        ew = gr_law_eval(&s->cfg.wall_law, fabs(vn), &s->law_clamped);
     if (ew < 1.0 && s->cfg.contact_duration > 0.0 && t - s->sched[i].t_last < s->cfg.contact_duration)
         ew = 1.0;
     v[a] = -v[a];
@@ -279,7 +322,7 @@ static void predict_cross(gr_edmd *s, int dim, int32_t i);
 static void schedule(gr_edmd *s, int32_t i);
 
 /* Cell mode: i moves into the next cell, wrapping around a periodic box. */
-static void do_cross(gr_edmd *s, int dim, int32_t i, double t)
+static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 {
     double *p = rec(s, i);
     gr_sched *e = &s->sched[i];
@@ -312,7 +355,8 @@ static void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 /* List mode: i (clock at t) has left its shell.  Its list is rebuilt about its present
  * position, which is first brought back into a periodic box (between rebuilds a
  * particle may stray up to delta beyond the box: pair tests take the nearest image). */
-static int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t, gr_error *err)
+static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t,
+                                          gr_error *err)
 {
     double *p = rec(s, i);
     gr_sched *e = &s->sched[i];

@@ -23,6 +23,7 @@
 #include <stdint.h>
 
 #include "common.h"
+#include "restitution.h"
 
 /* Why gr_edmd_advance returned (all are successes). */
 enum {
@@ -48,6 +49,9 @@ typedef struct {
     double shell;             /* > 0: neighbour lists with a shell this many largest
                                * diameters thick (no big particles then); 0: cell
                                * crossings -- a speed knob, see nlist.h */
+    gr_law law, wall_law;     /* kind GR_LAW_CONSTANT (zeroed): restitution and
+                               * wall_restitution above; else eps(v_n) replaces them
+                               * (restitution.h).  gr_edmd_new copies the tables. */
 } gr_edmd_config;
 
 typedef struct {
@@ -83,6 +87,7 @@ typedef struct {
     int64_t shell_exits;    /* neighbour lists: shell exits, each rebuilding one list */
     int64_t invalid;        /* events found stale on pop (partner collided since) */
     int64_t elastic_tc;     /* pair collisions made elastic by the TC model */
+    int64_t law_clamped;    /* collisions faster than a viscoelastic law's range */
     double virial;          /* sum over pair collisions of r_ij . dp_j */
     double wall_impulse;    /* sum over wall collisions of |dp_normal| */
     double kinetic;         /* total kinetic energy now */

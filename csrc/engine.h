@@ -50,6 +50,7 @@ struct gr_edmd {
     int64_t shell_exits;  /* list mode: shell exits, each rebuilding one list */
     double virial, wall_impulse, kinetic;
     double kinetic_time;  /* integral of the total kinetic energy over time, for the pressure */
+    int64_t law_clamped;  /* collisions past a viscoelastic law's range (restitution.h) */
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are

@@ -65,6 +65,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->shell_exits = s->shell_exits;
     c->invalid = s->invalid;
     c->elastic_tc = s->elastic_tc;
+    c->law_clamped = s->law_clamped;
     c->virial = s->virial;
     c->wall_impulse = s->wall_impulse;
     c->kinetic_time = s->kinetic_time;

@@ -6,6 +6,46 @@
 
 #include "engine.h"
 
+/* A restitution law (restitution.h) the engine can evaluate: kind known, parameters
+ * finite and in range, a table increasing in speed with values in [0, 1]. */
+static int validate_law(const gr_law *law, gr_error *err)
+{
+    switch (law->kind) {
+    case GR_LAW_CONSTANT:
+        return GR_OK;
+    case GR_LAW_VISCOELASTIC:
+        if (!(law->scale > 0.0 && isfinite(law->scale) && law->v_max > 0.0)) {
+            gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, law->scale,
+                         "a viscoelastic law needs A kappa^(2/5) > 0 and finite, and v_max > 0");
+            return GR_ERR_VALUE;
+        }
+        return GR_OK;
+    case GR_LAW_TABLE:
+        if (!(law->count >= 1 && law->count <= GR_LAW_TABLE_MAX) || !law->speeds || !law->values) {
+            gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, (double)law->count,
+                         "a restitution table needs 1 to " GR_XSTR(GR_LAW_TABLE_MAX) " points");
+            return GR_ERR_VALUE;
+        }
+        for (int64_t k = 0; k < law->count; k++) {
+            double v = law->speeds[k], e = law->values[k];
+            if (!(v >= 0.0 && isfinite(v)) || (k > 0 && !(v > law->speeds[k - 1]))) {
+                gr_error_set(err, GR_ERR_VALUE, k, -1, NAN, v,
+                             "a restitution table's speeds must be finite, >= 0 and increasing");
+                return GR_ERR_VALUE;
+            }
+            if (!(e >= 0.0 && e <= 1.0)) {
+                gr_error_set(err, GR_ERR_VALUE, k, -1, NAN, e,
+                             "a restitution table's values must lie in [0, 1]");
+                return GR_ERR_VALUE;
+            }
+        }
+        return GR_OK;
+    default:
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, law->kind, "unknown kind of restitution law");
+        return GR_ERR_VALUE;
+    }
+}
+
 int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const double *vel,
                        const double *radius, const double *mass, gr_error *err)
 {
@@ -29,6 +69,9 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
                      "wall restitution must be positive and finite");
         return GR_ERR_VALUE;
     }
+    int status = validate_law(&cfg->law, err);
+    if (status == GR_OK) status = validate_law(&cfg->wall_law, err);
+    if (status != GR_OK) return status;
     if (!(cfg->contact_duration >= 0.0 && isfinite(cfg->contact_duration))) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->contact_duration,
                      "contact duration must be finite and >= 0");

@@ -8,7 +8,7 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 
-from . import analysis, clustering, errors, langevin, theory
+from . import analysis, clustering, errors, langevin, restitution, theory
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
     ClusteringWarning,
@@ -24,6 +24,7 @@ from .errors import (
     UnstableStepError,
 )
 from .gsd_io import read
+from .restitution import ConstantRestitution, TabulatedRestitution, Viscoelastic
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory
@@ -63,6 +64,7 @@ def __dir__():
 
 __all__ = [
     "ClusteringWarning",
+    "ConstantRestitution",
     "EnsembleResult",
     "FrozenGasError",
     "GranularError",
@@ -75,13 +77,16 @@ __all__ = [
     "ProcessBackendError",
     "Scene",
     "Simulation",
+    "TabulatedRestitution",
     "Trajectory",
     "UnstableStepError",
+    "Viscoelastic",
     "analysis",
     "clustering",
     "ensemble",
     "errors",
     "langevin",
     "read",
+    "restitution",
     "theory",
 ]

@@ -69,6 +69,7 @@ def build(scene, cell_factor=1.0, big_ratio=_core.BIG_RATIO, shell="auto"):
         float(cell_factor),
         float(big_ratio),
         float(shell),
+        **scene._engine_laws(),
     )
 
 

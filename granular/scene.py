@@ -11,6 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _edmd
 from .placement import draw_velocities, lattice_order, place_lattice, place_rsa
+from .restitution import ConstantRestitution, RestitutionLaw, engine_law
 
 BOUNDARIES = ("periodic", "walls")
 
@@ -136,6 +137,19 @@ def _real(value, name):
     return a.astype(np.float64, copy=False)  # callers that keep it copy it (_array)
 
 
+def _restitution(value, name):
+    """A restitution as a Scene keeps it: a law, or a float (a ConstantRestitution's
+    number); the caller checks the number's range."""
+    if isinstance(value, ConstantRestitution):
+        return value.value
+    if isinstance(value, RestitutionLaw):
+        return value
+    try:
+        return float(value)
+    except TypeError:
+        raise TypeError(f"{name} must be a number or a restitution law, got {value!r}") from None
+
+
 def _array(value, name, shape):
     a = np.array(_real(value, name), dtype=np.float64, order="C", copy=True)
     if a.shape != shape:
@@ -160,11 +174,16 @@ class Scene:
     box : float, or (lower, upper) with scalars or length-d arrays
         A float L means the box [0, L]^d (the thesis' unit box is ``box=1``).
     boundary : {"periodic", "walls"}
-    wall_restitution : float
+    wall_restitution : float or RestitutionLaw
         Walls reflect with ``v' = e_w * (v mirrored)`` (thesis eq. 2.22): 1 elastic, < 1
-        inelastic, > 1 "heated".  Ignored for periodic boxes.
-    restitution : float in [0, 1]
-        Coefficient of restitution xi of pair collisions (thesis 2.10-2.11).
+        inelastic, > 1 "heated".  A law (``granular.restitution``) gives e_w from the
+        normal impact speed ``|v_n|`` of each hit, in the same rule (so the tangential
+        velocity is scaled by e_w too).  Ignored for periodic boxes.
+    restitution : float in [0, 1] or RestitutionLaw
+        Coefficient of restitution xi of pair collisions (thesis 2.10-2.11), or a law
+        xi(v_n) of the normal impact speed: ``granular.Viscoelastic``,
+        ``granular.TabulatedRestitution`` (a ``ConstantRestitution`` is stored as its
+        number).
     contact_duration : float >= 0
         TC model t_c (thesis 3.6): a collision within t_c of a particle's previous one is
         elastic, which prevents inelastic collapse.  0 turns it off.
@@ -185,8 +204,8 @@ class Scene:
         *,
         box: float | ArrayLike = 1.0,
         boundary: str = "periodic",
-        wall_restitution: float = 1.0,
-        restitution: float = 1.0,
+        wall_restitution: float | RestitutionLaw = 1.0,
+        restitution: float | RestitutionLaw = 1.0,
         contact_duration: float = 0.0,
     ) -> None:
         pos = _real(positions, "positions")
@@ -214,23 +233,32 @@ class Scene:
         if boundary not in BOUNDARIES:
             raise ValueError(f"boundary must be one of {BOUNDARIES}, got {boundary!r}")
         self.boundary = boundary
-        self.wall_restitution = float(wall_restitution)
-        if not (self.wall_restitution > 0 and math.isfinite(self.wall_restitution)):
+        self.wall_restitution = _restitution(wall_restitution, "wall_restitution")
+        if not isinstance(self.wall_restitution, RestitutionLaw) and not (
+            self.wall_restitution > 0 and math.isfinite(self.wall_restitution)
+        ):
             raise ValueError(
                 f"wall_restitution must be positive and finite, got {wall_restitution}"
             )
-        self.restitution = float(restitution)
-        if not 0.0 <= self.restitution <= 1.0:
+        self.restitution = _restitution(restitution, "restitution")
+        if not isinstance(self.restitution, RestitutionLaw) and not (
+            0.0 <= self.restitution <= 1.0
+        ):
             raise ValueError(f"restitution must lie in [0, 1], got {restitution}")
         self.contact_duration = float(contact_duration)
         if not (self.contact_duration >= 0 and math.isfinite(self.contact_duration)):
             raise ValueError(f"contact_duration must be finite and >= 0, got {contact_duration}")
         # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
         # the engine's own rules in O(N) through a cell grid, without building an engine.
-        _core.edmd_check(*self._engine_args())
+        _core.edmd_check(*self._engine_args(), **self._engine_laws())
+
+    def _engine_laws(self) -> dict[str, Any]:
+        """The restitution laws as keywords of ``_core.EDMD`` (None: the number)."""
+        return dict(law=engine_law(self.restitution), wall_law=engine_law(self.wall_restitution))
 
     def _engine_args(self) -> tuple:
-        """The scene as the C engine takes it (``_core.edmd_check`` and ``_core.EDMD``)."""
+        """The scene as the C engine takes it (``_core.edmd_check`` and ``_core.EDMD``),
+        with ``_engine_laws`` as keywords; a law's number is 1 (unused)."""
         return (
             self.positions,
             self.velocities,
@@ -239,8 +267,8 @@ class Scene:
             self.lower,
             self.upper,
             self.boundary == "periodic",
-            self.wall_restitution,
-            self.restitution,
+            1.0 if isinstance(self.wall_restitution, RestitutionLaw) else self.wall_restitution,
+            1.0 if isinstance(self.restitution, RestitutionLaw) else self.restitution,
             self.contact_duration,
         )
 
@@ -336,12 +364,12 @@ class Scene:
         dim: int = 3,
         box: float | ArrayLike = 1.0,
         boundary: str = "periodic",
-        restitution: float = 1.0,
+        restitution: float | RestitutionLaw = 1.0,
         *,
         speed: float | None = None,
         temperature: float | None = None,
         mass: float | ArrayLike = 1.0,
-        wall_restitution: float = 1.0,
+        wall_restitution: float | RestitutionLaw = 1.0,
         contact_duration: float = 0.0,
         remove_drift: bool = True,
         seed: Any = None,

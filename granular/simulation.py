@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _edmd
+from . import restitution as _restitution
 from ._edmd import check_memory as _check_memory
 from .errors import (
     ClusteringWarning,
@@ -103,7 +104,8 @@ class Simulation:
         """Counters since the start: events, pair_collisions, wall_collisions,
         cell_crossings (cell mode), shell_exits (neighbour lists: each rebuilds one
         list), stale_events,
-        tc_elastic_collisions, virial, wall_impulse, kinetic_energy,
+        tc_elastic_collisions, law_clamped_collisions (past a viscoelastic law's
+        range, see ``granular.Viscoelastic``), virial, wall_impulse, kinetic_energy,
         kinetic_time_integral, time, cells, shell (0: cells); and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
         with the time average <E_kin>_t (exact for a cooling gas too) and W the pair
@@ -313,6 +315,11 @@ class Simulation:
         finally:
             if bar is not None:
                 bar.close()
+        clamped = (
+            self._engine.counters()["law_clamped_collisions"] - start["law_clamped_collisions"]
+        )
+        if clamped:
+            _warn_clamped(clamped, self._initial)
         if final_sample and (nxt == 0 or self.time > times[0]):
             times = np.append(times[:nxt], self.time)
             self._sample_now(buf, nxt)
@@ -330,7 +337,7 @@ class Simulation:
         if not (
             isinstance(exc, InelasticCollapseError)
             and s.boundary == "walls"
-            and s.wall_restitution > 1.0
+            and _restitution.heats(s.wall_restitution)
             and energy0 > 0
         ):
             return None
@@ -369,8 +376,8 @@ class Simulation:
         energy never falls without a dissipative channel (inelastic pairs, of which there
         must be two, or absorbing walls)."""
         s = self._initial
-        pairs_lose = s.restitution < 1.0 and s.n >= 2
-        walls_lose = s.boundary == "walls" and s.wall_restitution < 1.0
+        pairs_lose = _restitution.loses_energy(s.restitution) and s.n >= 2
+        walls_lose = s.boundary == "walls" and _restitution.loses_energy(s.wall_restitution)
         mean = self._engine.counters()["kinetic_energy"] / s.n
         if not (pairs_lose or walls_lose) and target < mean:
             why = (
@@ -444,8 +451,10 @@ class _StallGuard:
     def __init__(self, sim, dissipative_only):
         s = sim._initial
         self.limit = max(self.MIN_LIMIT, 1000 * s.n)
-        self.pairs = not dissipative_only or s.restitution < 1.0
-        self.walls = not dissipative_only or (s.boundary == "walls" and s.wall_restitution < 1.0)
+        self.pairs = not dissipative_only or _restitution.loses_energy(s.restitution)
+        self.walls = not dissipative_only or (
+            s.boundary == "walls" and _restitution.loses_energy(s.wall_restitution)
+        )
         self.dissipative_only = dissipative_only
         c = sim._engine.counters()
         self.progress = self._progress(c)
@@ -506,3 +515,18 @@ def _progress_bar(progress, t0, t1, collisions):
     if math.isfinite(collisions):
         return _ProgressBar(0.0, collisions, by_time=False)
     return None
+
+
+def _warn_clamped(count, scene):
+    """Warn that collisions were faster than a viscoelastic law's series reaches."""
+    import warnings
+
+    laws = [x for x in (scene.restitution, scene.wall_restitution) if hasattr(x, "max_speed")]
+    speeds = ", ".join(f"{law.max_speed:.4g}" for law in laws)
+    warnings.warn(
+        f"{count} collisions in this run were faster than the viscoelastic law's range "
+        f"(normal impact speed above max_speed = {speeds}) and got the restitution at "
+        "max_speed: the second-order series is not valid there (granular.Viscoelastic)",
+        RuntimeWarning,
+        stacklevel=3,
+    )

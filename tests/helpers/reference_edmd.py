@@ -1,7 +1,11 @@
 """A slow, obvious event-driven MD in pure NumPy: the reference the C engine is tested
 against.  Every step computes every pair's collision time over all 3^d periodic images
 (or every wall time), moves all particles to the earliest event and applies the thesis'
-collision rule (2.10-2.11) or wall rule (2.22).  O(N^2) per event: tests only."""
+collision rule (2.10-2.11) or wall rule (2.22).  O(N^2) per event: tests only.
+
+A restitution may be a number or a law (anything callable on a normal impact speed, as
+granular.restitution's laws are, evaluated with NumPy): eps(|dv . n|) for a pair, e_w(|v_a|)
+for a wall."""
 
 import itertools
 
@@ -49,6 +53,10 @@ def run_scene(scene, t_stop, sample_times):
     )
 
 
+def _eps(restitution, speed):
+    return float(restitution(speed)) if callable(restitution) else restitution
+
+
 def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0):
     """Positions (unwrapped) and velocities at sample_times."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
@@ -87,11 +95,13 @@ def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0):
             if periodic:
                 dr -= L * np.round(dr / L)
             dv = v[j] - v[i]
-            f = (1 + xi) * np.dot(dv, dr) / (np.dot(dr, dr) * (m[i] + m[j]))
+            eps = _eps(xi, -np.dot(dv, dr) / np.sqrt(np.dot(dr, dr)))
+            f = (1 + eps) * np.dot(dv, dr) / (np.dot(dr, dr) * (m[i] + m[j]))
             v[i] += f * m[j] * dr
             v[j] -= f * m[i] * dr
         else:
             p, a = wall
+            e_w = _eps(wall_e, abs(v[p, a]))
             v[p, a] = -v[p, a]
-            v[p] *= wall_e
+            v[p] *= e_w
     return np.array(out_x), np.array(out_v)

@@ -1,0 +1,361 @@
+"""Restitution laws: the coefficient of normal restitution as a function of the normal
+impact speed of a collision, ``v_n = |(v_j - v_i) * n|`` (n the unit normal at contact).
+
+A Scene's ``restitution`` (pair collisions) and ``wall_restitution`` take a number, as
+always, or one of these laws.  The engine (csrc/restitution.h) evaluates the law at every
+collision; a number keeps the engine's constant-restitution loop, which runs no law code.
+
+- :class:`ConstantRestitution`: a number written as a law (a Scene stores it as the number).
+- :class:`Viscoelastic`: spheres with the dissipative Hertz contact force (Brilliantov,
+  Spahn, Hertzsch & Poeschel 1996), eps(v) from the series of Schwager & Poeschel (1998).
+- :class:`TabulatedRestitution`: a measured curve, interpolated linearly.
+
+Each law is a small immutable value: it compares by value, pickles, and can be called on
+speeds (``law(v)``) with NumPy, the slow obvious evaluation that the engine's is tested
+against.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+# Kinds of law as the engine numbers them (csrc/restitution.h GR_LAW_*).
+_KIND_VISCOELASTIC = 1
+_KIND_TABLE = 2
+
+# eps = 1 - C1 delta + C2 delta^2, delta = A kappa^(2/5) v^(1/5) (Schwager & Poeschel 1998,
+# Phys. Rev. E 57, 650; Brilliantov & Poeschel, Kinetic Theory of Granular Gases, 2004,
+# ch. 6): C1 = Gamma(3/5) sqrt(pi) / (2^(1/5) 5^(2/5) Gamma(21/10)), C2 = (3/5) C1^2.
+C1: float = math.gamma(3 / 5) * math.sqrt(math.pi) / (2**0.2 * 5**0.4 * math.gamma(21 / 10))
+C2: float = 0.6 * C1**2
+# The series is used up to this delta (csrc/restitution.h GR_VISCO_DELTA_MAX): the next,
+# dropped term is about -0.5 delta^3 (tests/test_restitution.py integrates the contact),
+# below 0.008 here; past delta = C1 / (2 C2) = 0.72 the truncated series rises again.
+DELTA_MAX: float = 0.25
+# A table of at most this many points (csrc/restitution.h GR_LAW_TABLE_MAX).
+TABLE_MAX = 1_000_000
+
+
+def _positive(value: Any, name: str) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be a number, got {value!r}") from None
+    if not (x > 0 and math.isfinite(x)):
+        raise ValueError(f"{name} must be positive and finite, got {value!r}")
+    return x
+
+
+class RestitutionLaw:
+    """Base of the restitution laws: eps(v_n) for normal impact speeds v_n >= 0."""
+
+    def __call__(self, speed: ArrayLike) -> NDArray[np.float64]:
+        """eps at the given normal impact speeds (>= 0), as the engine applies it."""
+        raise NotImplementedError
+
+    @property
+    def loses_energy(self) -> bool:
+        """Whether some collision loses kinetic energy under this law (eps < 1)."""
+        raise NotImplementedError
+
+    def _engine(self) -> tuple:
+        """The law as the engine takes it: (kind, scale, v_max, speeds, values)."""
+        raise NotImplementedError
+
+    def _key(self) -> tuple:
+        raise NotImplementedError
+
+    def __eq__(self, other: object) -> bool:
+        return type(other) is type(self) and self._key() == other._key()  # type: ignore[attr-defined]
+
+    def __hash__(self) -> int:
+        return hash((type(self).__name__, self._key()))
+
+
+class ConstantRestitution(RestitutionLaw):
+    """A constant coefficient of restitution written as a law.
+
+    ``Scene(restitution=ConstantRestitution(0.9))`` is ``Scene(restitution=0.9)``: the
+    scene stores the number, and the engine runs its constant-restitution loop.
+
+    Parameters
+    ----------
+    value : float
+        The coefficient, in [0, 1] for pair collisions (a wall also takes values > 1).
+
+    Raises
+    ------
+    ValueError
+        If value is negative or not finite.
+    """
+
+    def __init__(self, value: float) -> None:
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise TypeError(f"a restitution must be a number, got {value!r}") from None
+        if not (v >= 0 and math.isfinite(v)):
+            raise ValueError(f"a restitution must be finite and >= 0, got {value!r}")
+        self.value = v
+
+    def __call__(self, speed: ArrayLike) -> NDArray[np.float64]:
+        return np.full(np.shape(speed), self.value)
+
+    @property
+    def loses_energy(self) -> bool:
+        return self.value < 1.0
+
+    def _key(self) -> tuple:
+        return (self.value,)
+
+    def __repr__(self) -> str:
+        return f"ConstantRestitution({self.value!r})"
+
+
+class Viscoelastic(RestitutionLaw):
+    """The restitution of viscoelastic spheres, eps falling from 1 as the impact speed grows.
+
+    Spheres whose contact follows the dissipative Hertz force
+    ``F = rho (xi^(3/2) + (3/2) A xi^(1/2) dxi/dt)``, ``rho = 2 Y sqrt(R_eff) / (3 (1 - nu^2))``
+    (xi the compression; Brilliantov, Spahn, Hertzsch & Poeschel 1996) restitute with ::
+
+        eps(v) = 1 - C1 delta + C2 delta^2,   delta = A kappa^(2/5) v^(1/5),
+        kappa = (3/2)^(3/2) Y sqrt(R_eff) / (m_eff (1 - nu^2)),
+
+    C1 = 1.15345, C2 = (3/5) C1^2 = 0.79827 (Schwager & Poeschel 1998), v the normal
+    impact speed, R_eff and m_eff the reduced radius and mass.  Only ``A kappa^(2/5)``
+    enters; ``characteristic_speed`` ``(A kappa^(2/5))^-5`` is the speed at which delta = 1.
+
+    The series is of order 2 in delta.  Its next term is about -0.5 delta^3 (found by
+    integrating the contact numerically, tests/test_restitution.py), so it is used for
+    delta <= 0.25 only (eps >= 0.76, error < 0.008), i.e. speeds up to ``max_speed``.  A
+    faster collision gets eps(max_speed), and the engine counts it
+    (``Simulation.stats()['law_clamped_collisions']``; ``Simulation.run`` warns): a gas
+    whose collisions often exceed ``max_speed`` is outside this law.
+
+    All pairs use the one ``A kappa^(2/5)``: exact for equal spheres; for a mixture kappa
+    of each pair would differ, which this law does not model.  In 2D the same law is used
+    for disks as a model choice: there is no Hertz law for disks.
+
+    Parameters
+    ----------
+    damping : float
+        The dissipative constant A (a time), > 0.
+    kappa : float
+        The Hertz constant kappa above (length^(-1/2) time^(-2)), > 0.
+
+    Raises
+    ------
+    ValueError
+        If damping or kappa is not positive and finite.
+
+    References
+    ----------
+    N. V. Brilliantov, F. Spahn, J.-M. Hertzsch, T. Poeschel, Phys. Rev. E 53, 5382 (1996).
+    T. Schwager, T. Poeschel, Phys. Rev. E 57, 650 (1998).
+    N. V. Brilliantov, T. Poeschel, Kinetic Theory of Granular Gases, OUP (2004), ch. 6.
+    """
+
+    def __init__(self, damping: float, kappa: float) -> None:
+        self.damping = _positive(damping, "damping (A)")
+        self.kappa = _positive(kappa, "kappa")
+        self.scale = self.damping * self.kappa**0.4
+        if not (self.scale > 0 and math.isfinite(self.scale)):
+            raise ValueError(
+                f"A kappa^(2/5) = {self.scale!r} is outside float64: choose other units"
+            )
+
+    @classmethod
+    def from_material(
+        cls, young: float, poisson: float, damping: float, radius: float, mass: float
+    ) -> Viscoelastic:
+        """The law for two equal spheres of a material.
+
+        Parameters
+        ----------
+        young : float
+            Young's modulus Y, > 0.
+        poisson : float
+            Poisson's ratio nu, in (-1, 0.5].
+        damping : float
+            The dissipative constant A, > 0.
+        radius, mass : float
+            Of each sphere: R_eff = radius / 2, m_eff = mass / 2.
+
+        Returns
+        -------
+        Viscoelastic
+            With kappa = (3/2)^(3/2) Y sqrt(R_eff) / (m_eff (1 - nu^2)).
+
+        Raises
+        ------
+        ValueError
+            If a parameter is out of range.
+        """
+        y = _positive(young, "young")
+        r = _positive(radius, "radius")
+        m = _positive(mass, "mass")
+        nu = float(poisson)
+        if not -1.0 < nu <= 0.5:
+            raise ValueError(f"poisson must lie in (-1, 0.5], got {poisson!r}")
+        kappa = 1.5**1.5 * y * math.sqrt(r / 2) / ((m / 2) * (1 - nu * nu))
+        return cls(damping, kappa)
+
+    @classmethod
+    def from_restitution(cls, restitution: float, speed: float) -> Viscoelastic:
+        """The law whose eps at normal impact speed ``speed`` is ``restitution``.
+
+        Only A kappa^(2/5) matters: the law returned has kappa = 1 and the damping that
+        gives this value.
+
+        Parameters
+        ----------
+        restitution : float
+            eps at that speed, in [eps(delta = 0.25), 1) = [0.7615, 1).
+        speed : float
+            > 0.
+
+        Returns
+        -------
+        Viscoelastic
+
+        Raises
+        ------
+        ValueError
+            If restitution lies outside the series' range or speed is not positive.
+        """
+        v = _positive(speed, "speed")
+        e = float(restitution)
+        lowest = 1.0 - C1 * DELTA_MAX + C2 * DELTA_MAX**2
+        if not lowest <= e < 1.0:
+            raise ValueError(
+                f"restitution must lie in [{lowest:.4f}, 1) for the viscoelastic series "
+                f"(delta <= {DELTA_MAX}), got {restitution!r}"
+            )
+        delta = (C1 - math.sqrt(C1 * C1 - 4.0 * C2 * (1.0 - e))) / (2.0 * C2)
+        return cls(delta / v**0.2, 1.0)
+
+    @property
+    def characteristic_speed(self) -> float:
+        """(A kappa^(2/5))^-5: the impact speed at which delta would be 1."""
+        return _power5(1.0 / self.scale)
+
+    @property
+    def max_speed(self) -> float:
+        """The largest impact speed at which the series is used (delta = 0.25)."""
+        return _power5(DELTA_MAX / self.scale)
+
+    def delta(self, speed: ArrayLike) -> NDArray[np.float64]:
+        """The expansion parameter A kappa^(2/5) v^(1/5) at impact speeds v >= 0."""
+        return self.scale * np.asarray(speed, dtype=np.float64) ** 0.2
+
+    def __call__(self, speed: ArrayLike) -> NDArray[np.float64]:
+        v = np.minimum(np.asarray(speed, dtype=np.float64), self.max_speed)
+        d = self.scale * v**0.2
+        return 1.0 - C1 * d + C2 * d * d
+
+    @property
+    def loses_energy(self) -> bool:
+        return True
+
+    def _engine(self) -> tuple:
+        return (_KIND_VISCOELASTIC, self.scale, self.max_speed, np.empty(0), np.empty(0))
+
+    def _key(self) -> tuple:
+        return (self.damping, self.kappa)
+
+    def __repr__(self) -> str:
+        return f"Viscoelastic(damping={self.damping!r}, kappa={self.kappa!r})"
+
+
+def _power5(x: float) -> float:
+    try:
+        return x**5
+    except OverflowError:
+        return math.inf
+
+
+class TabulatedRestitution(RestitutionLaw):
+    """A restitution curve given as a table, e.g. measured: eps interpolated linearly in v.
+
+    Between two points eps is interpolated linearly; below the first speed it is the first
+    value, above the last the last (as ``numpy.interp``).  A table that should reach
+    eps = 1 at rest must say so with a point (0, 1).
+
+    Parameters
+    ----------
+    speeds : array_like
+        Normal impact speeds, finite, >= 0 and strictly increasing (1 to 10^6 points).
+    values : array_like
+        eps at those speeds, each in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        If the arrays differ in length, are empty or too long, contain NaN, or break the
+        rules above (the message names the first offending point).
+    """
+
+    def __init__(self, speeds: ArrayLike, values: ArrayLike) -> None:
+        x = np.array(speeds, dtype=np.float64, copy=True).reshape(-1)
+        y = np.array(values, dtype=np.float64, copy=True).reshape(-1)
+        if x.shape != y.shape:
+            raise ValueError(f"speeds and values differ in length: {x.size} and {y.size}")
+        if not 1 <= x.size <= TABLE_MAX:
+            raise ValueError(f"a restitution table needs 1 to {TABLE_MAX} points, got {x.size}")
+        bad = np.flatnonzero(~(np.isfinite(x) & (x >= 0)))
+        if bad.size:
+            raise ValueError(f"speeds must be finite and >= 0: speeds[{bad[0]}] = {x[bad[0]]}")
+        bad = np.flatnonzero(np.diff(x) <= 0)
+        if bad.size:
+            k = bad[0] + 1
+            raise ValueError(
+                f"speeds must increase strictly: speeds[{k}] = {x[k]} after {x[k - 1]}"
+            )
+        bad = np.flatnonzero(~((y >= 0) & (y <= 1)))
+        if bad.size:
+            raise ValueError(f"values must lie in [0, 1]: values[{bad[0]}] = {y[bad[0]]}")
+        x.setflags(write=False)
+        y.setflags(write=False)
+        self.speeds = x
+        self.values = y
+
+    def __call__(self, speed: ArrayLike) -> NDArray[np.float64]:
+        return np.interp(np.asarray(speed, dtype=np.float64), self.speeds, self.values)
+
+    @property
+    def loses_energy(self) -> bool:
+        return bool(np.any(self.values < 1.0))
+
+    def _engine(self) -> tuple:
+        return (_KIND_TABLE, 0.0, 0.0, self.speeds, self.values)
+
+    def _key(self) -> tuple:
+        return (self.speeds.tobytes(), self.values.tobytes())
+
+    def __repr__(self) -> str:
+        return (
+            f"TabulatedRestitution(speeds={self.speeds.tolist()!r}, "
+            f"values={self.values.tolist()!r})"
+        )
+
+
+def loses_energy(restitution: float | RestitutionLaw) -> bool:
+    """Whether a restitution (a number or a law) makes some collision lose energy."""
+    if isinstance(restitution, RestitutionLaw):
+        return restitution.loses_energy
+    return restitution < 1.0
+
+
+def heats(restitution: float | RestitutionLaw) -> bool:
+    """Whether a wall restitution can add energy (a number > 1; laws stay in [0, 1])."""
+    return not isinstance(restitution, RestitutionLaw) and restitution > 1.0
+
+
+def engine_law(restitution: float | RestitutionLaw) -> tuple | None:
+    """The law as the engine takes it, or None for a number."""
+    return restitution._engine() if isinstance(restitution, RestitutionLaw) else None
