@@ -343,6 +343,41 @@ class LangevinResult:
             exponent=self.exponent,
         )
 
+    def ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
+        """The measured ergodicity-breaking parameter at the TAMSD lags (or ``lags``):
+        ``EB = (<TAMSD^2> - <TAMSD>^2) / <TAMSD>^2`` over the particles (thesis 2.114-2.119;
+        He, Burov, Metzler & Barkai, PRL 101, 058101 (2008)); 0 for an ergodic process as
+        t_stop / lag grows.  Theory: ``theory_ergodicity_breaking``."""
+        per = self._tamsd(lags, per_particle=True)
+        mean = per.mean(axis=0)
+        return per.var(axis=0) / mean**2
+
+    def theory_ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
+        """The expected EB of this run's TAMSD estimator (its window starts, every
+        ``sde_lag_stride`` steps) at its lags or at ``lags``:
+        ``theory.udsbm_ergodicity_breaking`` (cost: squared windows per lag)."""
+        from . import theory
+
+        lag_t = self.tamsd_lags if lags is None else np.atleast_1d(np.asarray(lags, float))
+        n_steps = round(self.t_stop / self.dt)
+        out = []
+        for lag in lag_t:
+            k = round(lag / self.dt)
+            starts = np.arange(0, n_steps - k + 1, _core.sde_lag_stride(k)) * self.dt
+            out.append(
+                theory.udsbm_ergodicity_breaking(
+                    k * self.dt,
+                    starts,
+                    self.D0,
+                    self.gamma0,
+                    self.tau0,
+                    self.exponent,
+                    self.dim,
+                    v0_sq=self.v0_sq,
+                )
+            )
+        return np.array(out)
+
     def __repr__(self) -> str:
         return (
             f"LangevinResult(model={self.model!r}, scheme={self.scheme!r}, n={self.n}, "
@@ -477,8 +512,7 @@ def run(
     exponent = float(exponent)
     if not (exponent > 0 and math.isfinite(exponent)):
         raise ValueError(
-            f"exponent must be positive and finite (UDSBM's (1 + t/tau0)^-exponent), got "
-            f"{exponent}"
+            f"exponent must be positive and finite (UDSBM's (1 + t/tau0)^-exponent), got {exponent}"
         )
     if model == "langevin":
         if exponent != 1.0:
