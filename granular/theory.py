@@ -732,8 +732,20 @@ def _powerlaw_ode(gamma0, tau0, exponent, v0_sq_reduced, t_max_reduced):
     """Dense solution of the second-moment ODEs in units of 1/gamma0 (time), D0/gamma0
     (x^2), D0 (x v), D0 gamma0 (v^2): with g = w^-a, w = 1 + t/tau0,
     d<x^2> = 2 <xv>, d<xv> = <v^2> - g <xv>, d<v^2> = -2 g <v^2> + 2 g^3 (the noise
-    2 D gamma^2).  DOP853 at rtol 1e-12."""
+    2 D gamma^2).  DOP853 at rtol 1e-12.  Constant coefficients (tau0 = inf): the closed
+    forms of the Langevin model (2.68 with the start's transient), no integration."""
     from scipy.integrate import solve_ivp
+
+    if math.isinf(tau0):
+        excess = v0_sq_reduced - 1.0
+
+        def langevin(s):
+            s = np.asarray(s, dtype=np.float64)
+            omc, e = -np.expm1(-s), np.exp(-s)
+            xx = 2.0 * _x_plus_expm1(s) + excess * omc**2
+            return np.array([xx, omc + excess * e * omc, 1.0 + excess * e * e])
+
+        return langevin
 
     c = 1.0 / (gamma0 * tau0)  # w = 1 + c s, s = gamma0 t
 
@@ -884,7 +896,9 @@ def _position_covariance(t1, t2, sol, D0, gamma0, tau0, exponent):
     """<x(t1) x(t2)> per dimension (``_powerlaw_propagator_integral``), from the dense
     moment solution in reduced units."""
     m = np.minimum(t1, t2)
-    y = sol((gamma0 * m).reshape(-1)).reshape((3, *np.shape(m)))
+    # the moments at each distinct time once (window ends repeat across pairs)
+    times, where = np.unique(m, return_inverse=True)
+    y = sol(gamma0 * times)[:, where.reshape(-1)].reshape((3, *np.shape(m)))
     k = _powerlaw_propagator_integral(m, np.abs(t2 - t1), gamma0, tau0, exponent)
     return y[0] * D0 / gamma0 + y[1] * D0 * k
 
