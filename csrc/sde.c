@@ -83,7 +83,9 @@ typedef struct {
     int udsbm, em;
     exact_coef ex0;
     const exact_coef *table; /* the exact scheme's UDSBM coefficients per step, or NULL */
-    int64_t table_from;      /* the step that table[0] starts from */
+    int64_t table_from;      /* the step that table[0] and em_table[0] start from */
+    const double *em_table;  /* Euler-Maruyama's (1 - gamma dt, sqrt(2 D dt) gamma) per step
+                                for an exponent != 1 (a pow a step saved per particle), or NULL */
 } step_params;
 
 /* Steps from+1 .. to of particle i (the step numbered k goes from t = (k-1) dt to k dt and
@@ -103,7 +105,10 @@ static GR_ALWAYS_INLINE void run_steps(
         gr_stream rs = gr_stream_at(p->key, (uint64_t)(step - 1), (uint64_t)i);
         if (p->em) {
             double a_coef = 1.0 - p->g0 * dt, b = p->b0;
-            if (p->udsbm) { /* gamma(t_n), D(t_n) at the start of the step (2.110) */
+            if (p->em_table) {
+                a_coef = p->em_table[2 * (step - 1 - p->table_from)];
+                b = p->em_table[2 * (step - 1 - p->table_from) + 1];
+            } else if (p->udsbm) { /* gamma(t_n), D(t_n) at the start of the step (2.110) */
                 const double t = (double)(step - 1) * dt;
                 double s = udsbm_decay(1.0 + t / p->tau0, p->expo);
                 a_coef = 1.0 - p->g0 * s * dt;
@@ -179,9 +184,21 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
             table[st - step_from] = exact_for(g0 * s, D0 * s, dt);
         }
     }
+    /* EM's coefficients per step, computed exactly as inline; only for an exponent != 1,
+     * whose pow would otherwise be paid per particle and step (a = 1 divides, as cheap as
+     * the table, and stays as it was) */
+    double *em_table = NULL;
+    if (udsbm && cfg->scheme == GR_SDE_EM && expo != 1.0 && out->step_coef) {
+        em_table = out->step_coef;
+        for (int64_t st = step_from; st < step_to; st++) {
+            double s = udsbm_decay(1.0 + (double)st * dt / tau0, expo);
+            em_table[2 * (st - step_from)] = 1.0 - g0 * s * dt;
+            em_table[2 * (st - step_from) + 1] = b0 * s * sqrt(s);
+        }
+    }
 
     const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, expo, udsbm, cfg->scheme == GR_SDE_EM,
-                            ex0, table, step_from};
+                            ex0, table, step_from, em_table};
     /* where the segment starts among the samples */
     const int64_t ks0 = first_sample_from(out, step_from);
     for (int64_t local = 0; local < count; local++) {

@@ -53,7 +53,8 @@ typedef struct {
                                     per lag.  Scratch for a whole run; carried from call to
                                     call when a run is split into step segments */
     double *step_coef;           /* optional scratch, 5 x (step_to - step_from): the exact
-                                    scheme's UDSBM coefficients per step, computed once per
+                                    scheme's UDSBM coefficients per step (Euler-Maruyama's,
+                                    2 a step, for an exponent != 1), computed once per
                                     call instead of once per particle and step; NULL
                                     computes them inline (the same numbers) */
 } gr_sde_output;
