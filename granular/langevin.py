@@ -355,7 +355,9 @@ class LangevinResult:
     def theory_ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected EB of this run's TAMSD estimator (its window starts, every
         ``sde_lag_stride`` steps) at its lags or at ``lags``:
-        ``theory.udsbm_ergodicity_breaking`` (cost: squared windows per lag)."""
+        ``theory.udsbm_ergodicity_breaking`` (cost: squared windows per lag).  It assumes
+        Gaussian initial velocities (``initial`` "thermal" or "udsbm"), as Isserlis'
+        theorem there needs."""
         from . import theory
 
         lag_t = self.tamsd_lags if lags is None else np.atleast_1d(np.asarray(lags, float))

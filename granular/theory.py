@@ -393,9 +393,9 @@ def _check_dim(dim):
 # (2) Underdamped scaled Brownian motion with gamma0 (1 + t/tau0)^-a and D0 (1 + t/tau0)^-a
 # (``granular.langevin``, ``exponent`` a): a = 1 is the thesis' UDSBM, a = 5/6 the
 # viscoelastic gas' counterpart (Bodrova, Chechkin, Cherstvy & Metzler, PCCP 17, 21791
-# (2015); NJP 18, 063038 (2016)).  Its second moments are computed here from their exact
-# linear ODEs (no closed form for a != 1), its TAMSD and ergodicity-breaking parameter from
-# the exact position covariance.
+# (2015); Bodrova et al., Sci. Rep. 6, 30520 (2016)).  Its second moments are computed here
+# from their exact linear ODEs (no closed form for a != 1), its TAMSD and
+# ergodicity-breaking parameter from the exact position covariance.
 
 VISCOELASTIC_C1 = 1.1534
 VISCOELASTIC_C2 = 0.7982
@@ -788,8 +788,9 @@ def powerlaw_udsbm_moments(
 
     References
     ----------
-    Bodrova, Chechkin, Cherstvy & Sokolov, NJP 18, 063038 (2016) (UDSBM with power-law
-    coefficients); thesis App. C and (2.111)-(2.113) for a = 1.
+    Bodrova, Chechkin, Cherstvy, Safdari, Sokolov & Metzler, "Underdamped scaled Brownian
+    motion: (non-)existence of the overdamped limit in anomalous diffusion", Sci. Rep. 6,
+    30520 (2016) (UDSBM with power-law coefficients); thesis App. C and (2.111)-(2.113) for a = 1.
     """
     _check_powerlaw(gamma0, D0, tau0, exponent)
     t = np.asarray(t, dtype=np.float64)
@@ -832,7 +833,7 @@ def msd_powerlaw_udsbm_asymptote(
     faster against the age and the overdamped limit exists; the underdamped MSD exceeds
     this by a term that grows more slowly (relative O(1/(gamma(t) t))).  For a = 1 the
     ratio gamma t stays gamma0 tau0 and the MSD is larger by (gamma0 tau0 / (gamma0 tau0 -
-    1))^2 (thesis 2.113; Bodrova et al., NJP 18, 063038 (2016): the overdamped limit does
+    1))^2 (thesis 2.113; Bodrova et al., Sci. Rep. 6, 30520 (2016): the overdamped limit does
     not exist); for a > 1 the motion ends ballistic.
 
     Raises
@@ -961,7 +962,8 @@ def udsbm_ergodicity_breaking(
 
     EB -> 0 for an ergodic process as t_stop / lag grows (Brownian motion: 4 lag / (3 d
     t_stop), He, Burov, Metzler & Barkai, PRL 101, 058101 (2008)); UDSBM's stays finite
-    (Bodrova et al., PCCP 17, 21791 (2015); Safdari et al., J. Phys. A 48, 375002 (2015)).
+    (Bodrova et al., PCCP 17, 21791 (2015); Safdari, Cherstvy, Chechkin, Bodrova & Metzler,
+    "Ageing underdamped scaled Brownian motion", arXiv:1609.07246).
     Cost O(len(starts)^2).
 
     Parameters
