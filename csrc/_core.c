@@ -590,9 +590,9 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     out.lag_len = ints + L;
     out.lag_work = ints + 2 * L;
     /* the per-step coefficient table of exact UDSBM (and of EM for an exponent != 1),
-     * shared by the call's particles: only worth it for several, and only when not too large (else, or if the allocation fails,
-     * the core computes the coefficients inline: slower, the same numbers).  The bound
-     * keeps 5 x steps + 1 far from overflowing. */
+     * shared by the call's particles: only worth it for several, and only when not too
+     * large (else, or if the allocation fails, the core computes the coefficients inline:
+     * slower, the same numbers).  The bound keeps 5 x steps + 1 far from overflowing. */
     double *coef = NULL;
     const int64_t seg = step_to - step_from;
     if (cfg.model == GR_SDE_UDSBM && (cfg.scheme == GR_SDE_EXACT || cfg.exponent != 1.0) &&
