@@ -542,17 +542,22 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     static char *names[] = {"dim", "model", "scheme", "gamma0", "D0", "tau0", "dt", "key",
                             "n", "first", "step_from", "step_to", "n_steps", "x", "v",
                             "sample_steps", "x2", "v2", "positions", "lags", "tamsd", "ring",
-                            NULL};
+                            "exponent", NULL};
     gr_sde_config cfg;
+    cfg.exponent = 1.0; /* UDSBM's (1 + t/tau0)^-exponent: optional, the thesis' 1 */
     unsigned long long key;
     long long n, first, step_from, step_to, n_steps;
     PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO", names, &cfg.dim,
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO|d", names, &cfg.dim,
                                      &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0, &cfg.tau0,
                                      &cfg.dt, &key, &n, &first, &step_from, &step_to, &n_steps,
                                      &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags, &otamsd,
-                                     &oring))
+                                     &oring, &cfg.exponent))
         return NULL;
+    if (!(cfg.exponent > 0.0 && cfg.exponent < INFINITY)) {
+        PyErr_SetString(PyExc_ValueError, "exponent must be positive and finite");
+        return NULL;
+    }
     cfg.key = key;
     if (cfg.dim < 1 || cfg.dim > 3 || n < 0 || first < 0) {
         PyErr_SetString(PyExc_ValueError, "dim must be 1..3 and n, first non-negative");
@@ -630,13 +635,14 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     out.lag_stride = ints;
     out.lag_len = ints + L;
     out.lag_work = ints + 2 * L;
-    /* the per-step coefficient table of exact UDSBM, shared by the call's particles: only
-     * worth it for several, and only when not too large (else, or if the allocation fails,
-     * the core computes the coefficients inline: slower, the same numbers).  The bound
-     * keeps 5 x steps + 1 far from overflowing. */
+    /* the per-step coefficient table of exact UDSBM (and of EM for an exponent != 1),
+     * shared by the call's particles: only worth it for several, and only when not too
+     * large (else, or if the allocation fails, the core computes the coefficients inline:
+     * slower, the same numbers).  The bound keeps 5 x steps + 1 far from overflowing. */
     double *coef = NULL;
     const int64_t seg = step_to - step_from;
-    if (cfg.model == GR_SDE_UDSBM && cfg.scheme == GR_SDE_EXACT && count > 1 && seg <= (1LL << 22))
+    if (cfg.model == GR_SDE_UDSBM && (cfg.scheme == GR_SDE_EXACT || cfg.exponent != 1.0) &&
+        count > 1 && seg <= (1LL << 22))
         coef = PyMem_Calloc((size_t)(5 * seg + 1), sizeof(double));
     out.step_coef = coef;
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
@@ -696,7 +702,8 @@ static PyMethodDef core_methods[] = {
     /* ==== SDE methods begin ==== */
     {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
      "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
-     " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring): advance particles"
+     " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring, exponent=1.0):"
+     " advance particles"
      " first..first+len(x) over the steps [step_from, step_to) of a run of n_steps,"
      " accumulating into the given arrays; ring (sde_ring_size doubles) carries one particle"
      " from segment to segment (internal: use granular.langevin)."},

@@ -2,11 +2,13 @@
  * for N independent particles: public interface.
  *
  *   dx = v dt,   dv = -gamma(t) v dt + sqrt(2 D(t)) gamma(t) dW
- *   Langevin: gamma = gamma0, D = D0;  UDSBM: gamma0 / (1 + t/tau0), D0 / (1 + t/tau0)
+ *   Langevin: gamma = gamma0, D = D0;
+ *   UDSBM: gamma0 (1 + t/tau0)^-a, D0 (1 + t/tau0)^-a  (a = exponent: 1 is the thesis'
+ *   UDSBM, Haff's cooling; 5/6 the viscoelastic gas' T ~ t^(-5/3))
  *
  * Schemes: Euler-Maruyama exactly as the thesis' (2.92)/(2.110), or the exact update of
  * the Ornstein-Uhlenbeck process over a step (coefficients frozen at the step's midpoint
- * for UDSBM).  Random numbers come from rng.h, keyed by (step, particle): results do not
+ * for UDSBM: exact for the OU step, O((dt/tau0)^2) per step for the time dependence).  Random numbers come from rng.h, keyed by (step, particle): results do not
  * depend on chunking.  The caller owns every buffer; nothing is allocated here. */
 #ifndef GR_SDE_H
 #define GR_SDE_H
@@ -22,6 +24,8 @@ typedef struct {
     int dim;                 /* 1, 2 or 3 */
     int model, scheme;
     double gamma0, D0, tau0; /* tau0 = +inf for Langevin */
+    double exponent;         /* a of UDSBM's (1 + t/tau0)^-a, > 0; 1 takes the thesis'
+                                1/(1 + t/tau0) exactly as before (no pow) */
     double dt;
     uint64_t key;            /* random stream key */
 } gr_sde_config;
@@ -49,7 +53,8 @@ typedef struct {
                                     per lag.  Scratch for a whole run; carried from call to
                                     call when a run is split into step segments */
     double *step_coef;           /* optional scratch, 5 x (step_to - step_from): the exact
-                                    scheme's UDSBM coefficients per step, computed once per
+                                    scheme's UDSBM coefficients per step (Euler-Maruyama's,
+                                    2 a step, for an exponent != 1), computed once per
                                     call instead of once per particle and step; NULL
                                     computes them inline (the same numbers) */
 } gr_sde_output;

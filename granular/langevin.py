@@ -6,8 +6,12 @@ Each of N independent particles follows
 
 - ``model="langevin"``: constant gamma0, D0 -- the underdamped Langevin equation, a model of
   a molecular gas (its MSD is the molecular gas' (2.68));
-- ``model="udsbm"``: gamma0 / (1 + t/tau0) and D0 / (1 + t/tau0) -- underdamped scaled
-  Brownian motion, a model of a granular gas cooling by Haff's law (MSD 2.113).
+- ``model="udsbm"``: gamma0 (1 + t/tau0)^-a and D0 (1 + t/tau0)^-a -- underdamped scaled
+  Brownian motion, a model of a granular gas.  ``exponent`` a = 1 (the default) is the
+  thesis' UDSBM, cooling by Haff's law T ~ t^-2 (MSD 2.113); a = 5/6 is the gas of
+  viscoelastic particles, T ~ t^(-5/3), D ~ T^(1/2) ~ t^(-5/6), MSD ~ t^(1/6)
+  (Bodrova, Chechkin, Cherstvy & Metzler, PCCP 17, 21791 (2015); ``theory.viscoelastic_*``).
+  In general the temperature D gamma ~ (1 + t/tau0)^(-2a).
 
 Schemes
 -------
@@ -22,7 +26,9 @@ Ornstein-Uhlenbeck process with the step's coefficients -- exact for the Langevi
 any step, and stable at any step.  For UDSBM the coefficients are frozen at the step's
 midpoint; since they change on the time scale 1 + t/tau0, the local error per step is
 O((dt / tau0)^2) relative, and the integrated error O(dt^2 / (tau0 (tau0 + t))) -- far
-below Euler-Maruyama's O(gamma0 dt) bias.
+below Euler-Maruyama's O(gamma0 dt) bias.  The same holds for any exponent a: the step
+takes gamma0 w^-a, D0 w^-a at the midpoint's w = 1 + t/tau0 (measured in
+docs/powerlaw_udsbm.md).
 
 The exact scheme is the default; Euler-Maruyama, the thesis' scheme, is one keyword away.
 
@@ -184,6 +190,7 @@ class LangevinResult:
     final_positions, final_velocities : (N, d) the state at ``t_stop``
     model, scheme : as given to ``run``
     gamma0, D0, tau0, dt, t_stop : the coefficients, step and duration (whole steps)
+    exponent : a of UDSBM's (1 + t/tau0)^-a (1 for the Langevin model)
     n, dim : particles and dimensions
     v0_sq : initial mean squared velocity per component
     """
@@ -209,6 +216,7 @@ class LangevinResult:
     dim: int
     t_stop: float
     v0_sq: float
+    exponent: float = 1.0
 
     @property
     def msd(self) -> _ArrayAndMethod:
@@ -312,7 +320,7 @@ class LangevinResult:
         }
         if self.positions is not None:
             out["positions"] = self.positions
-        for name in ("gamma0", "D0", "tau0", "dt", "t_stop", "v0_sq"):
+        for name in ("gamma0", "D0", "tau0", "dt", "t_stop", "v0_sq", "exponent"):
             out[name] = np.asarray(getattr(self, name))
         return out
 
@@ -327,6 +335,10 @@ class LangevinResult:
         t = self.times if t is None else t
         if self.model == "langevin":
             return theory.msd_langevin(t, self.D0, self.gamma0, self.dim, v0_sq=self.v0_sq)
+        if self.exponent != 1.0:
+            return theory.msd_powerlaw_udsbm(
+                t, self.D0, self.gamma0, self.tau0, self.exponent, self.dim, v0_sq=self.v0_sq
+            )
         return theory.msd_udsbm(t, self.D0, self.gamma0, self.tau0, self.dim, v0_sq=self.v0_sq)
 
     def theory_tamsd(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
@@ -341,7 +353,45 @@ class LangevinResult:
             t_stop=self.t_stop,
             dim=self.dim,
             v0_sq=self.v0_sq,
+            exponent=self.exponent,
         )
+
+    def ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
+        """The measured ergodicity-breaking parameter at the TAMSD lags (or ``lags``):
+        ``EB = (<TAMSD^2> - <TAMSD>^2) / <TAMSD>^2`` over the particles (thesis 2.114-2.119;
+        He, Burov, Metzler & Barkai, PRL 101, 058101 (2008)); 0 for an ergodic process as
+        t_stop / lag grows.  Theory: ``theory_ergodicity_breaking``."""
+        per = self._tamsd(lags, per_particle=True)
+        mean = per.mean(axis=0)
+        return per.var(axis=0) / mean**2
+
+    def theory_ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
+        """The expected EB of this run's TAMSD estimator (its window starts, every
+        ``sde_lag_stride`` steps) at its lags or at ``lags``:
+        ``theory.udsbm_ergodicity_breaking`` (cost: squared windows per lag).  It assumes
+        Gaussian initial velocities (``initial`` "thermal" or "udsbm"), as Isserlis'
+        theorem there needs."""
+        from . import theory
+
+        lag_t = self.tamsd_lags if lags is None else np.atleast_1d(np.asarray(lags, float))
+        n_steps = round(self.t_stop / self.dt)
+        out = []
+        for lag in lag_t:
+            k = round(lag / self.dt)
+            starts = np.arange(0, n_steps - k + 1, _core.sde_lag_stride(k)) * self.dt
+            out.append(
+                theory.udsbm_ergodicity_breaking(
+                    k * self.dt,
+                    starts,
+                    self.D0,
+                    self.gamma0,
+                    self.tau0,
+                    self.exponent,
+                    self.dim,
+                    v0_sq=self.v0_sq,
+                )
+            )
+        return np.array(out)
 
     def __repr__(self) -> str:
         return (
@@ -361,6 +411,7 @@ def theory_tamsd(
     tau0: float = math.inf,
     dim: int = 3,
     v0_sq: float | None = None,
+    exponent: float = 1.0,
 ) -> NDArray[np.float64]:
     """The expected time-averaged MSD of a run, total over ``dim``: for each lag the mean,
     over the windows the engine averages (starting every ``sde_lag_stride`` steps from 0
@@ -368,7 +419,9 @@ def theory_tamsd(
     ``theory.msd_langevin`` from the velocity variance reached at the window's start for
     the Langevin model (tau0 = inf), ``theory.udsbm_increment_msd`` for UDSBM.
     ``v0_sq`` is the initial mean squared velocity per component (None: thermal, or App.
-    C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD."""
+    C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD.  For UDSBM
+    with ``exponent`` a != 1, ``theory.powerlaw_udsbm_increment_msd`` (numerical moments;
+    ``v0_sq`` must then be given)."""
     from . import theory
 
     n_steps = round(t_stop / dt)
@@ -384,6 +437,12 @@ def theory_tamsd(
                 else thermal + (v0_sq - thermal) * np.exp(-2 * gamma0 * starts)
             )
             incr = theory.msd_langevin(lag, D0, gamma0, dim, v0_sq=v_sq)
+        elif exponent != 1.0:
+            if v0_sq is None:
+                raise ValueError("the power-law UDSBM (exponent != 1) needs v0_sq")
+            incr = theory.powerlaw_udsbm_increment_msd(
+                lag, starts, D0, gamma0, tau0, exponent, dim, v0_sq=v0_sq
+            )
         else:
             incr = theory.udsbm_increment_msd(lag, starts, D0, gamma0, tau0, dim, v0_sq=v0_sq)
         out.append(float(np.mean(incr)))
@@ -406,6 +465,7 @@ def run(
     t_stop: float,
     tau0: float = math.inf,
     model: str | None = None,
+    exponent: float = 1.0,
     scheme: str = "exact",
     dim: int = 3,
     sample_times: ArrayLike | None = None,
@@ -424,6 +484,9 @@ def run(
     gamma0, D0 : friction and diffusivity (per dimension) at t = 0
     tau0 : UDSBM time scale (infinite: the Langevin model)
     model : "langevin" or "udsbm" (default: "udsbm" when tau0 is finite)
+    exponent : a > 0 of UDSBM's gamma0 (1 + t/tau0)^-a, D0 (1 + t/tau0)^-a: 1 (default)
+        the thesis' UDSBM (Haff's law), 5/6 the viscoelastic gas (T ~ t^(-5/3),
+        MSD ~ t^(1/6)); only for model="udsbm"
     scheme : "exact" (the default: exact OU update, stable at any step) or "em"
         (Euler-Maruyama, thesis 2.92/2.110)
     dt, t_stop : step and duration (t_stop is rounded to whole steps, at most
@@ -436,7 +499,8 @@ def run(
         rounded to whole steps like the sample times (``result.tamsd_lags``)
     initial : "thermal" -- Gaussian velocities with <v_a^2> = T0/m = D0 gamma0;
         "udsbm" -- Gaussian with App. C's "correct" <v_a^2> = D0 gamma0 a/(a - 1),
-        a = gamma0 tau0, for which the UDSBM MSD is exactly (2.113);
+        a = gamma0 tau0, for which the UDSBM MSD is exactly (2.113) (exponent 1 only:
+        for another exponent no initial variance makes <v^2> a pure power of 1 + t/tau0);
         "fixed" -- every particle at ``speed`` (default sqrt(d D0 gamma0), the thermal rms
         speed) in an isotropic random direction (thesis 3.3, made isotropic).
     store_positions : keep (T, N, d) positions at the sample times
@@ -460,7 +524,17 @@ def run(
         raise ValueError(f"model must be one of {MODELS}, got {model!r}")
     if model == "udsbm" and math.isinf(tau0):
         raise ValueError("UDSBM needs a finite tau0")
+    exponent = float(exponent)
+    if not (exponent > 0 and math.isfinite(exponent)):
+        raise ValueError(
+            f"exponent must be positive and finite (UDSBM's (1 + t/tau0)^-exponent), got {exponent}"
+        )
     if model == "langevin":
+        if exponent != 1.0:
+            raise ValueError(
+                "exponent is UDSBM's (model='udsbm'); the Langevin model has constant "
+                f"coefficients, got exponent={exponent}"
+            )
         tau0 = math.inf
     if scheme not in SCHEMES:
         raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
@@ -518,6 +592,12 @@ def run(
     elif initial == "udsbm":
         if model != "udsbm":
             raise ValueError("initial='udsbm' is App. C's initial speed of the UDSBM model")
+        if exponent != 1.0:
+            raise ValueError(
+                "initial='udsbm' is App. C's initial speed for exponent 1; with exponent "
+                f"{exponent} start 'thermal' or 'fixed' (theory.msd_powerlaw_udsbm takes any "
+                "initial speed)"
+            )
         from .theory import udsbm_v0_sq
 
         v0_sq = udsbm_v0_sq(D0, gamma0, tau0)
@@ -588,6 +668,7 @@ def run(
                     lags,
                     tamsd_sum,
                     ring,
+                    exponent=exponent,
                 )
                 if bar is not None:
                     bar.update(len(xs) * (step_to - step_from))
@@ -622,6 +703,7 @@ def run(
         dim=dim,
         t_stop=n_steps * dt,
         v0_sq=v0_sq,
+        exponent=exponent if model == "udsbm" else 1.0,
     )
 
 

@@ -20,7 +20,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 # what the formulas return: a float for scalar arguments, else an array of their shape
 FloatOrArray = float | NDArray[np.float64]
@@ -519,3 +519,643 @@ def shear_mode_level(box: FloatOrArray, critical: FloatOrArray) -> FloatOrArray:
     with np.errstate(divide="ignore"):
         level = np.where(x2 < 1, 1.0 / (1.0 - np.minimum(x2, 1.0)), np.inf)
     return level[()] if level.ndim == 0 else level
+
+
+# == Viscoelastic granular gases and UDSBM with power-law coefficients (issue 15) ============
+#
+# Two parts.  (1) The homogeneous cooling of a gas of viscoelastic spheres, whose restitution
+# depends on the normal impact speed g (Brilliantov, Spahn, Hertzsch & Poeschel, PRE 53, 5382
+# (1996); the series of Schwager & Poeschel, PRE 57, 650 (1998)):
+#
+#     eps(g) = 1 - C1 A kappa^(2/5) g^(1/5) + C2 A^2 kappa^(4/5) g^(2/5) - ...,
+#
+# A the dissipative constant (a time), kappa = (3/2)^(3/2) Y sqrt(R_eff) / (m_eff (1 - nu^2))
+# from Young's modulus Y, Poisson's ratio nu and the effective radius and mass.  Everything
+# here depends on them only through the one material number ``a_kappa`` = A kappa^(2/5)
+# (units of (time/length)^(1/5)), the coefficient of g^(1/5) in 1 - eps over C1.  The
+# series is one in the dimensionless delta = a_kappa (4T/m)^(1/10) (a_kappa times the
+# 1/5-th power of the mean squared normal impact speed 4T/m of a Maxwellian gas): it holds
+# while delta << 1, i.e. for impacts slow against the speed at which eps would vanish.
+# Brilliantov & Poeschel (Kinetic Theory of Granular Gases, OUP 2004, ch. 8; PRE 61, 5573
+# (2000)) write their small parameter with the thermal speed in another normalisation; it
+# is the same combination up to a numerical factor, so the cooling law below is theirs.
+#
+# (2) Underdamped scaled Brownian motion with gamma0 (1 + t/tau0)^-a and D0 (1 + t/tau0)^-a
+# (``granular.langevin``, ``exponent`` a): a = 1 is the thesis' UDSBM, a = 5/6 the
+# viscoelastic gas' counterpart (Bodrova, Chechkin, Cherstvy & Metzler, PCCP 17, 21791
+# (2015); Bodrova et al., Sci. Rep. 6, 30520 (2016)).  Its second moments are computed here
+# from their exact linear ODEs (no closed form for a != 1), its TAMSD and
+# ergodicity-breaking parameter from the exact position covariance.
+
+VISCOELASTIC_C1 = 1.1534
+VISCOELASTIC_C2 = 0.7982
+
+
+def _collision_moment(p: float, temperature: FloatOrArray, mass: float) -> FloatOrArray:
+    """<g^p> over collisions of a Maxwellian gas, g the normal impact speed: collisions
+    weight the normal relative velocity (a Gaussian of variance 2T/m) by g, so g has the
+    density (g/s^2) exp(-g^2 / 2 s^2), s^2 = 2T/m, and <g^p> = (4T/m)^(p/2) Gamma(1 + p/2)
+    (p = 2 gives 4T/m: the constant-xi loss (1 - xi^2) T of ``haff_tau0``)."""
+    return (4.0 * np.asarray(temperature, dtype=np.float64) / mass) ** (p / 2) * math.gamma(
+        1 + p / 2
+    )
+
+
+def _check_a_kappa(a_kappa: float) -> float:
+    a_kappa = float(a_kappa)
+    if not (a_kappa >= 0 and math.isfinite(a_kappa)):
+        raise ValueError(
+            f"a_kappa (A kappa^(2/5), the viscoelastic dissipation) must be >= 0 and finite, "
+            f"got {a_kappa}"
+        )
+    return a_kappa
+
+
+def viscoelastic_delta(
+    a_kappa: float, temperature: FloatOrArray, mass: float = 1.0
+) -> FloatOrArray:
+    """The small parameter of the viscoelastic restitution series at a temperature,
+    ``delta = a_kappa (4 T / m)^(1/10)``: 1 - eps at the mean squared impact speed is about
+    C1 delta.  The series, and every viscoelastic formula here, needs delta << 1.
+
+    Parameters
+    ----------
+    a_kappa : A kappa^(2/5) of eps(g) = 1 - C1 A kappa^(2/5) g^(1/5) + ... (Schwager &
+        Poeschel 1998), in (time/length)^(1/5)
+    temperature, mass : T (k_B = 1) and the particle mass
+
+    Returns
+    -------
+    delta, dimensionless
+    """
+    return _check_a_kappa(a_kappa) * (4.0 * np.asarray(temperature, dtype=np.float64) / mass) ** 0.1
+
+
+def viscoelastic_cooling_rate(
+    temperature: FloatOrArray,
+    a_kappa: float,
+    density: float,
+    radius: float,
+    mass: float = 1.0,
+    dim: int = 3,
+    eta: float | None = None,
+    order: int = 1,
+) -> FloatOrArray:
+    """Cooling rate zeta(T) of a viscoelastic gas, dT/dt = -zeta(T) T, in the Maxwellian
+    approximation, to first or second order in the restitution series.
+
+    Each collision of equal masses loses (m/4)(1 - eps(g)^2) g^2; averaged over collisions
+    (``_collision_moment``) and multiplied by the collision frequency omega(T) of
+    ``collision_frequency`` over the dimension (as ``haff_tau0`` does for constant xi),
+    with 1 - eps^2 = 2 C1 u - (C1^2 + 2 C2) u^2 + O(u^3), u = a_kappa g^(1/5):
+
+        zeta_1 = (2/d) C1 Gamma(21/10) omega(T) delta(T),
+        zeta_2 = -(1/d) (C1^2 + 2 C2) Gamma(11/5) omega(T) delta(T)^2,
+
+    delta(T) = a_kappa (4T/m)^(1/10) (``viscoelastic_delta``).  zeta_1 ~ T^(3/5) gives the
+    T^(-5/3) law (``viscoelastic_temperature``).
+
+    Parameters
+    ----------
+    temperature : T
+    a_kappa : A kappa^(2/5) (see ``viscoelastic_delta``)
+    density, radius, mass, dim, eta : as for ``collision_frequency``
+    order : 1 (zeta_1) or 2 (zeta_1 + zeta_2)
+
+    Returns
+    -------
+    zeta(T), the rate of dT/dt = -zeta T
+
+    Raises
+    ------
+    ValueError
+        For a negative or non-finite a_kappa, or an order other than 1 or 2.
+
+    References
+    ----------
+    Schwager & Poeschel, PRE 57, 650 (1998) (the series, C1, C2); Brilliantov & Poeschel,
+    PRE 61, 5573 (2000) and Kinetic Theory of Granular Gases (OUP 2004), ch. 8 (the
+    cooling of viscoelastic particles, there with the Sonine correction a2 of the velocity
+    distribution, neglected here: a relative effect of order delta on zeta).
+    """
+    a_kappa = _check_a_kappa(a_kappa)
+    if order not in (1, 2):
+        raise ValueError(f"order must be 1 or 2, got {order}")
+    T = np.asarray(temperature, dtype=np.float64)
+    omega = collision_frequency(density, radius, T, mass, dim, eta)
+    delta = a_kappa * (4.0 * T / mass) ** 0.1
+    zeta = 2.0 / dim * VISCOELASTIC_C1 * math.gamma(2.1) * omega * delta
+    if order == 2:
+        c = VISCOELASTIC_C1**2 + 2 * VISCOELASTIC_C2
+        zeta = zeta - c * math.gamma(2.2) * omega * delta**2 / dim
+    return zeta[()] if np.ndim(zeta) == 0 else zeta
+
+
+def viscoelastic_tau0(
+    a_kappa: float,
+    density: float,
+    radius: float,
+    temperature0: float,
+    mass: float = 1.0,
+    dim: int = 3,
+    eta: float | None = None,
+) -> float:
+    """Time scale tau0' of the viscoelastic cooling law, ``tau0' = 5 / (3 zeta_1(T0))``
+    (``viscoelastic_cooling_rate``, order 1): dT/dt = -zeta_1(T0) (T/T0)^(3/5) T integrates
+    to T0 (1 + t/tau0')^(-5/3).  Infinite for a_kappa = 0 (elastic).
+
+    Parameters
+    ----------
+    a_kappa : A kappa^(2/5) (see ``viscoelastic_delta``)
+    density, radius, temperature0, mass, dim, eta : as for ``haff_tau0``
+
+    Returns
+    -------
+    tau0'
+
+    Raises
+    ------
+    ValueError
+        For a negative or non-finite a_kappa.
+
+    References
+    ----------
+    Brilliantov & Poeschel, Kinetic Theory of Granular Gases (OUP 2004), ch. 8; Schwager
+    & Poeschel, PRE 57, 650 (1998).
+    """
+    zeta = float(viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta))
+    return math.inf if zeta == 0.0 else 5.0 / (3.0 * zeta)
+
+
+def viscoelastic_temperature(t: FloatOrArray, temperature0: float, tau0: float) -> FloatOrArray:
+    """Leading-order cooling of viscoelastic particles, ``T0 (1 + t/tau0')^(-5/3)``
+    (tau0' from ``viscoelastic_tau0``): Haff's law T0 (1 + t/tau0)^-2 with the exponent
+    of eps(g)'s g^(1/5).  Valid for delta(T0) << 1, in the homogeneous cooling state (no
+    clusters); its relative error is of order delta(T(t)), which decays as t^(-1/6), so
+    the law becomes exact at late times (the gas grows more elastic as it cools).
+
+    References
+    ----------
+    Schwager & Poeschel, PRE 57, 650 (1998); Brilliantov & Poeschel, Kinetic Theory of
+    Granular Gases (OUP 2004), ch. 8.
+    """
+    return temperature0 * (1.0 + np.asarray(t, dtype=np.float64) / tau0) ** (-5.0 / 3.0)
+
+
+def viscoelastic_cooling_time(
+    temperature: FloatOrArray,
+    temperature0: float,
+    a_kappa: float,
+    density: float,
+    radius: float,
+    mass: float = 1.0,
+    dim: int = 3,
+    eta: float | None = None,
+) -> FloatOrArray:
+    """Time at which the gas has cooled from T0 to T under the second-order rate
+    zeta_1 + zeta_2 (``viscoelastic_cooling_rate``, order 2), exactly.
+
+    With y = (T/T0)^(1/10), alpha = zeta_1(T0) and beta = -zeta_2(T0) (> 0), the rate is
+    zeta = y^6 (alpha - beta y) and dt = -10 dy / (y^7 (alpha - beta y)); by partial fractions
+
+        t = 10 [ sum_{k=0}^{5} beta^k (y^(k-6) - 1) / ((6 - k) alpha^(k+1))
+                 - r ln y + r ln((alpha - beta y) / (alpha - beta)) ],   r = beta^6 / alpha^7,
+
+    which is (5/3)((T/T0)^(-3/5) - 1) / alpha, the leading order, for beta = 0.
+
+    Raises
+    ------
+    ValueError
+        If zeta_2 is not smaller than zeta_1 at T0 (delta too large for the series).
+    """
+    alpha = float(viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta))
+    beta = alpha - float(
+        viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta, order=2)
+    )
+    if 0.0 < alpha <= beta:
+        raise ValueError(
+            f"the second-order term of the restitution series ({beta:.3g}) is not smaller than "
+            f"the first ({alpha:.3g}): delta = "
+            f"{float(viscoelastic_delta(a_kappa, temperature0, mass)):.3g} is too large for the "
+            "series"
+        )
+    y = (np.asarray(temperature, dtype=np.float64) / temperature0) ** 0.1
+    if np.any((y <= 0) | (y > 1)):
+        raise ValueError("temperature must lie in (0, T0]")
+    if alpha == 0.0:
+        return np.where(y == 1, 0.0, math.inf)
+    out = np.zeros_like(y)
+    for k in range(6):
+        out += beta**k * (y ** (k - 6) - 1) / ((6 - k) * alpha ** (k + 1))
+    r = beta**6 / alpha**7
+    out += -r * np.log(y) + r * np.log1p(beta * (1 - y) / (alpha - beta))
+    out = 10.0 * out
+    return out[()] if out.ndim == 0 else out
+
+
+def viscoelastic_temperature_second_order(
+    t: FloatOrArray,
+    temperature0: float,
+    a_kappa: float,
+    density: float,
+    radius: float,
+    mass: float = 1.0,
+    dim: int = 3,
+    eta: float | None = None,
+) -> FloatOrArray:
+    """T(t) with the next correction of the restitution series: the inverse of
+    ``viscoelastic_cooling_time`` (bisection to rounding between the leading-order laws
+    with rates zeta_1 and zeta_1 + zeta_2 at T0, which bracket it).  Its difference from
+    ``viscoelastic_temperature`` is relative O(delta(T0)) early and decays like delta(T(t))
+    ~ t^(-1/6).  Maxwellian approximation (see ``viscoelastic_cooling_rate``)."""
+    alpha = float(viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta))
+    beta = alpha - float(
+        viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta, order=2)
+    )
+    t = np.asarray(t, dtype=np.float64)
+    if np.any(t < 0):
+        raise ValueError("t must be >= 0")
+    if alpha == 0.0:  # elastic: no cooling
+        return temperature0 * np.ones_like(t)[()]
+    # y^6 (alpha - beta) <= zeta / ... : cooling with rate alpha y^6 is the faster bound
+    lo = (1 + 0.6 * alpha * t) ** (-1 / 6)
+    hi = (1 + 0.6 * max(alpha - beta, 0.0) * t) ** (-1 / 6)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        late = (
+            viscoelastic_cooling_time(
+                temperature0 * np.maximum(mid, 1e-300) ** 10,
+                temperature0,
+                a_kappa,
+                density,
+                radius,
+                mass,
+                dim,
+                eta,
+            )
+            > t
+        )  # cooled to mid only after t: at t it is still warmer
+        lo = np.where(late, mid, lo)
+        hi = np.where(late, hi, mid)
+    out = temperature0 * (0.5 * (lo + hi)) ** 10
+    return out[()] if out.ndim == 0 else out
+
+
+def viscoelastic_diffusion(t: FloatOrArray, D0: float, tau0: float) -> FloatOrArray:
+    """Self-diffusion coefficient of the viscoelastic gas, ``D(t) = D0 (1 + t/tau0')^(-5/6)``.
+
+    Enskog's D ~ sqrt(T) / (n g2 sigma^2) (``diffusion_d0``) with T(t) of
+    ``viscoelastic_temperature``; D0 is ``diffusion_d0`` at T0 with xi = 1, the
+    leading order in delta (the constant-xi factor 4/(1 + xi)^2 tends to 1 as eps -> 1;
+    its first-order correction and the Sonine one are of relative order delta(T(t)),
+    vanishing as t^(-1/6)).  tau0' from ``viscoelastic_tau0``.
+
+    References
+    ----------
+    Brilliantov & Poeschel, PRE 61, 1716 (2000) "Self-diffusion in granular gases" and
+    Kinetic Theory of Granular Gases (OUP 2004), ch. 14; Bodrova, Chechkin, Cherstvy &
+    Metzler, PCCP 17, 21791 (2015).
+    """
+    return D0 * (1.0 + np.asarray(t, dtype=np.float64) / tau0) ** (-5.0 / 6.0)
+
+
+def msd_viscoelastic(t: FloatOrArray, D0: float, tau0: float, dim: int = 3) -> FloatOrArray:
+    """MSD of the viscoelastic gas, total over ``dim``, from D(t) of
+    ``viscoelastic_diffusion``: ``2 d int_0^t D = 12 d D0 tau0' ((1 + t/tau0')^(1/6) - 1)``,
+    for t much longer than the mean collision time (it misses the ballistic start, as the
+    thesis' 2.80 does for constant xi).  Late times: ``12 d D0 tau0'^(5/6) t^(1/6)``
+    (``msd_viscoelastic_asymptote``), subdiffusion with exponent 1/6.
+
+    References
+    ----------
+    Brilliantov & Poeschel, Kinetic Theory of Granular Gases (OUP 2004), ch. 14; Bodrova
+    et al., PCCP 17, 21791 (2015).
+    """
+    u = np.log1p(np.asarray(t, dtype=np.float64) / tau0)
+    return 12.0 * dim * D0 * tau0 * np.expm1(u / 6.0)
+
+
+def msd_viscoelastic_asymptote(
+    t: FloatOrArray, D0: float, tau0: float, dim: int = 3
+) -> FloatOrArray:
+    """Late-time power law of ``msd_viscoelastic``: ``12 d D0 tau0'^(5/6) t^(1/6)``; the
+    full expression exceeds it by the factor (1 + tau0'/t)^(1/6) - (tau0'/t)^(1/6), so it
+    is within 10% only from t ~ 10^5 tau0' on -- fit late exponents, or compare with the
+    full expression."""
+    return 12.0 * dim * D0 * tau0 ** (5.0 / 6.0) * np.asarray(t, dtype=np.float64) ** (1.0 / 6.0)
+
+
+def viscoelastic_langevin_coefficients(
+    n: float,
+    radius: float,
+    volume: float,
+    a_kappa: float,
+    temperature0: float,
+    mass: float = 1.0,
+    dim: int = 3,
+) -> LangevinCoefficients:
+    """gamma0, D0 and tau0' of the power-law UDSBM model of a viscoelastic gas, to run
+    with ``langevin.run(..., exponent=5/6)``: D0 Enskog's at T0 (``diffusion_d0``, xi = 1),
+    gamma0 = T0 / (m D0) as the thesis' (2.55), tau0' = ``viscoelastic_tau0``.  Then
+    D gamma ~ (1 + t/tau0')^(-5/3) is the cooling law and D the D(t) of
+    ``viscoelastic_diffusion`` (Bodrova et al., PCCP 17, 21791 (2015))."""
+    density = n / volume
+    d0 = float(diffusion_d0(density, radius, 1.0, temperature0, mass, dim))
+    tau0 = viscoelastic_tau0(a_kappa, density, radius, temperature0, mass, dim)
+    return LangevinCoefficients(temperature0 / (mass * d0), d0, tau0)
+
+
+# -- UDSBM with power-law coefficients: moments, TAMSD, ergodicity breaking --------------------
+
+
+def _check_powerlaw(gamma0, D0, tau0, exponent):
+    for name, value in (("gamma0", gamma0), ("D0", D0)):
+        if not (value > 0 and math.isfinite(value)):
+            raise ValueError(f"{name} must be positive and finite, got {value}")
+    if not tau0 > 0:
+        raise ValueError(f"tau0 must be positive (inf: constant coefficients), got {tau0}")
+    if not (exponent > 0 and math.isfinite(exponent)):
+        raise ValueError(f"exponent must be positive and finite, got {exponent}")
+
+
+def _powerlaw_ode(gamma0, tau0, exponent, v0_sq_reduced, t_max_reduced):
+    """Dense solution of the second-moment ODEs in units of 1/gamma0 (time), D0/gamma0
+    (x^2), D0 (x v), D0 gamma0 (v^2): with g = w^-a, w = 1 + t/tau0,
+    d<x^2> = 2 <xv>, d<xv> = <v^2> - g <xv>, d<v^2> = -2 g <v^2> + 2 g^3 (the noise
+    2 D gamma^2).  DOP853 at rtol 1e-12.  Constant coefficients (tau0 = inf): the closed
+    forms of the Langevin model (2.68 with the start's transient), no integration."""
+    from scipy.integrate import solve_ivp
+
+    if math.isinf(tau0):
+        excess = v0_sq_reduced - 1.0
+
+        def langevin(s):
+            s = np.asarray(s, dtype=np.float64)
+            omc, e = -np.expm1(-s), np.exp(-s)
+            xx = 2.0 * _x_plus_expm1(s) + excess * omc**2
+            return np.array([xx, omc + excess * e * omc, 1.0 + excess * e * e])
+
+        return langevin
+
+    c = 1.0 / (gamma0 * tau0)  # w = 1 + c s, s = gamma0 t
+
+    def rhs(s, y):
+        g = (1.0 + c * s) ** -exponent
+        return [2.0 * y[1], y[2] - g * y[1], -2.0 * g * y[2] + 2.0 * g**3]
+
+    sol = solve_ivp(
+        rhs,
+        (0.0, max(t_max_reduced, 1e-12)),
+        [0.0, 0.0, v0_sq_reduced],
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-15,
+        dense_output=True,
+    )
+    if not sol.success:  # pragma: no cover - DOP853 on this smooth linear system
+        raise RuntimeError(f"moment ODE failed: {sol.message}")
+    return sol.sol
+
+
+def powerlaw_udsbm_moments(
+    t: FloatOrArray,
+    D0: float,
+    gamma0: float,
+    tau0: float,
+    exponent: float,
+    v0_sq: float | None = None,
+) -> tuple[FloatOrArray, FloatOrArray, FloatOrArray]:
+    """<x^2>, <x v>, <v^2> per dimension of UDSBM with power-law coefficients,
+    dv = -gamma(t) v dt + sqrt(2 D(t)) gamma(t) dW, gamma = gamma0 w^-a, D = D0 w^-a,
+    w = 1 + t/tau0, from x = 0 and <v^2> = v0_sq (default D0 gamma0, thermal).
+
+    The exact moment equations d<x^2>/dt = 2<xv>, d<xv>/dt = <v^2> - gamma <xv>,
+    d<v^2>/dt = -2 gamma <v^2> + 2 D gamma^2 (Ito) integrated numerically (relative
+    error ~1e-11): for a != 1 they have no elementary closed form (the velocity
+    propagator exp(-gamma0 tau0 (w^(1-a) - 1)/(1 - a)) leads to incomplete gamma
+    functions).  For a = 1 this is the thesis' (2.113) / ``msd_udsbm`` (tested), for
+    tau0 = inf the Langevin (2.68).
+
+    References
+    ----------
+    Bodrova, Chechkin, Cherstvy, Safdari, Sokolov & Metzler, "Underdamped scaled Brownian
+    motion: (non-)existence of the overdamped limit in anomalous diffusion", Sci. Rep. 6,
+    30520 (2016) (UDSBM with power-law coefficients); thesis App. C and (2.111)-(2.113) for a = 1.
+    """
+    _check_powerlaw(gamma0, D0, tau0, exponent)
+    t = np.asarray(t, dtype=np.float64)
+    if np.any(t < 0) or not np.all(np.isfinite(t)):
+        raise ValueError("t must be finite and >= 0")
+    v0 = D0 * gamma0 if v0_sq is None else float(v0_sq)
+    s = gamma0 * t
+    sol = _powerlaw_ode(gamma0, tau0, exponent, v0 / (D0 * gamma0), float(np.max(s, initial=0.0)))
+    y = sol(s.reshape(-1)).reshape((3, *t.shape))
+    xx, xv, vv = y[0] * D0 / gamma0, y[1] * D0, y[2] * D0 * gamma0
+    if t.ndim == 0:
+        return float(xx), float(xv), float(vv)
+    return xx, xv, vv
+
+
+def msd_powerlaw_udsbm(
+    t: FloatOrArray,
+    D0: float,
+    gamma0: float,
+    tau0: float,
+    exponent: float,
+    dim: int = 3,
+    v0_sq: float | None = None,
+) -> FloatOrArray:
+    """Ensemble MSD of UDSBM with power-law coefficients, total over ``dim``:
+    ``dim <x^2>`` of ``powerlaw_udsbm_moments`` (see there).  Late times, for a < 1:
+    ``msd_powerlaw_udsbm_asymptote``."""
+    xx, _, _ = powerlaw_udsbm_moments(t, D0, gamma0, tau0, exponent, v0_sq)
+    return dim * np.asarray(xx) if np.ndim(xx) else dim * xx
+
+
+def msd_powerlaw_udsbm_asymptote(
+    t: FloatOrArray, D0: float, tau0: float, exponent: float, dim: int = 3
+) -> FloatOrArray:
+    """Overdamped limit of the power-law UDSBM MSD for a < 1, total over ``dim``:
+    ``2 d int_0^t D = 2 d D0 tau0 ((1 + t/tau0)^(1-a) - 1) / (1 - a)``, ~ t^(1-a) (t^(1/6)
+    for the viscoelastic a = 5/6).
+
+    Why it holds for a < 1 only: gamma(t) t ~ t^(1-a) grows, so the velocity relaxes ever
+    faster against the age and the overdamped limit exists; the underdamped MSD exceeds
+    this by a term that grows more slowly (relative O(1/(gamma(t) t))).  For a = 1 the
+    ratio gamma t stays gamma0 tau0 and the MSD is larger by (gamma0 tau0 / (gamma0 tau0 -
+    1))^2 (thesis 2.113; Bodrova et al., Sci. Rep. 6, 30520 (2016): the overdamped limit does
+    not exist); for a > 1 the motion ends ballistic.
+
+    Raises
+    ------
+    ValueError
+        For exponent outside (0, 1).
+    """
+    if not 0 < exponent < 1:
+        raise ValueError(f"the overdamped asymptote needs 0 < exponent < 1, got {exponent}")
+    u = np.log1p(np.asarray(t, dtype=np.float64) / tau0)
+    b = 1.0 - exponent
+    return 2.0 * dim * D0 * tau0 * np.expm1(b * u) / b
+
+
+# Gauss-Legendre nodes for the propagator integral K: panels [0, 1/2], [1/2, 1], [1, 2], ...
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(20)
+
+
+def _powerlaw_propagator_integral(start, gap, gamma0, tau0, exponent):
+    """K(s, h) = int_s^{s+h} exp(-int_s^u gamma) du, the factor of <x(s) v(s)> in
+    <x(s) x(s+h)> = <x^2>(s) + <xv>(s) K (the velocity correlation decays with the
+    propagator after s).  Closed forms for tau0 = inf, (1 - exp(-gamma0 h))/gamma0, and
+    a = 1, tau0 w (1 - (w/W)^(A-1))/(A - 1) (A = gamma0 tau0, w = 1 + s/tau0,
+    W = 1 + (s+h)/tau0); for a < 1, in phi = int_s^u gamma, K = (w^a/gamma0) int_0^Phi
+    exp(-phi) (1 + (1-a) phi / (A w^(1-a)))^(a/(1-a)) dphi by 20-point Gauss-Legendre on
+    doubling panels; for a > 1 the same in z = ln(W/w) (relative error < 1e-9 against
+    scipy quad, a = 1.2 to 3, tests/test_theory_viscoelastic.py)."""
+    s, h = np.broadcast_arrays(
+        np.asarray(start, dtype=np.float64), np.asarray(gap, dtype=np.float64)
+    )
+    if math.isinf(tau0):
+        return -np.expm1(-gamma0 * h) / gamma0
+    A = gamma0 * tau0
+    w = 1.0 + s / tau0
+    lr = np.log1p(h / (tau0 + s))  # ln(W / w)
+    if exponent == 1.0:
+        if A == 1.0:
+            return tau0 * w * lr
+        return tau0 * w * -np.expm1(-(A - 1) * lr) / (A - 1)
+    b = 1.0 - exponent
+    wb = w**b
+    if exponent > 1.0:
+        # gamma's integral converges: in phi the integrand has a singular end, so integrate
+        # in z = ln(W/w) instead, du = (tau0 + s) e^z dz, on panels doubling from the
+        # relaxation scale 1 / (A w^b) of the start
+        z0 = 0.5 / (A * wb)
+        total = np.zeros(np.shape(s))
+        k = 0
+        while True:
+            a_ = np.minimum(z0 * (2.0**k - 1.0), lr)
+            b_ = np.minimum(z0 * (2.0 ** (k + 1) - 1.0), lr)
+            if not np.any(b_ > a_):
+                break
+            half = 0.5 * (b_ - a_)
+            z = (a_ + half)[..., None] + half[..., None] * _GL_X
+            f = np.exp(z - A * wb[..., None] * np.expm1(b * z) / b)
+            total += half * (f @ _GL_W)
+            k += 1
+        return (tau0 + s) * total
+    phi_end = A * wb * np.expm1(b * lr) / b
+    scale = b / (A * wb)
+    total = np.zeros(np.shape(s))
+    lo = 0.0
+    hi = 0.5
+    top = float(np.max(phi_end, initial=0.0))
+    while lo < top:
+        a_ = np.minimum(lo, phi_end)
+        b_ = np.minimum(hi, phi_end)
+        half = 0.5 * (b_ - a_)
+        if np.any(half > 0):
+            phi = (a_ + half)[..., None] + half[..., None] * _GL_X
+            base = np.maximum(1.0 + scale[..., None] * phi, 0.0)
+            f = np.exp(-phi) * base ** (exponent / b)
+            total += half * (f @ _GL_W)
+        lo, hi = hi, 2 * hi
+    return w**exponent / gamma0 * total
+
+
+def _position_covariance(t1, t2, sol, D0, gamma0, tau0, exponent):
+    """<x(t1) x(t2)> per dimension (``_powerlaw_propagator_integral``), from the dense
+    moment solution in reduced units."""
+    m = np.minimum(t1, t2)
+    # the moments at each distinct time once (window ends repeat across pairs)
+    times, where = np.unique(m, return_inverse=True)
+    y = sol(gamma0 * times)[:, where.reshape(-1)].reshape((3, *np.shape(m)))
+    k = _powerlaw_propagator_integral(m, np.abs(t2 - t1), gamma0, tau0, exponent)
+    return y[0] * D0 / gamma0 + y[1] * D0 * k
+
+
+def powerlaw_udsbm_increment_msd(
+    lag: FloatOrArray,
+    start: FloatOrArray,
+    D0: float,
+    gamma0: float,
+    tau0: float,
+    exponent: float,
+    dim: int = 3,
+    v0_sq: float | None = None,
+) -> FloatOrArray:
+    """Mean squared displacement over [start, start + lag] of UDSBM with power-law
+    coefficients, total over ``dim``: ``<x^2>(s+lag) - <x^2>(s) - 2 <xv>(s) K(s, lag)``
+    per dimension, with K the integral of the velocity propagator over the lag (the
+    thesis' 2.116-2.118: the cross term <x(s) x(s+lag)> = <x^2>(s) + <xv>(s) K).  Moments
+    from ``powerlaw_udsbm_moments``; their difference loses digits when the increment is
+    small against <x^2>(s) (relative error ~1e-11 <x^2>(s) / increment).  Equals
+    ``udsbm_increment_msd`` for a = 1 (tested)."""
+    _check_powerlaw(gamma0, D0, tau0, exponent)
+    lag, start = np.broadcast_arrays(
+        np.asarray(lag, dtype=np.float64), np.asarray(start, dtype=np.float64)
+    )
+    if np.any(lag < 0) or np.any(start < 0):
+        raise ValueError("lag and start must be >= 0")
+    v0 = D0 * gamma0 if v0_sq is None else float(v0_sq)
+    sol = _powerlaw_ode(
+        gamma0, tau0, exponent, v0 / (D0 * gamma0), float(gamma0 * np.max(start + lag, initial=0))
+    )
+    y0 = sol((gamma0 * start).reshape(-1)).reshape((3, *start.shape))
+    y1 = sol((gamma0 * (start + lag)).reshape(-1)).reshape((3, *start.shape))
+    k = _powerlaw_propagator_integral(start, lag, gamma0, tau0, exponent)
+    out = dim * ((y1[0] - y0[0]) * D0 / gamma0 - 2.0 * y0[1] * D0 * k)
+    return out[()] if out.ndim == 0 else out
+
+
+def udsbm_ergodicity_breaking(
+    lag: float,
+    starts: ArrayLike,
+    D0: float,
+    gamma0: float,
+    tau0: float = math.inf,
+    exponent: float = 1.0,
+    dim: int = 3,
+    v0_sq: float | None = None,
+) -> float:
+    """Ergodicity-breaking parameter EB = Var(TAMSD) / <TAMSD>^2 of the time-averaged MSD
+    over windows [s_j, s_j + lag] (the engine's, or a fine grid for the continuous-time
+    average of the thesis' 2.115), for UDSBM with power-law coefficients (a = 1 the
+    thesis' UDSBM, tau0 = inf the Langevin model).
+
+    The process is Gaussian with zero mean, so with C_jk the covariance per dimension of
+    the increments of windows j and k (from ``<x(t1) x(t2)>``, see
+    ``powerlaw_udsbm_increment_msd``) and d independent dimensions, Isserlis' theorem gives
+    ``Cov(|dx_j|^2, |dx_k|^2) = 2 d C_jk^2`` and
+
+        EB = 2 sum_jk C_jk^2 / (d (sum_j C_jj)^2).
+
+    EB -> 0 for an ergodic process as t_stop / lag grows (Brownian motion: 4 lag / (3 d
+    t_stop), He, Burov, Metzler & Barkai, PRL 101, 058101 (2008)); UDSBM's stays finite
+    (Bodrova et al., PCCP 17, 21791 (2015); Safdari, Cherstvy, Chechkin, Bodrova & Metzler,
+    "Ageing underdamped scaled Brownian motion", arXiv:1609.07246).
+    Cost O(len(starts)^2).
+
+    Parameters
+    ----------
+    lag : the lag
+    starts : (M,) window starts
+    D0, gamma0, tau0, exponent, v0_sq : the model (see ``powerlaw_udsbm_moments``)
+    dim : dimensions summed in ``|dx|^2``
+
+    Returns
+    -------
+    EB
+    """
+    _check_powerlaw(gamma0, D0, tau0, exponent)
+    s = np.asarray(starts, dtype=np.float64).reshape(-1)
+    if not lag > 0 or s.size == 0 or np.any(s < 0):
+        raise ValueError("need lag > 0 and at least one window start >= 0")
+    v0 = D0 * gamma0 if v0_sq is None else float(v0_sq)
+    sol = _powerlaw_ode(gamma0, tau0, exponent, v0 / (D0 * gamma0), gamma0 * (s.max() + lag))
+    a, b = s[:, None], s[None, :]
+
+    def cov(t1, t2):
+        return _position_covariance(t1, t2, sol, D0, gamma0, tau0, exponent)
+
+    c = cov(a + lag, b + lag) - cov(a + lag, b) - cov(a, b + lag) + cov(a, b)
+    return float(2.0 * np.sum(c * c) / (dim * np.trace(c) ** 2))

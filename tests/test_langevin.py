@@ -427,7 +427,7 @@ def test_default_samples_end_at_t_stop_for_any_step_count(monkeypatch):
     logspace overshoots it (10^15 + 3 steps: 10^15 + 4); no stepping is needed to see it,
     so the C core is replaced by a stub (called once)."""
     seen = []
-    monkeypatch.setattr(langevin._core, "sde_run", lambda *args: seen.append(args[15]))
+    monkeypatch.setattr(langevin._core, "sde_run", lambda *args, **kw: seen.append(args[15]))
     monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", 10**16)
     r = langevin.run(1, gamma0=G0, D0=D0, dt=1.0, t_stop=1e15 + 3, seed=1)
     assert r.times[-1] == 1e15 + 3 and np.all(np.diff(r.times) > 0)

@@ -8,7 +8,8 @@ libm calls (Python's ``math`` module calls the C library's exp, log and sqrt) --
 integrates each particle step by step, written from the equations rather than from the C:
 
     dx = v dt,   dv = -gamma(t) v dt + sqrt(2 D(t)) gamma(t) dW
-    Langevin: gamma0, D0;   UDSBM: gamma0 / (1 + t/tau0), D0 / (1 + t/tau0)
+    Langevin: gamma0, D0;   UDSBM: gamma0 (1 + t/tau0)^-a, D0 (1 + t/tau0)^-a, a = exponent
+    (a = 1: the thesis' gamma0 / (1 + t/tau0), D0 / (1 + t/tau0))
 
 - "em": Euler-Maruyama, thesis (2.92)/(2.110), coefficients at the start of the step;
 - "exact": the exact Gaussian update of the Ornstein-Uhlenbeck process over a step (mean
@@ -93,9 +94,9 @@ class Stream:
                 return x  # under the density in the layer's wedge
 
 
-def coefficients(model, gamma0, D0, tau0, t):
+def coefficients(model, gamma0, D0, tau0, t, exponent=1.0):
     """gamma(t), D(t)."""
-    s = 1.0 if model == "langevin" else 1.0 / (1.0 + t / tau0)
+    s = 1.0 if model == "langevin" else (1.0 + t / tau0) ** -exponent
     return gamma0 * s, D0 * s
 
 
@@ -117,7 +118,7 @@ def ou_step(gamma, D, dt):
     return c, (1 - c) / gamma, np.linalg.cholesky(cov)
 
 
-def run(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, first=0):
+def run(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, first=0, exponent=1.0):
     """Positions (n_steps + 1, N, d) and velocities (n_steps + 1, N, d) at every step of
     particles first .. first + N - 1 starting at the origin with velocities v0 (N, d)."""
     v0 = np.asarray(v0, dtype=np.float64)
@@ -130,12 +131,12 @@ def run(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, first=0):
         for k in range(1, n_steps + 1):
             rs = Stream(key, k - 1, first + i)
             if scheme == "em":
-                g, D = coefficients(model, gamma0, D0, tau0, (k - 1) * dt)
+                g, D = coefficients(model, gamma0, D0, tau0, (k - 1) * dt, exponent)
                 for a in range(d):
                     dW = math.sqrt(dt) * rs.normal()
                     x[a], v[a] = x[a] + v[a] * dt, v[a] - g * v[a] * dt + math.sqrt(2 * D) * g * dW
             else:
-                g, D = coefficients(model, gamma0, D0, tau0, (k - 0.5) * dt)
+                g, D = coefficients(model, gamma0, D0, tau0, (k - 0.5) * dt, exponent)
                 c, drift, L = ou_step(g, D, dt)
                 for a in range(d):
                     z1, z2 = rs.normal(), rs.normal()
@@ -168,6 +169,7 @@ def engine(
     first=0,
     n=None,
     sample_steps=None,
+    exponent=1.0,
 ):
     """The C engine's raw entry point (``_core.sde_run``) over a whole run, with fresh
     buffers, for comparison with ``run``: samples at every step unless ``sample_steps``.
@@ -212,5 +214,6 @@ def engine(
         lags,
         tamsd,
         ring,
+        exponent=exponent,
     )
     return positions[:, first : first + count], v, x2, tamsd[first : first + count]
