@@ -11,6 +11,7 @@ that checks them against theory.
 from . import analysis, errors, langevin, theory
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
+    CheckpointError,
     FrozenGasError,
     GranularError,
     HeatedWallsError,
@@ -61,6 +62,7 @@ def __dir__():
 
 
 __all__ = [
+    "CheckpointError",
     "EnsembleResult",
     "FrozenGasError",
     "GranularError",

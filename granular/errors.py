@@ -72,3 +72,9 @@ class ProcessBackendError(GranularError, RuntimeError):
 class NoProgressError(GranularError, RuntimeError):
     """A run without a time limit made no progress towards its stop criterion (no
     collision in a great many events), so it would never end."""
+
+
+class CheckpointError(GranularError, ValueError):
+    """A checkpoint (``Simulation.load``, an ensemble's ``save_to`` directory) cannot be
+    used: not a checkpoint, truncated or corrupt, written by another version of granular,
+    or made for another model."""
