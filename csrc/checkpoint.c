@@ -335,6 +335,33 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
             if (t->big.idx[m] == i) return "its big particles are inconsistent";
     }
 
+    /* numbers: the time and every particle clock finite (0 <= t_i <= t: a clock only
+     * moves to an event's time), positions within a box length of the box (list mode
+     * lets them stray a shell's width beyond a periodic box), list centres too, speeds
+     * finite and within the scene's limit of 1e140 (granular/scene.py), counters of
+     * energy finite.  Out-of-range numbers would make NaNs that the engine's cell
+     * arithmetic is not built for. */
+    if (!(t->t >= 0.0 && t->t < INFINITY) || !isfinite(t->eps_t) || !isfinite(t->kinetic) ||
+        !isfinite(t->kinetic_time) || !isfinite(t->virial) || !isfinite(t->wall_impulse) ||
+        t->t_prev_event != t->t_prev_event)
+        return "its time or energy counters are not finite";
+    for (int32_t i = 0; i < n; i++) {
+        const double *p = rec(t, i);
+        if (!(TIME(p, d) >= 0.0 && TIME(p, d) <= t->t)) return "a particle's clock is out of range";
+        for (int k = 0; k < d; k++) {
+            const double L = s->L[k];
+            if (!(p[k] >= b->lo[k] - L && p[k] <= b->hi[k] + L) || !(fabs(VEL(p, d)[k]) <= 1e140))
+                return "a particle's position or velocity is out of range";
+            if (s->nl.shell > 0.0) {
+                const double x = t->nl.centre[(size_t)i * (d + 1) + k];
+                if (!(x >= b->lo[k] - L && x <= b->hi[k] + L))
+                    return "a neighbour list's centre is out of range";
+            }
+        }
+        if (s->nl.shell > 0.0 && !same_double(t->nl.centre[(size_t)i * (d + 1) + d], RAD(p, d)))
+            return "a neighbour list's centre is corrupt";
+    }
+
     /* scheduling states: every index an event follows is in range; a particle with no
      * partner has no collision and one with no crossing has no crossing time, so the
      * loop never takes them for a wall or a crossing of axis -1 */
@@ -344,6 +371,9 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         const gr_sched *e = &t->sched[i];
         if (e->partner < -1 - 2 * d || e->partner >= n || e->last < -1 - 2 * d || e->last >= n)
             return "a particle's partner index is out of range";
+        /* predictions are made from the particle's clock on (NaN is reported by the loop) */
+        const double clock = TIME(rec(t, i), d);
+        if (e->t_coll < clock || e->t_cross < clock) return "a particle's next event lies in its past";
         if (e->partner == -1 && e->t_coll != INFINITY)
             return "a particle has a collision time but no partner";
         /* (lists: t_cross is the shell exit, and cross is not used) */

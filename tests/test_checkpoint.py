@@ -335,3 +335,20 @@ def test_corrupted_engine_states_never_crash_the_core():
     summary = json.loads(proc.stdout.strip().splitlines()[-1])
     # both outcomes must occur, or the corruption is too weak or too strong to test much
     assert summary["refused"] > 300 and summary["accepted"] > 50, summary
+
+
+@pytest.mark.parametrize(
+    "stop",
+    [{"collisions_per_particle": 7}, {"kinetic_energy": 0.3}, {"events": 4321}],
+)
+def test_saving_where_a_stop_criterion_ended_the_run(stop, tmp_path):
+    """A run that stopped right after an event (a criterion, an event budget) rather than
+    at a time in between events continues bit for bit too."""
+    scene = Scene.random(200, 0.015, dim=2, restitution=0.7, temperature=1.0, seed=18)
+    sim = Simulation(scene)
+    sim.run(stop_when=stop)
+    sim.save(tmp_path / "s")
+    loaded = Simulation.load(tmp_path / "s")
+    more = {"collisions_per_particle": 20}
+    _assert_same_trajectory(sim.run(stop_when=more), loaded.run(stop_when=more))
+    _assert_same_state(sim, loaded)
