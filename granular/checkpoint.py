@@ -64,7 +64,7 @@ def dumps(sim: Simulation) -> bytes:
         "format_version": FORMAT_VERSION,
         "granular_version": _version(),
         "layout": str(_core.CHECKPOINT_LAYOUT),
-        "knobs": dict(sim._knobs),
+        "knobs": {k: v if isinstance(v, str) else float(v) for k, v in sim._knobs.items()},
         "scene": {name: getattr(scene, name) for name in _SCENE_PARAMS},
         "engine_state_sha256": hashlib.sha256(state).hexdigest(),
     }
