@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import _core, _edmd
+from . import _core
 from .errors import CheckpointError
 from .scene import Scene
 

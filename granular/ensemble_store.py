@@ -138,7 +138,8 @@ class RunStore:
             with np.load(path, allow_pickle=False) as npz:
                 arrays = {k: npz[k] for k in npz.files}
             meta = json.loads(str(arrays.pop(_META)[()]))
-        except Exception as exc:  # noqa: BLE001 -- any unreadable file gets the same advice
+        # any unreadable file (bad zip, missing entry, bad JSON) gets the same advice
+        except Exception as exc:
             raise CheckpointError(
                 f"{path} is unreadable ({exc.__class__.__name__}: {exc}); delete it and "
                 "call again to redo that run"

@@ -555,4 +555,3 @@ def _progress_bar(progress, t0, t1, collisions):
     if math.isfinite(collisions):
         return _ProgressBar(0.0, collisions, by_time=False)
     return None
-

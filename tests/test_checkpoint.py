@@ -261,7 +261,7 @@ def test_files_from_another_version_are_refused(saved, tmp_path):
     ):
         path = tmp_path / f"{field}.ckpt"
         path.write_bytes(_rewrite_meta(saved, **{field: value}))
-        with pytest.raises(CheckpointError, match="written by granular .* this is granular"):
+        with pytest.raises(CheckpointError, match=r"written by granular .* this is granular"):
             Simulation.load(path)
     assert ck.loads(saved).time == 0.5  # the unaltered bytes load
 
@@ -272,7 +272,7 @@ def test_truncated_corrupt_and_foreign_files_are_refused(saved, tmp_path):
     cuts = sorted({0, 1, 10, len(saved) // 2, len(saved) - 1, *rng.integers(0, len(saved), 20)})
     for cut in cuts:
         path.write_bytes(saved[:cut])
-        with pytest.raises(CheckpointError, match="truncated or corrupt|not a granular"):
+        with pytest.raises(CheckpointError, match=r"truncated or corrupt|not a granular"):
             Simulation.load(path)
     for _ in range(30):  # flipped bytes: the zip's CRC-32, the header or the checksum see it
         data = bytearray(saved)
@@ -302,7 +302,7 @@ def test_truncated_corrupt_and_foreign_files_are_refused(saved, tmp_path):
 def test_an_engine_state_for_another_scene_is_refused(saved):
     """A state whose checksum matches but which belongs to another scene or other knobs:
     the C core compares sizes, config, radii and masses."""
-    meta, arrays = ck._read_npz(saved, "x")
+    _, arrays = ck._read_npz(saved, "x")
     state = bytes(arrays["engine_state"])
     base = Scene.random(100, 0.02, dim=2, restitution=0.9, seed=16)
     engine = Simulation(base)._engine

@@ -134,7 +134,9 @@ def test_resuming_needs_a_seed_and_a_fresh_seed_sequence(tmp_path):
     with pytest.raises(CheckpointError, match="fresh SeedSequence"):
         ensemble(model, 2, seed=ss, backend="serial", save_to=tmp_path)
     with pytest.raises(ValueError, match="pickled"):
-        ensemble(lambda seed: {"x": np.zeros(1)}, 1, seed=1, backend="serial", save_to=tmp_path / "l")
+        ensemble(
+            lambda seed: {"x": np.zeros(1)}, 1, seed=1, backend="serial", save_to=tmp_path / "l"
+        )
 
 
 def test_half_written_and_damaged_run_files(tmp_path):
@@ -147,8 +149,8 @@ def test_half_written_and_damaged_run_files(tmp_path):
     assert CALLS == [2]
     victim = tmp_path / "p0000-r000001.npz"
     victim.write_bytes(victim.read_bytes()[:50])
-    with pytest.raises(CheckpointError, match="p0000-r000001.npz is unreadable.*delete it"):
+    with pytest.raises(CheckpointError, match=r"p0000-r000001\.npz is unreadable.*delete it"):
         ensemble(model, 3, seed=11, backend="serial", save_to=tmp_path)
     (tmp_path / "ensemble.json").unlink()
-    with pytest.raises(CheckpointError, match="no ensemble.json"):
+    with pytest.raises(CheckpointError, match=r"no ensemble\.json"):
         ensemble(model, 3, seed=11, backend="serial", save_to=tmp_path)

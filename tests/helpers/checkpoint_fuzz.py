@@ -41,7 +41,7 @@ def corrupt(state, rng, n):
             data[int(rng.integers(0, len(data)))] ^= int(rng.integers(1, 256))
         return bytes(data), "flip"
     if kind in (3, 4):  # an aligned int32 overwritten with an index near a range's ends
-        values = SPECIAL_INTS + [n - 1, n, n + 1, -n, int(rng.integers(-(2**31), 2**31))]
+        values = [*SPECIAL_INTS, n - 1, n, n + 1, -n, int(rng.integers(-(2**31), 2**31))]
         k = 4 * int(rng.integers(0, len(data) // 4))
         v = int(values[int(rng.integers(0, len(values)))])
         data[k : k + 4] = np.int32(v).tobytes()
