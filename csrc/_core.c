@@ -446,9 +446,11 @@ static PyObject *EDMD_save_state(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     PyObject *out = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)size);
     if (!out) return NULL;
     int status;
+    self->busy = 1; /* no advance() while the state is read without the GIL */
     Py_BEGIN_ALLOW_THREADS
     status = gr_edmd_save(self->sim, (unsigned char *)PyBytes_AS_STRING(out), size);
     Py_END_ALLOW_THREADS
+    self->busy = 0;
     if (status != GR_OK) {
         Py_DECREF(out);
         return raise_status(status, NULL);

@@ -49,6 +49,10 @@ _SCENE_ARRAYS = ("positions", "velocities", "radii", "masses", "lower", "upper")
 _SCENE_PARAMS = ("boundary", "wall_restitution", "restitution", "contact_duration")
 
 
+# The largest speed the C restore accepts (csrc/checkpoint.c; granular/scene.py's limit).
+_MAX_SPEED = 1e140
+
+
 def _version() -> str:
     from . import __version__
 
@@ -57,6 +61,12 @@ def _version() -> str:
 
 def dumps(sim: Simulation) -> bytes:
     """The checkpoint of ``sim`` as the bytes of an ``.npz`` file (see ``Simulation.save``)."""
+    _, vel, _ = sim._engine.state()
+    if not np.all(np.abs(vel) <= _MAX_SPEED):
+        raise CheckpointError(
+            "this Simulation's velocities are not finite or beyond 1e140 (as a NonFiniteError "
+            "or HeatedWallsError leaves them): the state cannot continue, so it is not saved"
+        )
     state = np.frombuffer(sim._engine.save_state(), dtype=np.uint8)
     scene = sim._initial
     meta = {

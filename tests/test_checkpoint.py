@@ -352,3 +352,15 @@ def test_saving_where_a_stop_criterion_ended_the_run(stop, tmp_path):
     more = {"collisions_per_particle": 20}
     _assert_same_trajectory(sim.run(stop_when=more), loaded.run(stop_when=more))
     _assert_same_state(sim, loaded)
+
+
+def test_a_state_that_cannot_continue_is_not_saved(tmp_path):
+    """Walls that multiply speeds by 1e100 overflow them to inf within three bounces: the
+    run stops with NonFiniteError, and saving that state is refused (nothing written)."""
+    scene = Scene.random(5, 0.01, dim=2, boundary="walls", wall_restitution=1e100, seed=19)
+    sim = Simulation(scene)
+    with pytest.raises((granular.NonFiniteError, granular.HeatedWallsError)):
+        sim.run(1.0)
+    with pytest.raises(CheckpointError, match="cannot continue"):
+        sim.save(tmp_path / "inf")
+    assert not list(tmp_path.iterdir())
