@@ -91,6 +91,19 @@ def _tracer_scene(dim, n_small, r_small, r_big, seed, **kw):
     return Scene(pos, vel, radii, box=1.0, **kw)
 
 
+def _symmetric_lattice():
+    """A square lattice whose rows move left and right and whose columns up and down:
+    events at exactly equal times everywhere (many pairs collide at one instant), where
+    the order of ties in the queue and the cell lists decides which comes first."""
+    k = 16  # spacing and positions binary fractions: equal distances exactly
+    g = (np.arange(k) + 0.5) / k
+    pos = np.stack(np.meshgrid(g, g, indexing="ij"), -1).reshape(-1, 2)
+    vel = np.zeros_like(pos)
+    vel[:, 0] = np.where((np.arange(k * k) // k) % 2 == 0, 1.0, -1.0)
+    vel[:, 1] = np.where(np.arange(k * k) % 2 == 0, 0.5, -0.5)
+    return Scene(pos, vel, 0.015, box=1.0, restitution=0.9)
+
+
 # -- every mode continues bit for bit ---------------------------------------------------
 
 MODES = {
@@ -132,6 +145,7 @@ MODES = {
         _tracer_scene(3, 300, 0.02, 0.15, seed=10, boundary="walls", restitution=0.9),
         {},
     ),
+    "2d-symmetric-lattice": lambda: (_symmetric_lattice(), {}),
     "3d-mixture-cell-factor": lambda: (
         Scene.random(300, np.linspace(0.02, 0.035, 300), dim=3, seed=11),
         {"cell_factor": 1.5, "big_ratio": math.inf},
