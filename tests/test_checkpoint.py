@@ -209,6 +209,8 @@ def test_saving_changes_nothing_and_a_split_run_equals_one_run(tmp_path):
     split.save(tmp_path / "b")
     assert (tmp_path / "a").read_bytes() == (tmp_path / "b").read_bytes()
     loaded = Simulation.load(tmp_path / "a")
+    loaded.save(tmp_path / "c")  # a loaded Simulation saves the very same file
+    assert (tmp_path / "c").read_bytes() == (tmp_path / "a").read_bytes()
     loaded.run(t2)
     _assert_same_state(whole, loaded)
 
