@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "big.h"
+#include "checkpoint.h"
 #include "common.h"
 #include "edmd.h"
 #include "rng.h"
@@ -481,6 +482,45 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
                          c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell);
 }
 
+/* ---- checkpoints (csrc/checkpoint.c) ---- */
+
+static PyObject *EDMD_save_state(EDMDObject *self, PyObject *Py_UNUSED(ignored))
+{
+    if (!check_ready(self)) return NULL;
+    const size_t size = gr_edmd_save_size(self->sim);
+    if (size > (size_t)PY_SSIZE_T_MAX) return PyErr_NoMemory();
+    PyObject *out = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)size);
+    if (!out) return NULL;
+    int status;
+    self->busy = 1; /* no advance() while the state is read without the GIL */
+    Py_BEGIN_ALLOW_THREADS
+    status = gr_edmd_save(self->sim, (unsigned char *)PyBytes_AS_STRING(out), size);
+    Py_END_ALLOW_THREADS
+    self->busy = 0;
+    if (status != GR_OK) {
+        Py_DECREF(out);
+        return raise_status(status, NULL);
+    }
+    return out;
+}
+
+static PyObject *EDMD_restore_state(EDMDObject *self, PyObject *arg)
+{
+    if (!check_ready(self)) return NULL;
+    Py_buffer view;
+    if (PyObject_GetBuffer(arg, &view, PyBUF_SIMPLE) < 0) return NULL;
+    gr_error err = {0, -1, -1, NAN, NAN, NULL};
+    int status;
+    self->busy = 1;
+    Py_BEGIN_ALLOW_THREADS
+    status = gr_edmd_restore(self->sim, view.buf, (size_t)view.len, &err);
+    Py_END_ALLOW_THREADS
+    self->busy = 0;
+    PyBuffer_Release(&view);
+    if (status != GR_OK) return raise_status(status, &err);
+    Py_RETURN_NONE;
+}
+
 static PyMethodDef EDMD_methods[] = {
     {"advance", (PyCFunction)(void (*)(void))EDMD_advance, METH_VARARGS | METH_KEYWORDS,
      "advance(t_stop, collisions_per_particle, kinetic_energy, max_events, sample_times, next,"
@@ -489,6 +529,11 @@ static PyMethodDef EDMD_methods[] = {
     {"state", (PyCFunction)EDMD_state, METH_NOARGS,
      "state() -> (positions wrapped in the box, velocities, image counters) at the current time"},
     {"counters", (PyCFunction)EDMD_counters, METH_NOARGS, "counters() -> dict"},
+    {"save_state", (PyCFunction)EDMD_save_state, METH_NOARGS,
+     "save_state() -> bytes: the engine's whole state (csrc/checkpoint.h)"},
+    {"restore_state", (PyCFunction)EDMD_restore_state, METH_O,
+     "restore_state(bytes): replace the state by a saved one; the engine must have been built"
+     " from the same scene and knobs.  ValueError names what does not fit."},
     {NULL, NULL, 0, NULL}
 };
 
@@ -738,6 +783,13 @@ PyMODINIT_FUNC PyInit__core(void)
     PyModule_AddIntConstant(m, "STOP_ENERGY", GR_STOP_ENERGY);
     PyModule_AddIntConstant(m, "STOP_IDLE", GR_STOP_IDLE);
     PyModule_AddIntConstant(m, "BIG_MAX", GR_BIG_MAX);
+    PyObject *layout = PyLong_FromUnsignedLongLong(gr_checkpoint_layout());
+    if (!layout || PyModule_AddObjectRef(m, "CHECKPOINT_LAYOUT", layout) < 0) {
+        Py_XDECREF(layout);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_DECREF(layout);
     PyObject *big_ratio = PyFloat_FromDouble(GR_BIG_RATIO);
     if (!big_ratio || PyModule_AddObjectRef(m, "BIG_RATIO", big_ratio) < 0) {
         Py_XDECREF(big_ratio);

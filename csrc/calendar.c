@@ -317,3 +317,75 @@ void gr_cq_renumber(gr_cq *q, const int32_t *newpos)
     }
     rebuild(q);
 }
+
+/* Walk the list from head (ids where == `where`, buckets in [blo, bhi) and, for a
+ * bucket slot >= 0, in that slot), marking ids seen.  Adds the ids walked to *count;
+ * returns NULL or the fault. */
+static const char *check_list(const gr_cq *q, int32_t head, int32_t where, int64_t blo,
+                              int64_t bhi, int64_t slot, uint8_t *seen, int64_t *count)
+{
+    int32_t prev = -1;
+    for (int32_t id = head; id != -1; id = q->item[id].next) {
+        if (id < 0 || id >= q->n) return "a queue list links to an id out of range";
+        if (seen[id]) return "a queue id is in two places, or a list has a cycle";
+        seen[id] = 1;
+        const gr_cq_item *it = &q->item[id];
+        if (it->where != where || it->prev != prev) return "a queue list's links are inconsistent";
+        if (!(it->t == it->t) || it->t == INFINITY) return "a queue list holds a key of +inf or NaN";
+        const int64_t b = bucket_of(q, it->t);
+        if (b < blo || b >= bhi || (slot >= 0 && (b & (q->nb - 1)) != slot))
+            return "a queue key sits in the wrong bucket";
+        if (++*count > q->n) return "a queue list is longer than the ids";
+        prev = id;
+    }
+    return NULL;
+}
+
+const char *gr_cq_check(const gr_cq *q, uint8_t *seen)
+{
+    const int32_t n = q->n;
+    if (q->nb < 16 || (q->nb & (q->nb - 1)) != 0) return "the queue's slot count is not a power of two";
+    if (q->n_near < 0 || q->n_near > n || q->n_list < 0 || q->n_list > n || q->n_over < 0 ||
+        q->n_over > n || q->n_near + q->n_list + q->n_over > n)
+        return "the queue's counts are out of range";
+    if (q->nan_id < -1 || q->nan_id >= n || q->over < -1 || q->over >= n)
+        return "a queue id is out of range";
+    if (!(q->inv_w > 0.0) || !isfinite(q->inv_w) || q->t0 != q->t0)
+        return "the queue's bucket width or start is not a positive finite number";
+    /* bucket numbers are saturated at 2^62, and the calendar spans at most nb of them */
+    const int64_t far = (int64_t)GR_CQ_FAR;
+    if (q->cur < -far || q->cur > far || q->over_from <= q->cur || q->over_from - q->cur > q->nb)
+        return "the queue's current bucket and overflow start are inconsistent";
+    for (int32_t k = 0; k < q->n_near; k++) {
+        const gr_cq_near e = q->near[k];
+        if (e.id < 0 || e.id >= n) return "the queue's near heap holds an id out of range";
+        if (seen[e.id]) return "a queue id is twice in the near heap";
+        seen[e.id] = 1;
+        const gr_cq_item *it = &q->item[e.id];
+        if (it->where != k || memcmp(&it->t, &e.t, sizeof e.t) != 0)
+            return "the queue's near heap disagrees with its items";
+        if (!(e.t == e.t) || e.t == INFINITY || bucket_of(q, e.t) > q->cur)
+            return "the queue's near heap holds a key that belongs elsewhere";
+        if (k > 0 && e.t < q->near[(k - 1) >> 1].t) return "the queue's near heap is not ordered";
+    }
+    int64_t listed = 0, over = 0;
+    for (int32_t slot = 0; slot < q->nb; slot++) {
+        const char *fault = check_list(q, q->head[slot], GR_CQ_LIST, q->cur + 1, q->over_from,
+                                       slot, seen, &listed);
+        if (fault) return fault;
+    }
+    if (listed != q->n_list) return "the queue's bucket lists do not hold n_list ids";
+    const char *fault = check_list(q, q->over, GR_CQ_OVER, q->over_from, INT64_MAX, -1, seen, &over);
+    if (fault) return fault;
+    if (over != q->n_over) return "the queue's overflow list does not hold n_over ids";
+    for (int32_t id = 0; id < n; id++) {
+        if (seen[id]) continue;
+        const gr_cq_item *it = &q->item[id];
+        if (it->where != GR_CQ_NONE) return "a queue id is marked as placed but is in no list";
+        if (it->t != INFINITY && !(it->t != it->t && id == q->nan_id))
+            return "a queue id with an event time is in no list";
+    }
+    if (q->nan_id >= 0 && (seen[q->nan_id] || q->item[q->nan_id].t == q->item[q->nan_id].t))
+        return "the queue's NaN id has no NaN key";
+    return NULL;
+}

@@ -93,4 +93,12 @@ static inline int32_t gr_cq_hint(const gr_cq *q)
  * every key along. */
 void gr_cq_renumber(gr_cq *q, const int32_t *newpos);
 
+/* Whether q keeps the invariants above, for a queue read from outside (a checkpoint)
+ * whose arrays are allocated (n ids, nb slots, near heap room for n) but whose contents
+ * are not to be trusted: every id and link in range, each list free of cycles, its back
+ * links right and its ids in the right buckets, the near heap ordered, every id with a
+ * finite key in exactly one place.  O(n + nb).  `seen`: n bytes of zeroed scratch.
+ * Returns NULL if so, else a static string naming the first fault. */
+const char *gr_cq_check(const gr_cq *q, uint8_t *seen);
+
 #endif

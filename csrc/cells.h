@@ -86,7 +86,7 @@ static inline void cell_coords(const gr_cells *g, int dim, const double *x, int3
 {
     for (int a = 0; a < dim; a++) {
         double f = floor((x[a] - g->lo[a]) / g->w[a]);
-        c[a] = f < 0.0 ? 0 : f >= g->nc[a] ? g->nc[a] - 1 : (int32_t)f;
+        c[a] = !(f >= 0.0) ? 0 : f >= g->nc[a] ? g->nc[a] - 1 : (int32_t)f; /* NaN: 0 */
     }
 }
 

@@ -11,6 +11,7 @@ that checks them against theory.
 from . import analysis, clustering, errors, langevin, restitution, theory
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
+    CheckpointError,
     ClusteringWarning,
     FrozenGasError,
     GranularError,
@@ -63,6 +64,7 @@ def __dir__():
 
 
 __all__ = [
+    "CheckpointError",
     "ClusteringWarning",
     "ConstantRestitution",
     "EnsembleResult",

@@ -522,19 +522,50 @@ class _PointReducer:
         )
 
 
-def _reduce_in_order(results, reducers, runs, bar):
+def _reduce_in_order(results, reducers, runs, bar, stored=None):
     """Feed each (index, status, payload) to its point's reducer in index order, whatever
     order the runs finish in, so that means are bit-identical across backends.  Results
-    that arrive early wait in ``pending``, which the windowed submission keeps small."""
+    that arrive early wait in ``pending``, which the windowed submission keeps small.
+    ``stored``: index -> (status, payload) of the runs a save_to directory already holds,
+    read from disk only when their turn comes."""
     pending = {}
     next_index = 0
+
+    def feed():
+        nonlocal next_index
+        while next_index in pending or (stored is not None and next_index in stored):
+            item = pending.pop(next_index) if next_index in pending else stored[next_index]
+            point, run = divmod(next_index, runs)
+            reducers[point].add(run, *item)
+            next_index += 1
+
+    feed()
     for index, status, payload in results:
         pending[index] = (status, payload)
-        while next_index in pending:
-            point, run = divmod(next_index, runs)
-            reducers[point].add(run, *pending.pop(next_index))
-            next_index += 1
+        feed()
         bar.update(1)
+
+
+class _Stored:
+    """The runs a RunStore holds, by call index, loaded when asked for."""
+
+    def __init__(self, store, indices, runs, seeds):
+        self.store, self.indices, self.runs, self.seeds = store, indices, runs, seeds
+
+    def __contains__(self, index):
+        return index in self.indices
+
+    def __getitem__(self, index):
+        point, run = divmod(index, self.runs)
+        return self.store.load(point, run, self.seeds[point][run])
+
+
+def _saving(results, store, runs, seeds):
+    """Write each run to the store as it finishes, then pass it on."""
+    for index, status, payload in results:
+        point, run = divmod(index, runs)
+        store.write(point, run, seeds[point][run], status, payload)
+        yield index, status, payload
 
 
 def ensemble(
@@ -547,6 +578,7 @@ def ensemble(
     progress: bool | None = None,
     keep_runs: bool = True,
     quantities: Sequence[str] = ("msd", "temperature"),
+    save_to: str | os.PathLike | None = None,
     **run_kwargs: Any,
 ) -> EnsembleResult | list[EnsembleResult]:
     """Run ``runs`` independent realizations of a model, or of every model of a sweep, and
@@ -590,6 +622,16 @@ def ensemble(
         ahead of the earliest unfinished run, so results waiting to be reduced in run
         order stay few.
     quantities : for EDMD, which of ``EDMD_QUANTITIES`` to collect.
+    save_to : str or path, optional
+        A directory where each run's result is written as it finishes, and from which a
+        later call with the same arguments resumes: runs already there are read back,
+        not repeated (``runs`` may grow between calls: ``runs=k`` then ``runs=n``
+        computes the n - k new ones), and the result is bit for bit the one an
+        uninterrupted call gives.  Needs a ``seed`` and a model that pickles (a Scene, a
+        module-level function or a partial of one: it is recognised by its pickle, not
+        by its code).  Files are written atomically; failed runs are stored too (delete
+        a run's file to redo it).  A directory made by another model, other run options,
+        quantities, seed or granular version is refused (``CheckpointError``).
 
     Returns
     -------
@@ -623,15 +665,33 @@ def ensemble(
                 f'ensemble(backend="processes") is called from {where[0]}, line {where[1]}, '
                 'outside an `if __name__ == "__main__":` block. ' + _GUARD_ADVICE
             )
-    seeds = _seeds(seed, runs, len(models) if sweep else None)
+    if save_to is not None and seed is None:
+        raise ValueError(
+            "save_to needs a seed (an int or a SeedSequence): runs are resumed by their seeds"
+        )
+    root = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    store = None
+    if save_to is not None:
+        from .ensemble_store import RunStore, fingerprint
+
+        store = RunStore(save_to, fingerprint(models, sweep, root, run_kwargs, quantities))
+    seeds = _seeds(root, runs, len(models) if sweep else None)
     tasks = [_Task(m, run_kwargs, tuple(quantities)) for m in models]
     # call index p * runs + r: run r of point p, the order in which runs are reduced
     calls = [
         (task, p * runs + r, s) for p, task in enumerate(tasks) for r, s in enumerate(seeds[p])
     ]
+    stored = None
+    if store is not None:
+        done = {i for _, i, _ in calls if store.has(*divmod(i, runs))}
+        stored = _Stored(store, done, runs, seeds)
+        calls = [call for call in calls if call[1] not in done]
     reducers = [_PointReducer(point_seeds, keep_runs) for point_seeds in seeds]
     pool_size = workers if workers is not None else os.cpu_count() or 1
     with _progress_bar(len(calls), progress) as bar:
-        _reduce_in_order(_results(calls, backend, pool_size), reducers, runs, bar)
+        results = _results(calls, backend, pool_size)
+        if store is not None:
+            results = _saving(results, store, runs, seeds)
+        _reduce_in_order(results, reducers, runs, bar, stored)
     results = [r.result() for r in reducers]
     return results if sweep else results[0]

@@ -78,3 +78,9 @@ class ClusteringWarning(UserWarning):
     """A granular gas in a periodic box beyond the critical size of the shear instability
     (``granular.theory.critical_box_size``): its homogeneous cooling will end (vortices,
     then clusters) and Haff's law will fail.  Issued once per Simulation, by ``run``."""
+
+
+class CheckpointError(GranularError, ValueError):
+    """A checkpoint (``Simulation.load``, an ensemble's ``save_to`` directory) cannot be
+    used: not a checkpoint, truncated or corrupt, written by another version of granular,
+    or made for another model."""

@@ -359,3 +359,36 @@ def heats(restitution: float | RestitutionLaw) -> bool:
 def engine_law(restitution: float | RestitutionLaw) -> tuple | None:
     """The law as the engine takes it, or None for a number."""
     return restitution._engine() if isinstance(restitution, RestitutionLaw) else None
+
+
+# -- a JSON-able description (checkpoints store a scene's parameters as JSON) -------------------
+
+_LAWS = {"Viscoelastic": Viscoelastic, "TabulatedRestitution": TabulatedRestitution}
+
+
+def describe(restitution: float | RestitutionLaw) -> float | dict:
+    """A number as it is; a law as ``{"law": class name, its arguments}``, whose floats JSON
+    writes in their shortest round-tripping form (so ``from_description`` gives the law back
+    bit for bit)."""
+    if isinstance(restitution, Viscoelastic):
+        return {"law": "Viscoelastic", "damping": restitution.damping, "kappa": restitution.kappa}
+    if isinstance(restitution, TabulatedRestitution):
+        return {
+            "law": "TabulatedRestitution",
+            "speeds": restitution.speeds.tolist(),
+            "values": restitution.values.tolist(),
+        }
+    if isinstance(restitution, ConstantRestitution):  # (a Scene keeps it as its number)
+        return restitution.value
+    return restitution
+
+
+def from_description(description: float | dict) -> float | RestitutionLaw:
+    """The inverse of ``describe``; raises ValueError for a description it does not know."""
+    if not isinstance(description, dict):
+        return description
+    args = dict(description)
+    name = args.pop("law", None)
+    if name not in _LAWS:
+        raise ValueError(f"unknown restitution law {name!r}")
+    return _LAWS[name](**args)

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
 import threading
 from typing import Any
 
@@ -78,20 +80,87 @@ class Simulation:
             raise TypeError(f"Simulation needs a granular.Scene, got {type(scene).__name__}")
         self._initial = scene
         self._engine = _edmd.build(scene, cell_factor, big_ratio, shell)
+        self._knobs = dict(cell_factor=cell_factor, big_ratio=big_ratio, shell=shell)
         # held for a whole run: the engine's own busy flag covers one C call only, and two
         # interleaved runs would write each other's samples
         self._running = threading.Lock()
         self._clustering_checked = False  # ClusteringWarning: once per Simulation
 
-    def _no_copy(self, *args):
-        raise TypeError(
-            "a Simulation cannot be copied or pickled: its state lives in the C engine, "
-            "which would be shared, not copied.  For an independent simulation from the "
-            "current state use Simulation(sim.scene) (it starts its counters, stats and "
-            "time from zero)"
-        )
+    # -- checkpoints ----------------------------------------------------------------
+    def save(self, path: str | os.PathLike) -> None:
+        """Write the whole engine state to ``path`` (a NumPy ``.npz`` file), so that
+        ``Simulation.load(path)`` continues the run bit for bit as if it never stopped.
 
-    __copy__ = __deepcopy__ = __reduce_ex__ = __reduce__ = _no_copy
+        Everything that decides the future is saved, not just positions and velocities:
+        each particle's position at its own clock, image and collision counters, the
+        predicted events as they were computed, the event queue, cell and neighbour
+        lists, the renumbering, the time and the statistics so far, the scene the
+        Simulation was built from and the knobs (``cell_factor``, ``big_ratio``,
+        ``shell``).  The file is written to a temporary name and renamed, so a crash
+        never leaves a half-written checkpoint: about 270 (2D) to 370 (3D, neighbour
+        lists) bytes per particle.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Where to write (used as given: no suffix is added).
+
+        Raises
+        ------
+        RuntimeError
+            If another thread is running this Simulation.
+        CheckpointError
+            If the state cannot continue (non-finite or overflowing velocities, as a
+            ``NonFiniteError`` leaves them): nothing is written.
+        """
+        from . import checkpoint
+
+        with self._exclusive():
+            checkpoint.save(self, path)
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> Simulation:
+        """The Simulation saved by ``save``, ready to ``run`` on exactly as the saved one
+        would have (same events, same bits).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+
+        Returns
+        -------
+        Simulation
+
+        Raises
+        ------
+        CheckpointError
+            If the file is not a checkpoint, is truncated or corrupt, or was written by
+            another granular version or engine layout (a run continues bit for bit only
+            in the version that saved it).
+        """
+        from . import checkpoint
+
+        return checkpoint.load(path)
+
+    def __reduce__(self):
+        # pickling (and copy.copy / copy.deepcopy, Dask) goes through a checkpoint: the
+        # copy gets its own engine with the same state, never a shared one
+        from . import checkpoint
+
+        with self._exclusive():
+            return (checkpoint.loads, (checkpoint.dumps(self),))
+
+    @contextlib.contextmanager
+    def _exclusive(self):
+        """Hold the run lock, or raise RuntimeError if a run holds it."""
+        if not self._running.acquire(blocking=False):
+            raise RuntimeError(
+                "another thread is running this Simulation; save or copy it between runs"
+            )
+        try:
+            yield
+        finally:
+            self._running.release()
 
     # -- state ----------------------------------------------------------------------
     @property

@@ -31,6 +31,9 @@ COVERED_BY_NAMES = {
 }
 NOT_PUBLIC = {
     "placement": "Scene.random's placement and velocity draws, not called by users",
+    "checkpoint": "the file format behind Simulation.save / Simulation.load",
+    "ensemble_store": "the directory behind ensemble(..., save_to=)",
+    "_animate": "behind granular.plot.animate",
 }
 
 

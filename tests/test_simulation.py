@@ -587,12 +587,15 @@ def test_a_second_concurrent_run_raises_at_once():
     assert sim.run(2.0).times[-1] == 2.0
 
 
-def test_copying_or_pickling_a_simulation_is_refused():
-    """A copy would share the C engine; the message says how to get an independent one."""
+def test_copying_or_pickling_a_simulation_gives_an_independent_engine():
+    """Copies go through a checkpoint (granular/checkpoint.py): never a shared C engine.
+    Bit-for-bit continuation is tested in test_checkpoint.py."""
     sim = Simulation(Scene.random(50, 0.02, seed=1))
-    for copier in (copy.copy, copy.deepcopy, pickle.dumps):
-        with pytest.raises(TypeError, match=r"Simulation\(sim.scene\)"):
-            copier(sim)
+    for copier in (copy.copy, copy.deepcopy, lambda s: pickle.loads(pickle.dumps(s))):
+        other = copier(sim)
+        assert other._engine is not sim._engine
+        other.run(0.1)
+        assert other.time == 0.1 and sim.time == 0.0
 
 
 def test_plot_and_interop_are_attributes_imported_lazily():

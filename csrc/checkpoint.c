@@ -1,0 +1,471 @@
+/* checkpoint.c -- saving an engine's state to bytes and restoring it (checkpoint.h).
+ *
+ * One function, transfer(), lists everything a checkpoint holds in order, and is used in
+ * both directions, so what is written and what is read cannot drift apart.  Reading
+ * goes into freshly allocated arrays, which are checked (check_state) before they
+ * replace the engine's own: a bad buffer leaves the engine untouched. */
+#define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
+#define _POSIX_C_SOURCE 200112L /* posix_memalign */
+#include <math.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "checkpoint.h"
+#include "engine.h"
+#include "hugemem.h"
+
+static const char magic[8] = {'G', 'R', 'E', 'D', 'M', 'D', 'C', 'K'};
+#define GR_BYTE_ORDER_MARK 0x01020304u
+
+/* FNV-1a over the numbers that describe the layout. */
+static uint64_t mix(uint64_t h, uint64_t x)
+{
+    for (int k = 0; k < 8; k++) {
+        h ^= (x >> (8 * k)) & 0xff;
+        h *= 0x100000001b3ULL;
+    }
+    return h;
+}
+
+uint64_t gr_checkpoint_layout(void)
+{
+    const uint64_t parts[] = {
+        GR_CHECKPOINT_VERSION, sizeof(void *), sizeof(double), sizeof(gr_edmd),
+        sizeof(gr_edmd_config), sizeof(gr_cq), sizeof(gr_cells), sizeof(gr_nlist),
+        sizeof(gr_big), GR_BIG_MAX, GR_NL_BITS, GR_NL_CAP_MAX,
+        sizeof(gr_sched), offsetof(gr_sched, t_coll), offsetof(gr_sched, t_cross),
+        offsetof(gr_sched, t_last), offsetof(gr_sched, count), offsetof(gr_sched, pcount),
+        offsetof(gr_sched, partner), offsetof(gr_sched, last), offsetof(gr_sched, c),
+        offsetof(gr_sched, cross), offsetof(gr_sched, streak), offsetof(gr_sched, nn),
+        sizeof(gr_cq_item), offsetof(gr_cq_item, t), offsetof(gr_cq_item, next),
+        offsetof(gr_cq_item, prev), offsetof(gr_cq_item, where),
+    };
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++) h = mix(h, parts[k]);
+    return h;
+}
+
+/* ---- a cursor over the buffer: writing (out != NULL), reading (in != NULL), or only
+ * counting bytes (neither) ---- */
+
+typedef struct {
+    unsigned char *out;
+    const unsigned char *in;
+    size_t size, at;
+    int bad; /* a read past the end */
+} cursor;
+
+static void io(cursor *c, void *p, size_t bytes)
+{
+    if (c->in) {
+        if (c->bad || bytes > c->size - c->at) {
+            c->bad = 1;
+            return;
+        }
+        memcpy(p, c->in + c->at, bytes);
+    } else if (c->out) {
+        memcpy(c->out + c->at, p, bytes);
+    }
+    c->at += bytes;
+}
+
+#define IO(c, x) io((c), &(x), sizeof(x))
+
+/* The header: what the sizes of the arrays that follow depend on. */
+typedef struct {
+    char magic[8];
+    uint32_t version, byte_order;
+    uint64_t layout;
+    uint64_t total;      /* bytes of the whole checkpoint */
+    int64_t n;
+    int32_t dim, stride, lists, nb, ncells, nc[3], cap, big_n;
+} header;
+
+static header header_of(const gr_edmd *s, size_t total)
+{
+    header h;
+    memset(&h, 0, sizeof h);
+    memcpy(h.magic, magic, sizeof magic);
+    h.version = GR_CHECKPOINT_VERSION;
+    h.byte_order = GR_BYTE_ORDER_MARK;
+    h.layout = gr_checkpoint_layout();
+    h.total = total;
+    h.n = s->n;
+    h.dim = s->dim;
+    h.stride = s->stride;
+    h.lists = s->nl.shell > 0.0;
+    h.nb = s->queue.nb;
+    h.ncells = s->cells.ncells;
+    for (int a = 0; a < 3; a++) h.nc[a] = s->cells.nc[a];
+    h.cap = s->nl.cap;
+    h.big_n = s->big.n;
+    return h;
+}
+
+static void io_header(cursor *c, header *h)
+{
+    io(c, h->magic, sizeof h->magic);
+    IO(c, h->version);
+    IO(c, h->byte_order);
+    IO(c, h->layout);
+    IO(c, h->total);
+    IO(c, h->n);
+    IO(c, h->dim);
+    IO(c, h->stride);
+    IO(c, h->lists);
+    IO(c, h->nb);
+    IO(c, h->ncells);
+    io(c, h->nc, sizeof h->nc);
+    IO(c, h->cap);
+    IO(c, h->big_n);
+}
+
+/* Everything after the header, in order.  The arrays of s must be allocated for the
+ * header's sizes.  Counts read on the way (the near heap's size, list lengths) are
+ * checked before they size a transfer; the rest of the checking is check_state's. */
+static void transfer(cursor *c, gr_edmd *s)
+{
+    const int32_t n = s->n;
+    const int d = s->dim;
+    gr_edmd_config *cfg = &s->cfg;
+    IO(c, cfg->dim);
+    IO(c, cfg->n);
+    io(c, cfg->lo, sizeof cfg->lo);
+    io(c, cfg->hi, sizeof cfg->hi);
+    IO(c, cfg->periodic);
+    IO(c, cfg->wall_restitution);
+    IO(c, cfg->restitution);
+    IO(c, cfg->contact_duration);
+    IO(c, cfg->cell_factor);
+    IO(c, cfg->big_ratio);
+    IO(c, cfg->shell);
+
+    IO(c, s->t);
+    IO(c, s->eps_t);
+    IO(c, s->t_prev_event);
+    IO(c, s->same_instant);
+    IO(c, s->events);
+    IO(c, s->pair);
+    IO(c, s->wall);
+    IO(c, s->invalid);
+    IO(c, s->elastic_tc);
+    IO(c, s->law_clamped);
+    IO(c, s->crossings);
+    IO(c, s->shell_exits);
+    IO(c, s->virial);
+    IO(c, s->wall_impulse);
+    IO(c, s->kinetic);
+    IO(c, s->kinetic_time);
+    IO(c, s->order.next);
+    IO(c, s->nl.broken);
+
+    io(c, s->P, (size_t)n * s->stride * sizeof *s->P);
+    io(c, s->mass, (size_t)n * sizeof *s->mass);
+    io(c, s->image, (size_t)n * d * sizeof *s->image);
+    io(c, s->sched, (size_t)n * sizeof *s->sched);
+    io(c, s->order.id_of, (size_t)n * sizeof *s->order.id_of);
+    io(c, s->big.is_big, (size_t)n * sizeof *s->big.is_big);
+    io(c, s->big.idx, (size_t)s->big.n * sizeof *s->big.idx);
+
+    gr_cq *q = &s->queue;
+    IO(c, q->t0);
+    IO(c, q->inv_w);
+    IO(c, q->cur);
+    IO(c, q->over_from);
+    IO(c, q->over);
+    IO(c, q->n_list);
+    IO(c, q->n_over);
+    IO(c, q->n_near);
+    IO(c, q->nan_id);
+    IO(c, q->changes);
+    IO(c, q->rebuild_at);
+    for (int32_t id = 0; id < n; id++) { /* field by field: no padding bytes in the file */
+        IO(c, q->item[id].t);
+        IO(c, q->item[id].next);
+        IO(c, q->item[id].prev);
+        IO(c, q->item[id].where);
+    }
+    io(c, q->head, (size_t)q->nb * sizeof *q->head);
+    if (q->n_near < 0 || q->n_near > n) { /* read: not to size the loop below */
+        c->bad = 1;
+        return;
+    }
+    for (int32_t k = 0; k < q->n_near; k++) {
+        IO(c, q->near[k].t);
+        IO(c, q->near[k].id);
+    }
+
+    io(c, s->cells.head, (size_t)s->cells.ncells * sizeof *s->cells.head);
+    io(c, s->cells.next, (size_t)n * sizeof *s->cells.next);
+    io(c, s->cells.prev, (size_t)n * sizeof *s->cells.prev);
+
+    if (s->nl.shell > 0.0) {
+        io(c, s->nl.centre, (size_t)n * (d + 1) * sizeof *s->nl.centre);
+        for (int32_t i = 0; i < n; i++) { /* only the entries in use */
+            const int16_t nn = s->sched[i].nn;
+            if (nn < 0 || nn > s->nl.cap) {
+                c->bad = 1;
+                return;
+            }
+            io(c, nl_row(&s->nl, i), (size_t)nn * sizeof(int32_t));
+        }
+    }
+}
+
+size_t gr_edmd_save_size(const gr_edmd *s)
+{
+    cursor c = {NULL, NULL, 0, 0, 0};
+    header h = header_of(s, 0);
+    io_header(&c, &h);
+    transfer(&c, (gr_edmd *)s); /* counting only: s is not written */
+    return c.at;
+}
+
+int gr_edmd_save(const gr_edmd *s, unsigned char *buf, size_t size)
+{
+    const size_t total = gr_edmd_save_size(s);
+    if (size < total) return GR_ERR_VALUE;
+    cursor c = {buf, NULL, size, 0, 0};
+    header h = header_of(s, total);
+    io_header(&c, &h);
+    transfer(&c, (gr_edmd *)s); /* writing: s is only read */
+    return GR_OK;
+}
+
+/* ---- restoring ---- */
+
+/* The arrays a restore replaces (the rest of the engine stays). */
+static void free_state(gr_edmd *t)
+{
+    free(t->P);
+    free(t->mass);
+    free(t->image);
+    free(t->sched);
+    free(t->order.id_of);
+    free(t->big.is_big);
+    free(t->queue.item);
+    free(t->queue.head);
+    free(t->queue.near);
+    free(t->cells.head);
+    free(t->cells.next);
+    free(t->cells.prev);
+    free(t->cells.occ);
+    free(t->nl.centre);
+    free(t->nl.rows);
+}
+
+/* t: a copy of s whose replaceable arrays are fresh, sized as s's (neighbour rows with
+ * `cap` entries each).  GR_OK or GR_ERR_NOMEM (nothing left allocated). */
+static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
+{
+    const size_t n = (size_t)s->n;
+    const int d = s->dim;
+    *t = *s;
+    t->P = gr_big_alloc((n * s->stride * sizeof(double) + 63) / 64 * 64);
+    t->mass = gr_big_alloc(n * sizeof(double));
+    t->image = calloc(n * d, sizeof(int64_t));
+    t->sched = gr_big_alloc(n * sizeof(gr_sched));
+    t->order.id_of = malloc(n * sizeof(int32_t));
+    t->big.is_big = calloc(n, 1);
+    t->queue.item = gr_big_alloc(n * sizeof(gr_cq_item));
+    t->queue.head = gr_big_alloc((size_t)s->queue.nb * sizeof(int32_t));
+    t->queue.near = malloc(n * sizeof(gr_cq_near));
+    t->cells.head = gr_big_alloc((size_t)s->cells.ncells * sizeof(int32_t));
+    t->cells.next = gr_big_alloc(n * sizeof(int32_t));
+    t->cells.prev = gr_big_alloc(n * sizeof(int32_t));
+    t->cells.occ = calloc(((size_t)s->cells.ncells + 63) / 64, sizeof(uint64_t));
+    const int lists = s->nl.shell > 0.0;
+    t->nl.centre = lists ? gr_big_alloc(n * (d + 1) * sizeof(double)) : NULL;
+    t->nl.rows = lists ? gr_big_alloc(n * (size_t)cap * sizeof(int32_t)) : NULL;
+    t->nl.cap = cap;
+    if (!t->P || !t->mass || !t->image || !t->sched || !t->order.id_of || !t->big.is_big ||
+        !t->queue.item || !t->queue.head || !t->queue.near || !t->cells.head ||
+        !t->cells.next || !t->cells.prev || !t->cells.occ ||
+        (lists && (!t->nl.centre || !t->nl.rows))) {
+        free_state(t);
+        return GR_ERR_NOMEM;
+    }
+    return GR_OK;
+}
+
+static int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* The queue key schedule() gives a particle with this scheduling state. */
+static double key_of(const gr_sched *e) { return e->t_coll < e->t_cross ? e->t_coll : e->t_cross; }
+
+/* Whether t, read from a checkpoint, is a state that s (built from the same scene) could
+ * have reached: NULL if so, else what is wrong.  seen: n bytes of zeroed scratch, left
+ * dirty; skel: n int32 of scratch. */
+static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen, int32_t *skel)
+{
+    const int32_t n = s->n;
+    const int d = s->dim;
+    const gr_edmd_config *a = &t->cfg, *b = &s->cfg;
+    if (a->dim != b->dim || a->n != b->n || a->periodic != b->periodic ||
+        memcmp(a->lo, b->lo, sizeof a->lo) != 0 || memcmp(a->hi, b->hi, sizeof a->hi) != 0 ||
+        !same_double(a->wall_restitution, b->wall_restitution) ||
+        !same_double(a->restitution, b->restitution) ||
+        !same_double(a->contact_duration, b->contact_duration) ||
+        !same_double(a->cell_factor, b->cell_factor) || !same_double(a->big_ratio, b->big_ratio) ||
+        !same_double(a->shell, b->shell))
+        return "its box, restitution, contact duration or engine knobs differ from the scene's";
+    if (t->nl.broken != 0 && t->nl.broken != 1) return "its neighbour-list flag is corrupt";
+
+    /* the renumbering is a permutation; through it each particle has the radius, mass
+     * and bigness the scene gives it (skel: the scene's index -> s's internal index) */
+    for (int32_t i = 0; i < n; i++) {
+        const int32_t u = t->order.id_of[i];
+        if (u < 0 || u >= n || seen[u]) return "its particle numbering is not a permutation";
+        seen[u] = 1;
+    }
+    for (int32_t k = 0; k < n; k++) skel[s->order.id_of[k]] = k;
+    int32_t big = 0;
+    for (int32_t i = 0; i < n; i++) {
+        const int32_t k = skel[t->order.id_of[i]];
+        if (!same_double(RAD(rec(t, i), d), RAD(rec(s, k), d)) ||
+            !same_double(t->mass[i], s->mass[k]) || t->big.is_big[i] != s->big.is_big[k])
+            return "a particle's radius, mass or bigness differs from the scene's";
+        big += t->big.is_big[i];
+    }
+    if (big != t->big.n) return "its big particles are inconsistent";
+    for (int32_t k = 0; k < t->big.n; k++) {
+        const int32_t i = t->big.idx[k];
+        if (i < 0 || i >= n || !t->big.is_big[i]) return "its big particles are inconsistent";
+        for (int32_t m = 0; m < k; m++)
+            if (t->big.idx[m] == i) return "its big particles are inconsistent";
+    }
+
+    /* numbers: the time and every particle clock finite (0 <= t_i <= t: a clock only
+     * moves to an event's time), positions within a box length of the box (list mode
+     * lets them stray a shell's width beyond a periodic box), list centres too, speeds
+     * finite and within the scene's limit of 1e140 (granular/scene.py), counters of
+     * energy finite.  Out-of-range numbers would make NaNs that the engine's cell
+     * arithmetic is not built for. */
+    if (!(t->t >= 0.0 && t->t < INFINITY) || !isfinite(t->eps_t) || !isfinite(t->kinetic) ||
+        !isfinite(t->kinetic_time) || !isfinite(t->virial) || !isfinite(t->wall_impulse) ||
+        t->t_prev_event != t->t_prev_event)
+        return "its time or energy counters are not finite";
+    for (int32_t i = 0; i < n; i++) {
+        const double *p = rec(t, i);
+        if (!(TIME(p, d) >= 0.0 && TIME(p, d) <= t->t)) return "a particle's clock is out of range";
+        for (int k = 0; k < d; k++) {
+            const double L = s->L[k];
+            if (!(p[k] >= b->lo[k] - L && p[k] <= b->hi[k] + L) || !(fabs(VEL(p, d)[k]) <= 1e140))
+                return "a particle's position or velocity is out of range";
+            if (s->nl.shell > 0.0) {
+                const double x = t->nl.centre[(size_t)i * (d + 1) + k];
+                if (!(x >= b->lo[k] - L && x <= b->hi[k] + L))
+                    return "a neighbour list's centre is out of range";
+            }
+        }
+        if (s->nl.shell > 0.0 && !same_double(t->nl.centre[(size_t)i * (d + 1) + d], RAD(p, d)))
+            return "a neighbour list's centre is corrupt";
+    }
+
+    /* scheduling states: every index an event follows is in range; a particle with no
+     * partner has no collision and one with no crossing has no crossing time, so the
+     * loop never takes them for a wall or a crossing of axis -1 */
+    const int lists = s->nl.shell > 0.0;
+    const int32_t codes = d == 3 ? 27 : 9;
+    for (int32_t i = 0; i < n; i++) {
+        const gr_sched *e = &t->sched[i];
+        if (e->partner < -1 - 2 * d || e->partner >= n || e->last < -1 - 2 * d || e->last >= n)
+            return "a particle's partner index is out of range";
+        /* predictions are made from the particle's clock on (NaN is reported by the loop) */
+        const double clock = TIME(rec(t, i), d);
+        if (e->t_coll < clock || e->t_cross < clock) return "a particle's next event lies in its past";
+        if (e->partner == -1 && e->t_coll != INFINITY)
+            return "a particle has a collision time but no partner";
+        /* (lists: t_cross is the shell exit, and cross is not used) */
+        if (e->cross < -1 || e->cross >= 2 * d || (!lists && e->cross == -1 && e->t_cross < INFINITY))
+            return "a particle's cell crossing is out of range";
+        for (int k = 0; k < d; k++)
+            if (e->c[k] < 0 || e->c[k] >= s->cells.nc[k]) return "a particle's cell is out of range";
+        if (e->nn < 0 || e->nn > (lists ? t->nl.cap : 0))
+            return "a neighbour list's length is out of range";
+        if (lists)
+            for (int k = 0; k < e->nn; k++) {
+                const int32_t entry = nl_row(&t->nl, i)[k];
+                if (entry < 0 || (entry >> GR_NL_BITS) >= n || (entry & GR_NL_CODE_MASK) >= codes)
+                    return "a neighbour list entry is out of range";
+            }
+        const double key = key_of(e), queued = t->queue.item[i].t;
+        if (!same_double(key, queued) && !(key != key && queued != queued))
+            return "a particle's queue key is not its next event";
+    }
+
+    /* the queue (its own invariants), then the cell lists: each particle that is not
+     * big in exactly the list of its cell, back links right */
+    memset(seen, 0, (size_t)n);
+    const char *fault = gr_cq_check(&t->queue, seen);
+    if (fault) return fault;
+    memset(seen, 0, (size_t)n);
+    const gr_cells *g = &t->cells;
+    int32_t filed = 0;
+    for (int32_t cell = 0; cell < g->ncells; cell++) {
+        int32_t prev = -1;
+        for (int32_t i = g->head[cell]; i != -1; i = g->next[i]) {
+            if (i < 0 || i >= n || seen[i] || t->big.is_big[i] || g->prev[i] != prev ||
+                cell_of(g, d, t->sched[i].c) != cell)
+                return "the cell lists are corrupt";
+            seen[i] = 1;
+            filed++;
+            prev = i;
+        }
+    }
+    if (filed != n - t->big.n) return "the cell lists do not hold every particle";
+    return NULL;
+}
+
+int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error *err)
+{
+    cursor c = {NULL, buf, size, 0, 0};
+    header h, want = header_of(s, size);
+    io_header(&c, &h);
+    const char *what = NULL;
+    if (c.bad || memcmp(h.magic, magic, sizeof magic) != 0) what = "not an engine checkpoint";
+    else if (h.byte_order != GR_BYTE_ORDER_MARK) what = "written on a machine of the other byte order";
+    else if (h.version != GR_CHECKPOINT_VERSION || h.layout != want.layout)
+        what = "written by a build with another state layout";
+    else if (h.total != size) what = "truncated, or with bytes appended";
+    else if (h.n != want.n || h.dim != want.dim || h.stride != want.stride || h.lists != want.lists ||
+             h.nb != want.nb || h.ncells != want.ncells || memcmp(h.nc, want.nc, sizeof h.nc) != 0 ||
+             h.big_n != want.big_n)
+        what = "made for another scene or other engine knobs (sizes differ)";
+    else if (h.lists && !(h.cap >= want.cap && h.cap <= GR_NL_CAP_MAX))
+        what = "its neighbour-list capacity is out of range";
+    else if (!h.lists && h.cap != want.cap)
+        what = "its neighbour-list capacity is out of range";
+    if (what) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, what);
+        return GR_ERR_VALUE;
+    }
+
+    gr_edmd t;
+    int status = alloc_state(&t, s, h.cap);
+    if (status != GR_OK) return status;
+    uint8_t *seen = calloc((size_t)s->n, 1);
+    int32_t *skel = malloc((size_t)s->n * sizeof *skel);
+    if (!seen || !skel) {
+        status = GR_ERR_NOMEM;
+    } else {
+        transfer(&c, &t);
+        if (c.bad || c.at != size) what = "truncated or corrupt";
+        else what = check_state(&t, s, seen, skel);
+        if (what) status = GR_ERR_VALUE;
+    }
+    free(seen);
+    free(skel);
+    if (status != GR_OK) {
+        free_state(&t);
+        if (status == GR_ERR_VALUE) gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, what);
+        return status;
+    }
+    /* the occupancy bits follow from the lists */
+    for (int32_t cell = 0; cell < t.cells.ncells; cell++)
+        if (t.cells.head[cell] >= 0) t.cells.occ[cell >> 6] |= (uint64_t)1 << (cell & 63);
+    free_state(s);
+    *s = t;
+    return GR_OK;
+}
