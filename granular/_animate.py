@@ -207,6 +207,7 @@ def animate(
     slab: tuple[float, float] | None = None,
     interval: float = 50.0,
     blit: bool | None = None,
+    title: str | None = None,
     ax: Axes | None = None,
 ) -> Any:
     """An animation of a trajectory: particles as disks at their true radii in the box.
@@ -220,7 +221,8 @@ def animate(
     stride : int
         Show every ``stride``-th of them: for long trajectories.
     trails : int or sequence of int, optional
-        Particles whose paths are drawn (and whose disks get ``trail_color``).  A trail
+        Particles whose paths are drawn (and whose disks get ``trail_color``, half
+        transparent so that the path shows across them).  A trail
         uses every sample up to the frame, not only the frames shown.
     trail_length : int, optional
         How many samples back a trail reaches (default: to the first sample).
@@ -238,6 +240,8 @@ def animate(
         Milliseconds between frames when shown (and the frame rate a saved file gets).
     blit : bool, optional
         Redraw only what changes, where the canvas supports it (default: when it does).
+    title : str, optional
+        Above the box (in 3D by default what is drawn: the projection or the slice).
     ax : matplotlib Axes, optional
         Draw into these (e.g. from ``plt.subplots()`` for a live window); by default a new
         Figure outside pyplot, so a notebook shows the animation once, not also a still.
@@ -297,8 +301,10 @@ def animate(
         from matplotlib import colormaps
 
         cmap = colormaps["viridis"]
+    # a trail particle's disk is see-through, so that its own path shows across it
+    trail_rgba = mcolors.to_rgba(trail_color, alpha=0.55)
     base = np.tile(mcolors.to_rgba(color), (n, 1))
-    base[is_trail] = mcolors.to_rgba(trail_color)
+    base[is_trail] = trail_rgba
 
     def collection():
         c = EllipseCollection(
@@ -313,7 +319,7 @@ def animate(
     # length towards the far side along each drawn axis, and along both); the axes span
     # exactly the box, so only the parts that reach into it are seen
     images = [collection() for _ in range(3)] if periodic else []
-    lines = [ax.plot([], [], "-", lw=1.2, color=trail_color)[0] for _ in trail_ids]
+    lines = [ax.plot([], [], "-", lw=1.2, color=trail_color, zorder=3)[0] for _ in trail_ids]
     ax.add_patch(
         Rectangle((lo[ax0], lo[ax1]), length[ax0], length[ax1], fill=False, lw=1.5, clip_on=False)
     )
@@ -324,7 +330,9 @@ def animate(
     ax.set_ylabel(plot.POSITION.format("xyz"[ax1]))
     if depth is not None:
         what = "projection" if slab is None else f"slice |{'xyz'[depth]} − {z0:g}| < {w:g}"
-        ax.set_title(f"{what} onto the {'xyz'[ax0]}{'xyz'[ax1]} plane", fontsize="medium")
+        title = title or f"{what} onto the {'xyz'[ax0]}{'xyz'[ax1]} plane"
+    if title:
+        ax.set_title(title, fontsize="medium")
     clock = ax.text(
         0.02,
         0.98,
@@ -347,7 +355,7 @@ def animate(
         xy = np.ascontiguousarray(x[:, [ax0, ax1]])
         rgba = cmap(norm(speeds[s])) if speeds is not None else base.copy()
         if speeds is not None:
-            rgba[is_trail] = mcolors.to_rgba(trail_color)
+            rgba[is_trail] = trail_rgba
         if slab is not None:
             dz = x[:, depth] - z0
             if periodic:
