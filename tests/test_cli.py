@@ -141,13 +141,13 @@ def test_demo_quick(tmp_path):
             r["msd_end_theory"],
             msd_margin_bound(r["xi"]),
         )
-    # the Brownian tracer: the GIF (one frame per 10 samples of t = 0 .. 60 at 4 per time
+    # the Brownian tracer: the GIF (one frame per 4 samples of t = 0 .. 60 at 4 per time
     # unit) and the MSD figure; its MSD at t = 1/gamma against the Langevin MSD with kinetic
     # theory's friction, within tracer_langevin_margin (tests/helpers/margins.py)
     from PIL import Image
 
     with Image.open(tmp_path / "demo" / "brownian.gif") as gif:
-        assert gif.n_frames == 25
+        assert gif.n_frames == 61
     assert (tmp_path / "demo" / "brownian_msd.png").stat().st_size > 10_000
     (b,) = strict_json(tmp_path / "demo" / "brownian.json")
     assert "Brownian tracer" in out.stdout and "correlated collisions" in out.stdout

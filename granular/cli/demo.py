@@ -174,12 +174,12 @@ def brownian(out, quick=False, runs=None, backend="processes"):
     t_gif, t_msd = 60.0, (12.0 if quick else 40.0)
     scene = Scene.seed_brownian_disks(seed=2020, tracer=True)
     c, density = tracer_theory(scene)
-    # the path from 4 samples per time unit; the GIF shows every 10th (quick) or 2nd
+    # the path from 4 samples per time unit; the GIF shows every 4th (quick) or every one
     traj = Simulation(scene).run(t_gif, sample_times=np.linspace(0.0, t_gif, int(4 * t_gif) + 1))
     anim = plot.animate(
         traj,
         trails=[0],
-        stride=10 if quick else 2,
+        stride=4 if quick else 1,
         interval=80,
         title="150 disks and a Brownian tracer (red)",
     )
@@ -190,7 +190,8 @@ def brownian(out, quick=False, runs=None, backend="processes"):
         functools.partial(tracer_run, times=times),
         runs,
         seed=3,
-        backend=backend,
+        # quick: the runs take milliseconds, less than starting worker processes would
+        backend="serial" if quick else backend,
         progress=False,
     )
     if res.failures:
