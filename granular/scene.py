@@ -435,8 +435,8 @@ class Scene:
         tracer_mass: float | None = None,
     ) -> Scene:
         """The 2D Brownian-motion note's scene: 150 elastic hard disks of radius 0.1 and
-        mass 1 between elastic walls at +-3, unit speed in random directions; optionally
-        with a Brownian tracer, one large heavy disk among them.
+        mass 1 between elastic walls at +-3, unit speed in random directions; or, with a
+        Brownian tracer, one large heavy disk among them.
 
         Parameters
         ----------
@@ -446,13 +446,13 @@ class Scene:
             the scene is the note's, bit for bit as before the tracer existed.
         tracer_radius : float, default 0.5
             Five times the small disks' radius: a disk that stands out in a picture and
-            whose Knudsen number (gas mean free path ~0.3 over its radius) is still near 1,
-            where the kinetic-theory friction holds (``theory.tracer_friction``).
+            whose Knudsen number (gas mean free path ~0.3 over its radius) is still near 1.
+            Kinetic theory's friction (``theory.tracer_friction``) holds for it at short
+            times; over longer ones it diffuses ~20% faster (docs/brownian_tracer.md).
         tracer_mass : float, default (tracer_radius / 0.1)^2
             The small disks' mass per area (25 at the default radius): as heavy as a disk
             of the same material.  Heavy against the gas, as Brownian motion needs
-            (m / M = 0.04): its velocity changes little per collision and relaxes at
-            the rate ``theory.tracer_friction``.
+            (m / M = 0.04): its velocity changes little per collision.
 
         Returns
         -------

@@ -46,7 +46,7 @@ def msd_margin_bound(xi):
 # effective friction of a tracer whose Knudsen number (gas mean free path ~0.3 over R = 0.5)
 # is near 1.  Measured for Scene.seed_brownian_disks(tracer=True) over 4000 runs
 # (docs/brownian_tracer.md): gamma_eff(t) = -ln(C(t) / C(0)) / t from the tracer's velocity
-# autocorrelation is 0.46 +- 0.02 at t ~ 0.3 and 0.36 +- 0.01 at t = 2 ~ 1/gamma, against
+# autocorrelation is 0.45-0.48 +- 0.02 at t ~ 0.3 and 0.36 +- 0.01 at t = 2 ~ 1/gamma, against
 # Enskog's 0.50: up to 30% lower by t = 1/gamma, hence 0.30; plus 0.05 for the gas density
 # and contact value theory uses (wall adsorption to first order, Santos et al.'s chi: the
 # density at contact measured within ~3% of theirs).  The MSD at t responds to a relative
