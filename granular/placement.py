@@ -30,7 +30,7 @@ def draw_velocities(rng, n, dim, masses, speed, temperature, remove_drift):
     return v
 
 
-def place_rsa(rng, radii, lo, hi, periodic, patience=100, max_rounds=5000):
+def place_rsa(rng, radii, lo, hi, periodic, patience=100, max_rounds=5000, fixed=None):
     """Random sequential addition in batches, with k-d trees for the neighbour search.
     Returns None if it does not finish (too dense): when ``patience`` rounds in a row
     place nobody, or after ``max_rounds`` rounds.  (A fixed number of rounds gave up on
@@ -38,7 +38,11 @@ def place_rsa(rng, radii, lo, hi, periodic, patience=100, max_rounds=5000):
 
     A few particles much larger than the rest (a tracer) would make every neighbour
     query as wide as they are; they are checked against everyone directly instead, and
-    the trees reach only as far as two of the others can touch."""
+    the trees reach only as far as two of the others can touch.
+
+    ``fixed = (positions (k, d), radii (k,))``: particles already in place (e.g. a tracer
+    put in the middle), which the new ones must not overlap; they are checked directly,
+    as big ones are, and are not among the rows returned."""
     from scipy.spatial import cKDTree
 
     n, dim = len(radii), len(lo)
@@ -49,6 +53,11 @@ def place_rsa(rng, radii, lo, hi, periodic, patience=100, max_rounds=5000):
     placed = np.empty((0, dim))
     placed_r = np.empty(0)
     placed_big = np.empty(0, dtype=bool)
+    if fixed is not None:
+        placed = np.array(fixed[0], dtype=np.float64).reshape(-1, dim)
+        placed_r = np.array(fixed[1], dtype=np.float64).reshape(-1)
+        placed_big = np.ones(len(placed_r), dtype=bool)
+    n_fixed = len(placed_r)
     box = L if periodic else None
     shift = lambda x: np.mod(x - lo, L) if periodic else x  # noqa: E731
     todo = order
@@ -94,6 +103,7 @@ def place_rsa(rng, radii, lo, hi, periodic, patience=100, max_rounds=5000):
     # particles of that radius, in `order` (stable sorts on -radius on both sides).  Which
     # of the equal particles gets which row does not matter (velocities are drawn apart);
     # for equal radii this is the order in which they were placed.
+    placed, placed_r = placed[n_fixed:], placed_r[n_fixed:]
     out[order] = placed[np.argsort(-placed_r, kind="stable")]
     return out
 

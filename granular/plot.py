@@ -22,6 +22,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._animate import animate  # noqa: F401 (public here; animations have their own module)
+
 if TYPE_CHECKING:  # matplotlib is an extra, imported only when a figure is drawn
     from matplotlib.axes import Axes
 

@@ -456,18 +456,95 @@ class Scene:
         return cls(engine.state()[0], velocities, radii, masses, **common)
 
     @classmethod
-    def seed_brownian_disks(cls, seed: Any = None) -> Scene:
+    def seed_brownian_disks(
+        cls,
+        seed: Any = None,
+        *,
+        tracer: bool | None = None,
+        tracer_radius: float | None = None,
+        tracer_mass: float | None = None,
+    ) -> Scene:
         """The 2D Brownian-motion note's scene: 150 elastic hard disks of radius 0.1 and
-        mass 1 between elastic walls at +-3, unit speed in random directions."""
-        return cls.random(
-            150,
-            0.1,
-            dim=2,
-            box=(-3.0, 3.0),
+        mass 1 between elastic walls at +-3, unit speed in random directions; or, with a
+        Brownian tracer, one large heavy disk among them.
+
+        Parameters
+        ----------
+        seed : anything ``numpy.random.SeedSequence`` takes
+        tracer : bool, optional
+            Add the tracer (implied by ``tracer_radius`` or ``tracer_mass``).  Without it
+            the scene is the note's, bit for bit as before the tracer existed.
+        tracer_radius : float, default 0.5
+            Five times the small disks' radius: a disk that stands out in a picture and
+            whose Knudsen number (gas mean free path ~0.3 over its radius) is still near 1.
+            Kinetic theory's friction (``theory.tracer_friction``) holds for it at short
+            times; over longer ones it diffuses ~20% faster (docs/brownian_tracer.md).
+        tracer_mass : float, default (tracer_radius / 0.1)^2
+            The small disks' mass per area (25 at the default radius): as heavy as a disk
+            of the same material.  Heavy against the gas, as Brownian motion needs
+            (m / M = 0.04): its velocity changes little per collision.
+
+        Returns
+        -------
+        Scene
+            Without a tracer, ``Scene.random`` of the note's parameters.  With one, the
+            tracer is particle 0, in the middle of the box (where the walls are
+            farthest); the 150 small disks are placed around it without overlap (random
+            sequential addition); all velocities are Maxwell-Boltzmann at the note's
+            temperature T = 0.5 (its unit speed is m v^2 / 2 = 0.5), so that the gas is
+            in equilibrium from the start and the tracer has its share of the energy.
+
+        Raises
+        ------
+        ValueError
+            A tracer radius or mass that is not positive and finite, ``tracer=False`` with
+            tracer arguments, or a tracer too large to leave room for the gas.
+        """
+        wants = tracer_radius is not None or tracer_mass is not None
+        if tracer is False and wants:
+            raise ValueError("tracer=False contradicts tracer_radius / tracer_mass")
+        if not (tracer or wants):
+            return cls.random(
+                150,
+                0.1,
+                dim=2,
+                box=(-3.0, 3.0),
+                boundary="walls",
+                speed=1.0,
+                remove_drift=False,
+                seed=seed,
+            )
+        r, m, lo, hi = 0.1, 1.0, np.full(2, -3.0), np.full(2, 3.0)
+        big_r = 5.0 * r if tracer_radius is None else float(tracer_radius)
+        if not (big_r > 0 and math.isfinite(big_r)):
+            raise ValueError(f"tracer_radius must be positive and finite, got {tracer_radius}")
+        if big_r >= 3.0:
+            raise ValueError(f"tracer_radius = {big_r:g} does not fit between the walls at +-3")
+        big_m = m * (big_r / r) ** 2 if tracer_mass is None else float(tracer_mass)
+        if not (big_m > 0 and math.isfinite(big_m)):
+            raise ValueError(f"tracer_mass must be positive and finite, got {tracer_mass}")
+        ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+        rng_pos, rng_vel, rng_tracer = (np.random.default_rng(s) for s in ss.spawn(3))
+        radii = np.full(150, r)
+        gas = place_rsa(rng_pos, radii, lo, hi, False, fixed=(np.zeros((1, 2)), [big_r]))
+        if gas is None:
+            raise ValueError(
+                f"150 disks of radius {r:g} found no room around a tracer of radius {big_r:g}"
+            )
+        # Maxwell-Boltzmann at the note's temperature (speed 1 for all is T = m / 2): the
+        # tracer meets an equilibrium gas from t = 0, as the Langevin prediction assumes
+        # (unit speeds would make its friction 13% larger until the gas relaxes: the
+        # friction goes with the gas' mean speed, 1 against sqrt(pi T / 2m) = 0.886)
+        temperature = 0.5 * m
+        v_gas = draw_velocities(rng_vel, 150, 2, np.full(150, m), None, temperature, False)
+        v_big = rng_tracer.normal(size=(1, 2)) * math.sqrt(temperature / big_m)
+        return cls(
+            np.vstack([np.zeros((1, 2)), gas]),
+            np.vstack([v_big, v_gas]),
+            np.concatenate([[big_r], radii]),
+            np.concatenate([[big_m], np.full(150, m)]),
+            box=(lo, hi),
             boundary="walls",
-            speed=1.0,
-            remove_drift=False,
-            seed=seed,
         )
 
     @classmethod

@@ -16,7 +16,7 @@ import sys
 import pytest
 from scipy import stats
 
-from helpers.margins import haff_margin, msd_margin_bound
+from helpers.margins import haff_margin, msd_margin_bound, tracer_langevin_margin
 
 FALSE_ALARM = 1e-4  # per check, two-sided
 
@@ -118,7 +118,7 @@ def test_demo_quick(tmp_path):
     T ~ (1 + t/tau0)^-2; the MSD within msd_margin_bound(xi)."""
     out = run("demo", "--quick", "--out", str(tmp_path / "demo"), cwd=tmp_path)
     assert "granular demo" in out.stdout
-    for name in ("demo.png", "msd.png", "temperature.png", "speeds.png"):
+    for name in ("demo.png", "msd.png", "temperature.png", "speeds.png", "brownian.gif"):
         assert (tmp_path / "demo" / name).stat().st_size > 10_000
     rows = {r["gas"]: r for r in strict_json(tmp_path / "demo" / "summary.json")}
     mol, gran = rows["molecular"], rows["granular"]
@@ -152,6 +152,24 @@ def test_demo_quick(tmp_path):
             r["msd_end_theory"],
             msd_margin_bound(r["xi"]),
         )
+    # the Brownian tracer: the GIF (one frame per 4 samples of t = 0 .. 60 at 4 per time
+    # unit) and the MSD figure; its MSD at t = 1/gamma against the Langevin MSD with kinetic
+    # theory's friction, within tracer_langevin_margin (tests/helpers/margins.py)
+    from PIL import Image
+
+    with Image.open(tmp_path / "demo" / "brownian.gif") as gif:
+        assert gif.n_frames == 61
+    assert (tmp_path / "demo" / "brownian_msd.png").stat().st_size > 10_000
+    (b,) = strict_json(tmp_path / "demo" / "brownian.json")
+    assert "Brownian tracer" in out.stdout and "correlated collisions" in out.stdout
+    assert_agrees(
+        "tracer MSD(1/gamma) / Langevin",
+        b["msd_ratio_one_over_gamma"],
+        b["msd_ratio_one_over_gamma_error"],
+        b["runs"],
+        1.0,
+        tracer_langevin_margin(b["gamma_theory"] * b["t_one_over_gamma"]),
+    )
 
 
 def test_bench_quick_json(tmp_path):

@@ -209,3 +209,86 @@ def test_thesis_standard_system_numbers():
     assert c.D0 == pytest.approx(d0, rel=1e-12)
     assert c.gamma0 == pytest.approx(T0 / d0, rel=1e-12)
     assert theory.langevin_coefficients(n, r, 1.0, 1.0, T0).tau0 == math.inf
+
+
+def _mean_force_on_slow_tracer(dim, sigma, n_chi, m, T, V=1e-3):
+    """Slow reference for tracer_friction: the mean impulse per time that a Maxwellian gas
+    (mass m, temperature T, contact density n_chi) gives an infinitely heavy disk/sphere of
+    contact radius sigma moving at V along x, summed by brute force over a grid of gas
+    velocities and contact normals (Rayleigh's collision integral: rate n chi sigma^(d-1)
+    |g.e| dOmega, impulse 2 m (g.e) e, g = v - V, approaching when g.e < 0)."""
+    s = math.sqrt(T / m)
+    if dim == 2:
+        u = np.linspace(-7 * s, 7 * s, 141)
+        vx, vy = np.meshgrid(u, u, indexing="ij")
+        v = np.stack([vx.ravel(), vy.ravel()], 1)
+        weight = np.exp(-(v**2).sum(1) / (2 * s * s)) / (2 * math.pi * s * s) * (u[1] - u[0]) ** 2
+        phi = (np.arange(360) + 0.5) * 2 * math.pi / 360
+        e = np.stack([np.cos(phi), np.sin(phi)], 1)
+        dA = sigma * (2 * math.pi / 360)  # sigma^(d-1) dOmega
+    else:
+        u = np.linspace(-6 * s, 6 * s, 33)
+        g3 = np.meshgrid(u, u, u, indexing="ij")
+        v = np.stack([g.ravel() for g in g3], 1)
+        weight = np.exp(-(v**2).sum(1) / (2 * s * s)) / (2 * math.pi * s * s) ** 1.5
+        weight *= (u[1] - u[0]) ** 3
+        k = 16  # Gauss-Legendre in cos(theta) times uniform in phi
+        c, wc = np.polynomial.legendre.leggauss(k)
+        phi = (np.arange(2 * k) + 0.5) * math.pi / k
+        C, P = np.meshgrid(c, phi, indexing="ij")
+        S = np.sqrt(1 - C**2)
+        e = np.stack([(S * np.cos(P)).ravel(), (S * np.sin(P)).ravel(), C.ravel()], 1)
+        dA = sigma**2 * np.repeat(wc, 2 * k) * (math.pi / k)
+    force = np.zeros(dim)
+    for sign in (1.0, -1.0):  # central difference in V: the O(V^2) terms cancel
+        for start in range(0, len(v), 4096):  # in blocks: velocities x normals is large
+            g = v[start : start + 4096] - sign * V * np.eye(dim)[0]
+            ge = g @ e.T  # (velocities, normals)
+            rate = n_chi * np.where(ge < 0, -ge, 0.0) * dA
+            impulse = weight[start : start + 4096, None] * rate * 2 * m * ge
+            force += sign * (impulse @ e).sum(0)
+    return -force[0] / (2 * V)  # M gamma: the force is -M gamma V
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_tracer_friction_is_the_collision_integral(dim):
+    """The closed form (2D: 2 n chi sigma sqrt(2 pi m T), 3D Epstein's (8/3) n chi sigma^2
+    sqrt(2 pi m T)) against the collision integral summed by brute force on a grid, for a
+    tracer so heavy that mu = m.  The grid sums are good to ~1e-3."""
+    n, r, R, T, m, M, chi = 3.0, 0.1, 0.7, 0.8, 1.3, 1e12, 1.25
+    sigma = R + r
+    closed = theory.tracer_friction(n, r, R, M, T, m, dim, chi=chi) * M
+    brute = _mean_force_on_slow_tracer(dim, sigma, n * chi, m, T)
+    assert closed == pytest.approx(brute, rel=1e-3)
+    literal = (2.0 if dim == 2 else 8 / 3 * sigma) * n * chi * sigma
+    assert closed == pytest.approx(literal * math.sqrt(2 * math.pi * m * T), rel=1e-9)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_tracer_friction_of_a_gas_particle_is_self_diffusion(dim):
+    """A 'tracer' equal to the gas particles (mu = m/2, z = 1) diffuses as Enskog's D_E
+    (diffusion_d0 at xi = 1): D = T / (M gamma)."""
+    n, r, T = (3.0, 0.05, 0.7) if dim == 2 else (20.0, 0.05, 0.7)
+    c = theory.tracer_langevin_coefficients(n, r, r, 1.0, T, 1.0, dim)
+    assert c.D0 == pytest.approx(theory.diffusion_d0(n, r, 1.0, T, 1.0, dim), rel=1e-12)
+    assert c.gamma0 * c.D0 == pytest.approx(T, rel=1e-12) and c.tau0 == math.inf
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_tracer_contact_value_limits(dim):
+    """Santos-Yuste-Lopez de Haro's G(eta, z) meets its three exact limits: a point tracer
+    (z = 0) 1 / (1 - eta), a tracer like the gas (z = 1) the gas' contact value, a flat wall
+    (R -> inf, z -> 2) the compressibility factor; and it is 1 in an empty gas."""
+    eta, r = 0.3, 0.1
+    assert theory.tracer_contact_value(eta, 1e-12, r, dim) == pytest.approx(1 / (1 - eta))
+    assert theory.tracer_contact_value(eta, r, r, dim) == pytest.approx(
+        theory.contact_value(eta, dim), rel=1e-12
+    )
+    assert theory.tracer_contact_value(eta, 1e9, r, dim) == pytest.approx(
+        theory.compressibility_factor(eta, dim), rel=1e-8
+    )
+    assert theory.tracer_contact_value(0.0, 0.5, r, dim) == pytest.approx(1.0, rel=1e-14)
+    with pytest.raises(ValueError, match="positive"):
+        theory.tracer_friction(-1.0, r, 0.5, 25.0, 0.5, dim=dim)
+    with pytest.raises(ValueError, match="radii"):
+        theory.tracer_contact_value(eta, 0.0, r, dim)
