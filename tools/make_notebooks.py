@@ -62,32 +62,40 @@ repro = [
     (
         "md:# The thesis' chapter 4, the story\n"
         "The same experiments as `python -m granular reproduce`, one at a time. "
-        "`reproduce.figure(name, quick=...)` runs one of them on the thesis' system with five "
-        "times its number of runs (`QUICK` shrinks it), writes its figures and returns their paths "
-        "and its summary rows: our value with its standard error over the runs, the thesis' value "
-        "and theory's. `reproduce.FIGURES` lists the names."
+        "`reproduce.figure(name, quick=..., runs=...)` runs one of them on the thesis' system, "
+        "writes its figures and returns their paths and its summary rows: our value with its "
+        "standard error over the runs, the thesis' value and theory's. `reproduce.FIGURES` lists "
+        "the names.\n\n"
+        "**Time:** by default each experiment runs the thesis' system with 4 runs (the "
+        "thesis' own count for most figures): the whole notebook took 3 min 5 s on 2 cores "
+        "that were busy with other jobs (load average 6), less on a quiet machine. "
+        "Set `FULL = True` for the statistics of `python -m granular reproduce` (five times the "
+        "thesis' runs): about 14 minutes on 2 cores."
     ),
     setup + "\nfrom granular.cli import reproduce\nfrom IPython.display import Image, display",
-    """out = "reproduction"
+    """FULL = False  # True: five times the thesis' runs, as `python -m granular reproduce`
+# 4 runs per experiment (the thesis' own count for most figures); None: reproduce's defaults
+RUNS = None if FULL or QUICK else 4
+out = "reproduction"
 rows = []
 list(reproduce.FIGURES)""",
     "md:## Verification: a head-on collision, energy conservation, collision counts (Figs 4.1-4.4)",
     """for name in ("4.1", "4.2-4.4"):
-    paths, new_rows = reproduce.figure(name, quick=QUICK, out=out)
+    paths, new_rows = reproduce.figure(name, quick=QUICK, runs=RUNS, out=out)
     rows += new_rows
     display(*[Image(p) for p in paths])""",
     "md:## Speed distributions and Table 4.1 (Figs 4.5-4.7)",
-    """paths, new_rows = reproduce.figure("4.5-4.7", quick=QUICK, out=out)
+    """paths, new_rows = reproduce.figure("4.5-4.7", quick=QUICK, runs=RUNS, out=out)
 rows += new_rows
 display(Image(paths[1]))
 new_rows""",
     "md:## Haff's law (Figs 4.8, 4.10) and 2D clustering (Fig. 4.9)",
     """for name in ("4.8+4.10", "4.9"):
-    paths, new_rows = reproduce.figure(name, quick=QUICK, out=out)
+    paths, new_rows = reproduce.figure(name, quick=QUICK, runs=RUNS, out=out)
     rows += new_rows
     display(*[Image(p) for p in paths])""",
     "md:## Brownian motion: MSD, diffusivity and long-time slopes (Figs 4.11-4.16, F.1-F.2)",
-    """paths, new_rows = reproduce.figure("4.11-4.16+F", quick=QUICK, out=out)
+    """paths, new_rows = reproduce.figure("4.11-4.16+F", quick=QUICK, runs=RUNS, out=out)
 rows += new_rows
 display(Image(paths[2]), Image(paths[-1]))
 new_rows""",
@@ -95,7 +103,7 @@ new_rows""",
         "md:## Langevin and UDSBM, ergodicity (Figs 4.17-4.23)\n"
         "Fig. 4.23: the time-averaged MSD of UDSBM for several t_stop, beside the ensemble MSD."
     ),
-    """paths, new_rows = reproduce.figure("4.17-4.23", quick=QUICK, out=out)
+    """paths, new_rows = reproduce.figure("4.17-4.23", quick=QUICK, runs=RUNS, out=out)
 rows += new_rows
 display(Image(paths[3]), Image(paths[-1]))
 new_rows""",
