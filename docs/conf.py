@@ -60,6 +60,7 @@ def _skip_namedtuple_fields(app, what, name, obj, skip, options):
 def setup(app):
     app.connect("autodoc-skip-member", _skip_namedtuple_fields)
 
+
 # --- HTML ----------------------------------------------------------------------------------
 html_theme = "furo"
 html_title = f"granular {release}"

@@ -1,7 +1,7 @@
 """docs/animation.gif: the Brownian tracer scene animated, for docs/animation.md.
 
 Run from the repository root: ``python tools/animation_figure.py``.  The picture is kept
-small (a few hundred kB at most: 40 frames, 60 dpi) because it lives in the repository.
+small (under 400 kB: 30 frames, 400 x 400 pixels) because it lives in the repository.
 """
 
 import argparse
@@ -15,14 +15,14 @@ import granular
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default=os.path.join("docs", "animation.gif"))
-    parser.add_argument("--frames", type=int, default=40)
-    parser.add_argument("--dpi", type=float, default=60.0)
+    parser.add_argument("--frames", type=int, default=30)
+    parser.add_argument("--dpi", type=float, default=80.0)
     args = parser.parse_args()
 
     scene = granular.Scene.seed_brownian_disks(seed=2020, tracer=True)
     t_stop = 20.0
-    # 4 samples per time unit for the trail; the GIF shows every 2nd (frames / 2 time units
-    # of motion at 2 frames per time unit)
+    # 4 samples per time unit, so the trail is smooth; the GIF shows every 2nd sample: one
+    # frame per half time unit, the tracer moving about a tenth of its radius between frames
     times = np.linspace(0.0, t_stop, int(4 * t_stop) + 1)
     traj = granular.Simulation(scene).run(t_stop=t_stop, sample_times=times)
     anim = granular.plot.animate(
