@@ -48,6 +48,19 @@ numpydoc_show_class_members = False  # members are documented on the class's own
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
 
+
+def _skip_namedtuple_fields(app, what, name, obj, skip, options):
+    # a NamedTuple's fields are documented in its Attributes section; the properties
+    # namedtuple makes for them only say "Alias for field number k"
+    if (getattr(obj, "__doc__", None) or "").startswith("Alias for field number"):
+        return True
+    return None
+
+
+def setup(app):
+    app.connect("autodoc-skip-member", _skip_namedtuple_fields)
+
+
 # --- HTML ----------------------------------------------------------------------------------
 html_theme = "furo"
 html_title = f"granular {release}"

@@ -104,10 +104,16 @@ def _shell_mean(values, shell_index, n_shells):
 class StructureFactor(NamedTuple):
     """S(k, t) averaged over the wave vectors of each ``|k|`` shell.
 
-    k : (S,) the shells' ``|k|``
-    n : (S,) ``|k| L_max / (2 pi)``: ``|n|`` in a cubic box
-    values : (T, S) S(k) at each sample
-    vectors : (S,) how many wave vectors (one of each +-k) each shell averages
+    Attributes
+    ----------
+    k : (S,) array
+        The shells' ``|k|``.
+    n : (S,) array
+        ``|k| L_max / (2 pi)``: ``|n|`` in a cubic box.
+    values : (T, S) array
+        S(k) at each sample.
+    vectors : (S,) array
+        How many wave vectors (one of each +-k) each shell averages.
     """
 
     k: NDArray[np.float64]
@@ -160,10 +166,16 @@ class CurrentCorrelations(NamedTuple):
     """Transverse and longitudinal momentum-current correlations per ``|k|`` shell, each 1 for an
     uncorrelated gas.
 
-    k : (S,) the shells' ``|k|``
-    transverse : (T, S) ``|j_perp(k)|^2 / ((d-1)/d sum_j m_j^2 |v_j|^2)``
-    longitudinal : (T, S) ``|j_par(k)|^2 / ((1/d) sum_j m_j^2 |v_j|^2)``
-    vectors : (S,) wave vectors per shell
+    Attributes
+    ----------
+    k : (S,) array
+        The shells' ``|k|``.
+    transverse : (T, S) array
+        ``|j_perp(k)|^2 / ((d-1)/d sum_j m_j^2 |v_j|^2)``.
+    longitudinal : (T, S) array
+        ``|j_par(k)|^2 / ((1/d) sum_j m_j^2 |v_j|^2)``.
+    vectors : (S,) array
+        Wave vectors per shell.
     """
 
     k: NDArray[np.float64]

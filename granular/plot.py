@@ -1,8 +1,10 @@
 """Figures: each function draws onto the given axes (or new ones) and returns them.
 
-matplotlib is imported only when a function is called.
+matplotlib is imported only when a function is called.  Animations of a trajectory:
+``animate`` (its own page in the API reference, ``granular.plot.animate``).
 
-Units follow the package (DESIGN.md) and every axis says which it shows:
+Units follow the package's conventions (docs/conventions.md) and every axis says which it
+shows:
 
 - ``L``: the length unit of the scene's coordinates -- the box edge in the thesis' unit
   box;
@@ -59,7 +61,7 @@ def energy(
     relative: bool = True,
 ) -> Axes:
     """Kinetic energy against time; with ``relative`` the deviation E(t)/E(0) - 1 (thesis
-    Fig. 4.2: rounding-level for a molecular gas)."""
+    Fig 4.2: rounding-level for a molecular gas)."""
     ax = _axes(ax)
     e = np.asarray(kinetic_energy, dtype=np.float64)
     y = e / e[0] - 1 if relative else e
@@ -235,7 +237,7 @@ def snapshot(
     ax: Axes | None = None,
     color: str = "C0",
 ) -> Axes:
-    """Disks of a 2D configuration drawn to scale (Fig. 4.9)."""
+    """Disks of a 2D configuration drawn to scale (Fig 4.9)."""
     from matplotlib.collections import EllipseCollection
 
     ax = _axes(ax)

@@ -134,7 +134,7 @@ class Viscoelastic(RestitutionLaw):
     integrating the contact numerically, tests/test_restitution.py), so it is used for
     delta <= 0.25 only (eps >= 0.76, error < 0.008), i.e. speeds up to ``max_speed``.  A
     faster collision gets eps(max_speed), and the engine counts it
-    (``Simulation.stats()['law_clamped_collisions']``; ``Simulation.run`` warns): a gas
+    (``Simulation.stats['law_clamped_collisions']``; ``Simulation.run`` warns): a gas
     whose collisions often exceed ``max_speed`` is outside this law.
 
     All pairs use the one ``A kappa^(2/5)``: exact for equal spheres; for a mixture kappa
@@ -156,7 +156,9 @@ class Viscoelastic(RestitutionLaw):
     References
     ----------
     N. V. Brilliantov, F. Spahn, J.-M. Hertzsch, T. Poeschel, Phys. Rev. E 53, 5382 (1996).
+
     T. Schwager, T. Poeschel, Phys. Rev. E 57, 650 (1998).
+
     N. V. Brilliantov, T. Poeschel, Kinetic Theory of Granular Gases, OUP (2004), ch. 6.
     """
 

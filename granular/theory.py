@@ -1,6 +1,7 @@
 """Analytic results the simulations are checked against.
 
-Equation numbers refer to the thesis (A. Gjersvoll, NTNU 2020) in ``shared/seeds``.
+Equation numbers refer to the thesis: A. Gjersvoll, *Simulation methods for granular gas
+dynamics in periodic three-dimensional systems*, master's thesis, NTNU, 2020 ([G20]).
 Conventions: k_B = 1, so temperature is energy, ``T = 2 <E_kin> / d`` per particle and
 ``<v_a^2> = T / m`` per velocity component.  **Every MSD here is the total over the d
 dimensions**: the thesis derives one-dimensional MSDs and multiplies by 3 (2.56); divide
