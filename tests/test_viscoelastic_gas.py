@@ -15,6 +15,8 @@ from scipy import stats
 import granular
 from granular import Scene, Simulation, TabulatedRestitution, Viscoelastic, langevin, theory
 
+from helpers.margins import diffusion_margin
+
 FALSE_ALARM = 1e-4
 DENSITY, R = 1000.0, 0.025  # the thesis' 3D gas (eta = 0.065)
 N = 250  # a periodic box of side 0.63, well below the critical size (checked below)
@@ -90,14 +92,18 @@ def cooling_runs():
     tau = theory.viscoelastic_tau0(law, DENSITY, R, eq.temperature, eta=eq.packing_fraction)
     times = np.concatenate([[0.0], np.geomspace(0.1 * tau, 1000 * tau, 25)])
     rng = np.random.default_rng(15)
-    temps, clamped, collisions = [], 0, 0
+    temps, msds, clamped, collisions = [], [], 0, 0
     for _ in range(20):
         s = eq.replace(restitution=law, velocities=eq.velocities[rng.permutation(N)])
         run = Simulation(s)
-        temps.append(run.run(t_stop=times[-1], sample_times=times, store=()).temperature)
+        traj = run.run(t_stop=times[-1], sample_times=times, store=("positions",))
+        temps.append(traj.temperature)
+        msds.append(traj.msd())
         clamped += run.stats["law_clamped_collisions"]
         collisions += run.stats["pair_collisions"]
-    return dict(eq=eq, law=law, tau=tau, times=times, T=np.array(temps), clamped=clamped)
+    return dict(
+        eq=eq, law=law, tau=tau, times=times, T=np.array(temps), msd=np.array(msds), clamped=clamped
+    )
 
 
 def test_viscoelastic_gas_is_in_range_and_below_the_critical_box(cooling_runs):
@@ -164,6 +170,46 @@ def test_viscoelastic_gas_cooling_exponent_approaches_minus_five_thirds(cooling_
     print(f"exponent {mean:.4f} +- {err:.4f}; leading {lead:.4f}, second order {second:.4f}")
     # and the second order, the better theory, within the 0.01 alone
     assert abs(mean - second) <= _student(len(per_run)) * err + 0.01, (mean, err, second)
+
+
+def test_viscoelastic_gas_msd_follows_the_second_order_theory(cooling_runs):
+    """<MSD(t)> over the 20 runs against theory.msd_viscoelastic_second_order from
+    t = 10 tau0' (past the ballistic start, which the theory's integral of D misses) to
+    1000 tau0'.  Margin diffusion_margin(eps_eff) = 7.8% with eps_eff = 0.879 the gas'
+    most inelastic (at T0): Enskog's D is ~4% low at this density (tests/helpers/margins.py,
+    the thesis' own measurement) plus the O(1 - eps) approximations of the Maxwellian D.
+    Measured: 3-5% above.  The leading order, msd_viscoelastic, lies ~20% below EDMD: the
+    O(delta) corrections matter."""
+    r = cooling_runs
+    eq, times = r["eq"], r["times"]
+    w = times >= 10 * r["tau"]
+    mean = r["msd"].mean(axis=0)[w]
+    err = r["msd"].std(axis=0, ddof=1)[w] / math.sqrt(len(r["msd"]))
+    theory_msd = theory.msd_viscoelastic_second_order(
+        times[w], eq.temperature, r["law"], DENSITY, R, eta=eq.packing_fraction
+    )
+    eps_eff = 1 - theory.VISCOELASTIC_C1 * math.gamma(2.1) * DELTA0
+    tol = _student(len(r["msd"])) * err + diffusion_margin(eps_eff) * theory_msd
+    bad = np.flatnonzero(np.abs(mean - theory_msd) > tol)
+    assert bad.size == 0, (times[w][bad] / r["tau"], mean[bad] / theory_msd[bad] - 1)
+
+
+def test_msd_second_order_limits():
+    """a_kappa = 0: the elastic gas' 2 d D_E t exactly (no cooling, eps = 1); small a_kappa:
+    within O(delta) of the leading order msd_viscoelastic."""
+    t = np.geomspace(0.01, 100.0, 9)
+    d_e = theory.diffusion_d0(DENSITY, R, 1.0, 0.5)
+    elastic = theory.msd_viscoelastic_second_order(t, 0.5, 0.0, DENSITY, R)
+    assert elastic == pytest.approx(6 * d_e * t, rel=1e-12)
+    law = Viscoelastic(1e-3, 1.0)  # delta(T0) = 1.1e-3
+    tau = theory.viscoelastic_tau0(law, DENSITY, R, 0.5)
+    ts = np.geomspace(0.1, 100.0, 5) * tau
+    ratio = theory.msd_viscoelastic_second_order(ts, 0.5, law, DENSITY, R) / (
+        theory.msd_viscoelastic(ts, d_e, tau)
+    )
+    # first-order corrections: some delta(T0) (x 1.34 in the rate, 0.6 C1 in D) and the
+    # quadrature's 1e-4
+    assert np.all(np.abs(ratio - 1) < 5 * 1.1e-3 + 1e-4), ratio
 
 
 def test_top_level_exports():
