@@ -9,7 +9,7 @@ Three parts, each against ``granular.theory``:
   elastic), started from a molecular gas equilibrated for 20 collisions per particle whose
   velocities each run shuffles (thesis 3.8), with ``delta(T0)`` = ``DELTA0`` = 0.1 (1 - eps
   about 11% at the mean impact speed; the series' clamp at delta = 0.25 is then never
-  reached: max_speed is 160 thermal-speed units).  Runs to ``T_MAX`` tau0' (10^4 full, 10^3
+  reached: max_speed is 159, the thermal speed 1.4).  Runs to ``T_MAX`` tau0' (10^4 full, 10^3
   quick), where T has fallen by 5-7 decades.  The rows fit the local exponents d ln T /
   d ln t and d ln MSD / d ln t per run over the last decade, [T_MAX / 10, T_MAX] tau0', and
   compare them with the same fit of the **full second-order expressions**
@@ -134,13 +134,19 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
     m1 = theory.msd_viscoelastic(times, c.D0, tau)
     names, rows = [], []
 
+    # the box against the critical size at the gas' most inelastic moment, its start
+    eps_eff = 1 - theory.VISCOELASTIC_C1 * math.gamma(2.1) * DELTA0
+    l_over_lc = float(eq.upper[0] - eq.lower[0]) / float(
+        theory.critical_box_size(DENSITY, RADIUS, eps_eff, eta=eta)
+    )
     t_slopes = [_slope(times, r["temperature"], window) for r in res.runs]
     s1, s2 = _slope(times, T1, window), _slope(times, T2, window)
     rows.append(
         mean_row(
             "visco.haff.exponent",
             f"d ln T / d ln t of the viscoelastic gas (EDMD, N = {N}, 3D periodic, "
-            f"delta(T0) = {DELTA0}), fitted over t / tau0' = {t_max / 10:g} ... {t_max:g}; "
+            f"delta(T0) = {DELTA0}, L / L_c = {l_over_lc:.2f} at the start), fitted over "
+            f"t / tau0' = {t_max / 10:g} ... {t_max:g}; "
             f"theory: the same fit of the second-order law "
             f"(viscoelastic_temperature_second_order); the leading order gives {s1:.4f} there, "
             f"its asymptote -5/3",
@@ -200,6 +206,8 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
     collapsing = [k for k in cases if k[2] is not None]
     visco_collapsed = sum(k[3][1] for k in collapsing)
     clamped = sum(k[3][2] for k in collapsing)
+    # how far past its constant-xi collapse each viscoelastic run went, in time
+    beyond = min((k[3][0] / k[2] for k in collapsing), default=math.nan)
     rows.append(
         row(
             "visco.collapse.2d",
@@ -207,7 +215,8 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
             f"initial collisions), out of the {len(collapsing)} of {len(cases)} walled 2D "
             f"scenes (N = {COLLAPSE_N}, area fractions {', '.join(map(str, etas))}) that "
             f"collapse with xi = {COLLAPSE_XI} within {COLLAPSE_CPP} collisions per particle; "
-            f"{clamped} collisions past the law's max_speed; theory: 0",
+            f"each viscoelastic run reaches at least {beyond:.1f} times its constant-xi "
+            f"collapse time; {clamped} collisions past the law's max_speed; theory: 0",
             visco_collapsed,
             None,
             len(collapsing),
