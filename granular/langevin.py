@@ -708,15 +708,59 @@ def run(
 
 
 def coefficients_from_scene(scene: Scene) -> LangevinCoefficients:
-    """gamma0, D0, tau0 of a Scene exactly as the thesis derives them (2.45, 2.52, 2.55),
-    from its N, radius, mass, restitution, box and temperature."""
+    """gamma0, D0 and tau0 of the model that stands for a Scene's gas.
+
+    A number restitution xi: exactly as the thesis derives them (2.45, 2.52, 2.55), from
+    its N, radius, mass, xi, box and temperature (tau0 infinite for xi = 1).  A
+    ``restitution.Viscoelastic`` law: the power-law UDSBM's (``exponent`` 5/6, see
+    ``from_scene``), gamma0 and D0 the same Enskog values at xi = 1 and tau0 the
+    viscoelastic cooling time tau0' (``theory.viscoelastic_langevin_coefficients``).
+
+    Parameters
+    ----------
+    scene : Scene
+        Its mean radius and mass are used (the theory is one of equal particles).
+
+    Returns
+    -------
+    LangevinCoefficients
+
+    Raises
+    ------
+    TypeError
+        If the scene's pair restitution is a law with no Langevin counterpart (e.g. a
+        ``TabulatedRestitution``): only a number and ``Viscoelastic`` have one.
+    """
+    return _scene_model(scene)[0]
+
+
+def _scene_model(scene: Scene) -> tuple[LangevinCoefficients, float]:
+    """The coefficients and the UDSBM exponent (1 or 5/6) of a Scene's gas."""
     from . import theory
+    from .restitution import RestitutionLaw, Viscoelastic
 
     radius = float(np.mean(scene.radii))
     mass = float(np.mean(scene.masses))
-    return theory.langevin_coefficients(
-        scene.n, radius, scene.volume, scene.restitution, scene.temperature, mass, scene.dim
+    law = scene.restitution
+    if isinstance(law, Viscoelastic):
+        c = theory.viscoelastic_langevin_coefficients(
+            scene.n, radius, scene.volume, law, scene.temperature, mass, scene.dim
+        )
+        return c, VISCOELASTIC_EXPONENT
+    if isinstance(law, RestitutionLaw):
+        raise TypeError(
+            f"no Langevin model stands for the restitution law {type(law).__name__}: "
+            "from_scene and coefficients_from_scene support a number xi (Langevin or UDSBM) "
+            "and granular.Viscoelastic (power-law UDSBM, exponent 5/6)"
+        )
+    c = theory.langevin_coefficients(
+        scene.n, radius, scene.volume, law, scene.temperature, mass, scene.dim
     )
+    return c, 1.0
+
+
+# UDSBM's exponent for a viscoelastic gas: T ~ t^(-5/3), D ~ t^(-5/6) (theory.viscoelastic_*)
+VISCOELASTIC_EXPONENT = 5.0 / 6.0
 
 
 def from_scene(
@@ -728,11 +772,20 @@ def from_scene(
     n: int | None = None,
     **kwargs: Any,
 ) -> LangevinResult:
-    """A Langevin run (xi = 1) or UDSBM run (xi < 1) with the scene's coefficients, so it
-    can be set beside an EDMD run of the same scene.  ``n`` defaults to the scene's N;
-    other arguments as in ``run``."""
-    c = coefficients_from_scene(scene)
+    """A Langevin run (xi = 1), UDSBM run (xi < 1) or power-law UDSBM run (exponent 5/6,
+    a ``Viscoelastic`` restitution) with the scene's coefficients
+    (``coefficients_from_scene``), so it can be set beside an EDMD run of the same scene.
+    ``n`` defaults to the scene's N; other arguments as in ``run``.
+
+    Raises
+    ------
+    TypeError
+        For a restitution law other than ``Viscoelastic`` (see ``coefficients_from_scene``).
+    """
+    c, exponent = _scene_model(scene)
     model = "langevin" if math.isinf(c.tau0) else "udsbm"
+    if model == "udsbm":
+        kwargs.setdefault("exponent", exponent)
     return run(
         scene.n if n is None else n,
         gamma0=c.gamma0,

@@ -128,7 +128,9 @@ class Viscoelastic(RestitutionLaw):
 
     C1 = 1.15345, C2 = (3/5) C1^2 = 0.79827 (Schwager & Poeschel 1998), v the normal
     impact speed, R_eff and m_eff the reduced radius and mass.  Only ``A kappa^(2/5)``
-    enters; ``characteristic_speed`` ``(A kappa^(2/5))^-5`` is the speed at which delta = 1.
+    enters (``a_kappa``, the number ``granular.theory`` takes; pass the law itself to its
+    viscoelastic functions); ``characteristic_speed`` ``(A kappa^(2/5))^-5`` is the speed
+    at which delta = 1.
 
     The series is of order 2 in delta.  Its next term is about -0.5 delta^3 (found by
     integrating the contact numerically, tests/test_restitution.py), so it is used for
@@ -240,6 +242,13 @@ class Viscoelastic(RestitutionLaw):
             )
         delta = (C1 - math.sqrt(C1 * C1 - 4.0 * C2 * (1.0 - e))) / (2.0 * C2)
         return cls(delta / v**0.2, 1.0)
+
+    @property
+    def a_kappa(self) -> float:
+        """A kappa^(2/5), the one material number of the law (``scale``), under the name
+        ``granular.theory``'s viscoelastic functions give it: the cooling law, tau0', D(t)
+        and the power-law UDSBM coefficients take this number or the law itself."""
+        return self.scale
 
     @property
     def characteristic_speed(self) -> float:

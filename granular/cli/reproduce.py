@@ -5,7 +5,8 @@ Public entry points
 ``FIGURES``
     The experiments in the thesis' order, by name: ``"4.1"``, ``"4.2-4.4"``, ``"4.5-4.7"``,
     ``"4.8+4.10"``, ``"4.9"``, ``"4.11-4.16+F"``, ``"4.17-4.23"``, then ``"clustering"``
-    (where the homogeneous cooling of Fig. 4.10 ends; ``reproduce_clustering``).
+    (where the homogeneous cooling of Fig. 4.10 ends; ``reproduce_clustering``) and
+    ``"viscoelastic"`` (the viscoelastic gas and its power-law UDSBM; ``reproduce_visco``).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -635,6 +636,21 @@ def _fig_clustering(cfg, out):
         )
 
 
+def _fig_visco(cfg, out):
+    """Viscoelastic gases (issue 15): see ``reproduce_visco``."""
+    from . import reproduce_visco
+
+    return reproduce_visco._fig_visco(
+        cfg,
+        out,
+        ensemble=functools.partial(_checked_ensemble, backend="threads"),
+        save=_save,
+        fig=_fig,
+        row=_row,
+        mean_row=_mean_row,
+    )
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -644,6 +660,7 @@ FIGURES = {
     "4.11-4.16+F": _fig_4_11_to_4_16_and_F,
     "4.17-4.23": _fig_4_17_to_4_23,
     "clustering": _fig_clustering,
+    "viscoelastic": _fig_visco,
 }
 
 
@@ -860,6 +877,7 @@ def _notes(cfg, by_id):
         ("Langevin and UDSBM (Figs 4.17-4.20)", "sde.", sde),
         ("Ergodicity (Figs 4.21-4.23)", "ergodicity.", ergodicity),
         ("Where homogeneous cooling ends (clustering)", "cluster.", _clustering_notes(by_id)),
+        ("Viscoelastic gases", "visco.", _visco_notes(by_id)),
     ]
 
 
@@ -867,6 +885,12 @@ def _clustering_notes(by_id):
     from . import reproduce_clustering
 
     return reproduce_clustering.notes(by_id)
+
+
+def _visco_notes(by_id):
+    from . import reproduce_visco
+
+    return reproduce_visco.notes(by_id)
 
 
 def _report(rows, cfg, names, seconds):
