@@ -293,7 +293,7 @@ slope = np.polyfit(np.log(tl), np.log(traj.msd()[late]), 1)[0]
 slope_u = np.polyfit(np.log(tl), np.log(np.interp(tl, u.times, u.msd())), 1)[0]
 slope_th = np.polyfit(np.log(tl), np.log(theory.msd_viscoelastic(tl, c.D0, c.tau0)), 1)[0]
 print(f"d ln MSD / d ln t over t in [{tl[0]:.3g}, {tl[-1]:.3g}]:")
-print(f"EDMD {slope:.3f}, UDSBM {slope_u:.3f}, theory {slope_th:.3f} (1/6 only as t -> infinity)")""",
+print(f"EDMD {slope:.3f}, UDSBM {slope_u:.3f}, theory {slope_th:.3f}", "(1/6 only as t -> inf)")""",
     (
         "md:Both models sit some 10-20% off each other at late times: the MSD's prefactor comes "
         "from Enskog's D0, which the thesis' EDMD already exceeds for constant xi (its section "
@@ -368,7 +368,7 @@ with warnings.catch_warnings():
     warnings.simplefilter("ignore", RuntimeWarning)  # a few hot-start collisions are clamped
     vsim.run(stop_when={"collisions_per_particle": 400}, store=())
 reached = vsim.stats["collisions_per_particle"]
-print(f"viscoelastic, mean eps {mean_eps(lo):.3f}: no collapse, {reached:.0f} collisions per particle")
+print(f"viscoelastic, mean eps {mean_eps(lo):.3f}: no collapse,", f"{reached:.0f} collisions each")
 fig, ax = plt.subplots(figsize=(4, 4))
 plot.snapshot(vsim.scene.positions, vsim.scene.radii, vsim.scene.lower, vsim.scene.upper, ax=ax)
 ax.set_title("viscoelastic disks, the end of the run");""",
@@ -408,7 +408,8 @@ box, tau0, big, big_ratio, caught = cool(big_n, 1)
 print(f"big box L = {box:.2f} = {box / lc:.2f} L_c; warned:", caught[0][:120] if caught else "no")
 small = [cool(small_n, 10 + k) for k in range(small_runs)]
 small_box = small[0][0]
-print(f"small box L = {small_box:.2f} = {small_box / lc:.2f} L_c; warned:", any(s[4] for s in small))""",
+warned = any(s[4] for s in small)
+print(f"small box L = {small_box:.2f} = {small_box / lc:.2f} L_c; warned:", warned)""",
     (
         "md:Left: T against Haff's law (Enskog's tau0). Middle: the energy of the flow field "
         "coarse-grained on cells about 0.4 wide, against the thermal energy (dotted: the level "
