@@ -27,7 +27,8 @@ runs need no equilibration: they draw the stationary Gaussian velocities directl
 Where methods fail: Euler-Maruyama's MSD error against gamma0*dt up to and past its
 stability limit (refused at gamma0*dt >= 2) beside the exact scheme; inelastic collapse of
 2D disks between walls over restitution and area fraction, with and without the TC
-model, and with the viscoelastic law of the same mean restitution; the cost of EDMD per unit time as the packing approaches the dense limit.
+model, and with the viscoelastic law of the same mean restitution; the cost of EDMD per
+unit time as the packing approaches the dense limit.
 """
 
 from __future__ import annotations
