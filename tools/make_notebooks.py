@@ -213,8 +213,8 @@ visco = [
         "instead of Haff's t^(-2), diffuse as MSD ~ t^(1/6), and do not collapse; a constant-xi "
         "gas in a box wider than the critical size of the shear instability leaves Haff's law "
         "as vortices and clusters grow.\n\n"
-        "Full size this notebook takes about one minute (53 s measured on a 2-core machine "
-        "under load; `GRANULAR_QUICK=1`: about 8 s)."
+        "Full size this notebook takes about one minute (42-53 s measured on a loaded 2-core "
+        "machine; `GRANULAR_QUICK=1`: about 8 s)."
     ),
     setup + "\nimport math\nimport warnings\nfrom granular import langevin",
     (
@@ -439,8 +439,8 @@ axes[2].set(xlabel="t / tau0", ylabel="S(k_min)")
 axes[2].legend();""",
     (
         "md:The big box at the end: the particles of a slab a sixth of the box thick, and the "
-        "flow field of that slab (mean velocity per cell, arrows): vortices and the dense "
-        "streams between them."
+        "flow field of that slab (mean velocity per cell, arrows): the box-scale shear flow, "
+        "streams running in opposite directions, and the dense bands it gathers."
     ),
     """x = np.mod(big.positions[-1] - big.lower, box) + big.lower
 v = big.velocities[-1] - big.velocities[-1].mean(axis=0)
