@@ -54,9 +54,10 @@ def test_notebook_runs(path, tmp_path, monkeypatch):
     assert sum(len(t) for t in text) < TEXT_LIMIT
 
 
-def test_there_are_three_notebooks():
+def test_there_are_four_notebooks():
     assert [p.stem for p in NOTEBOOKS] == [
         "01_quickstart",
         "02_thesis_reproduction",
         "03_langevin_vs_edmd",
+        "04_viscoelastic_and_clustering",
     ]

@@ -5,7 +5,9 @@ import json
 import math
 
 import numpy as np
+import pytest
 
+from granular import Viscoelastic
 from granular.cli import speed_accuracy
 from granular.simulation import _LIST_SHELL
 
@@ -24,8 +26,23 @@ def test_failure_maps_pin_each_failure_mode():
         )
         assert abs(by_g[g]["exact_v2_bias"]) < 5 * math.sqrt(2 / 6000)
     cells = speed_accuracy.collapse_map(quick=True)
-    plain = {(c["eta"], c["xi"]): c for c in cells if c["contact_duration"] == 0}
+    plain = {
+        (c["eta"], c["xi"]): c
+        for c in cells
+        if c["law"] == "constant" and c["contact_duration"] == 0
+    }
     tc = [c for c in cells if c["contact_duration"] > 0]
+    visco = {(c["eta"], c["xi"]): c for c in cells if c["law"] == "viscoelastic"}
+    assert set(visco) == set(plain)
+    # the law's series stops at eps = 0.76: xi = 0.3 cannot be matched and is not run;
+    # xi = 0.9 is, with the same mean restitution, and does not collapse
+    assert all(c["status"] == "n/a" for k, c in visco.items() if k[1] == 0.3)
+    assert all(c["status"] == "ok" for k, c in visco.items() if k[1] == 0.9)
+    assert all(
+        c["mean_eps"] == pytest.approx(0.9, abs=1e-9) and c["law_clamped_collisions"] == 0
+        for k, c in visco.items()
+        if k[1] == 0.9
+    )
     assert plain[(0.1, 0.3)]["status"] == "collapse"  # 2D walls, strongly inelastic
     assert plain[(0.1, 0.9)]["status"] in ("ok", "tc")
     assert all(c["status"] != "collapse" for c in tc)  # the TC model lets every run finish
@@ -34,7 +51,7 @@ def test_failure_maps_pin_each_failure_mode():
     # 4000 events per particle suffice for every cell here; 10 suffice for none
     assert "budget" not in {c["status"] for c in cells}
     starved = speed_accuracy.collapse_map(
-        quick=True, contact_durations=(1e-4,), events_per_particle=10
+        quick=True, contact_durations=(1e-4,), events_per_particle=10, viscoelastic=False
     )
     assert {c["status"] for c in starved} == {"budget"}
 
@@ -65,12 +82,12 @@ def test_speed_accuracy_cli_quick(tmp_path):
     data = json.loads((tmp_path / "speed_accuracy.json").read_text(), parse_constant=refuse)
     methods = {p["method"] for p in data["points"]}
     assert methods == {"edmd", "em", "exact"}
-    assert {p["gas"] for p in data["points"]} == {"granular", "molecular"}
+    assert {p["gas"] for p in data["points"]} == {"granular", "molecular", "viscoelastic"}
     for p in data["points"]:
         assert p["seconds"] > 0 and np.isfinite(p["msd_error"]) and np.isfinite(p["slope_error"])
     # per gas: Euler-Maruyama up to gamma0 dt = 1.9, just short of its limit; the exact
     # scheme at the same steps and past the limit
-    for gas in ("granular", "molecular"):
+    for gas in ("granular", "molecular", "viscoelastic"):
         em, exact = (
             {
                 round(p["gamma_dt"], 6)
@@ -79,7 +96,10 @@ def test_speed_accuracy_cli_quick(tmp_path):
             }
             for m in ("em", "exact")
         )
-        assert max(em) == 1.9 and em < exact and max(exact) > 2
+        if gas == "viscoelastic":  # both schemes at the same steps, up to gamma0 dt = 1.9
+            assert max(em) == 1.9 and em == exact
+        else:
+            assert max(em) == 1.9 and em < exact and max(exact) > 2
     for name in ("speed_accuracy.png", "em_stability.png", "collapse_map.png", "dense_cost.png"):
         assert (tmp_path / name).stat().st_size > 5000
     dense = data["dense_cost"]
@@ -92,12 +112,12 @@ def test_speed_accuracy_cli_quick(tmp_path):
 
 def test_collapse_map_chart_reads_well():
     """The collapse map's legend lists only the outcomes that occur, and each cell's label
-    lies inside its square (synthetic cells: all four outcomes possible, two occur)."""
+    lies inside its square (synthetic cells: five outcomes possible, two occur, then three
+    with a viscoelastic panel)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.patches import Rectangle
 
     cells = [
         dict(
@@ -110,6 +130,31 @@ def test_collapse_map_chart_reads_well():
     fig = speed_accuracy._collapse_map(plt, cells)
     legend = [t.get_text().split(":")[0] for t in fig.legends[0].get_texts()]
     assert sorted(legend) == ["collapse", "ok"]
+    _labels_inside_squares(fig)
+    plt.close(fig)
+    # a third panel, the viscoelastic law: cells it cannot match are n/a
+    cells += [
+        dict(
+            law="viscoelastic",
+            contact_duration=0.0,
+            eta=eta,
+            xi=xi,
+            status="n/a" if xi < 0.8 else "ok",
+        )
+        for eta in (0.05, 0.2, 0.4, 0.6, 0.7)
+        for xi in (0.9, 0.7, 0.5, 0.3, 0.1)
+    ]
+    fig = speed_accuracy._collapse_map(plt, cells)
+    legend = [t.get_text().split(":")[0] for t in fig.legends[0].get_texts()]
+    assert sorted(legend) == ["collapse", "n/a", "ok"] and len(fig.axes) == 3
+    assert "viscoelastic" in fig.axes[2].get_title()
+    _labels_inside_squares(fig)
+    plt.close(fig)
+
+
+def _labels_inside_squares(fig):
+    from matplotlib.patches import Rectangle
+
     renderer = fig.canvas.get_renderer()
     for ax in fig.axes:
         squares = [p.get_window_extent(renderer) for p in ax.patches if isinstance(p, Rectangle)]
@@ -122,4 +167,21 @@ def test_collapse_map_chart_reads_well():
                 and square.y0 <= box.y0
                 and box.y1 <= square.y1
             ), text.get_text()
-    plt.close(fig)
+
+
+def test_matched_viscoelastic_law_has_the_mean_restitution():
+    """The law matched to a constant xi has eps(g) averaged over the Rayleigh density of
+    initial impact speeds equal to xi, checked here by Monte Carlo: g = s sqrt(-2 ln U) is
+    Rayleigh with s^2 = 2 T / m; 400 000 draws give the mean to about 2e-5 (the spread of
+    eps over g, < 0.1, over sqrt(4e5)), so 2e-4 is ten standard errors.  Below the law's
+    range it refuses, saying why."""
+    rng = np.random.default_rng(1)
+    g = math.sqrt(2 * 1.5) * np.sqrt(-2 * np.log(rng.random(400_000)))
+    for xi in (0.95, 0.85):
+        law, info = speed_accuracy.matched_viscoelastic(xi, 1.5)
+        assert isinstance(law, Viscoelastic)
+        assert law(g).mean() == pytest.approx(xi, abs=2e-4)
+        assert info["clamped_share"] <= speed_accuracy.MATCH_CLAMPED_SHARE
+    for xi in (0.7, 0.5):  # the series stops at eps = 0.7615: out of reach
+        law, info = speed_accuracy.matched_viscoelastic(xi, 1.5)
+        assert law is None and info["mean_eps"] > 0.76

@@ -1,8 +1,9 @@
 """Speed against accuracy, and where each method fails
 (``python -m granular bench --speed-accuracy --out DIR``).
 
-Target: the MSD of a granular gas (xi = 0.8) and of a molecular gas in the thesis'
-standard box (N = 1000, r = 0.025, unit box, T0 = 2/3) at log-spaced times in [1e-2, 1e2].
+Target: the MSD of a granular gas (xi = 0.8), of a molecular gas and of a viscoelastic gas
+(``viscoelastic_points``: EDMD against power-law UDSBM, a = 5/6) in the thesis' standard box
+(N = 1000, r = 0.025, unit box, T0 = 2/3) at log-spaced times in [1e-2, 1e2].
 
 Error measures (each point measured, none modelled):
 - ``msd_error``: the largest relative deviation of the MSD from the reference over the
@@ -26,7 +27,8 @@ runs need no equilibration: they draw the stationary Gaussian velocities directl
 Where methods fail: Euler-Maruyama's MSD error against gamma0*dt up to and past its
 stability limit (refused at gamma0*dt >= 2) beside the exact scheme; inelastic collapse of
 2D disks between walls over restitution and area fraction, with and without the TC
-model; the cost of EDMD per unit time as the packing approaches the dense limit.
+model, and with the viscoelastic law of the same mean restitution; the cost of EDMD per
+unit time as the packing approaches the dense limit.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ import itertools
 import math
 import os
 import time
+import warnings
 
 import numpy as np
 
@@ -44,6 +47,7 @@ from .. import (
     Scene,
     Simulation,
     UnstableStepError,
+    Viscoelastic,
     analysis,
     ensemble,
     langevin,
@@ -206,6 +210,100 @@ def speed_accuracy_points(quick=False):
     return points, refs
 
 
+# The viscoelastic gas of the chart: the thesis' standard gas with the law whose eps is 0.9
+# at the rms normal impact speed of colliding pairs, sqrt(4 T0 / m) (delta(T0) = 0.09).
+VISCO_EPS, VISCO_A = 0.9, 5.0 / 6.0
+
+
+def _loglog_slope(times, msd, t_fit):
+    """The late exponent d ln MSD / d ln t, fitted over t >= t_fit."""
+    sel = (times >= t_fit) & (msd > 0)
+    return float(np.polyfit(np.log(times[sel]), np.log(msd[sel]), 1)[0])
+
+
+def viscoelastic_points(quick=False):
+    """The viscoelastic gas (``VISCO_EPS`` law) by EDMD (N, runs) against power-law UDSBM
+    (a = 5/6, ``theory.viscoelastic_langevin_coefficients``), both schemes, against an
+    EDMD reference.  ``slope_error`` here is the relative error of the late exponent
+    d ln MSD / d ln t over t in [t_max / 10, t_max] (it tends to 1/6 only as t -> inf).
+    Theory's MSD (``theory.msd_viscoelastic``) is reported beside, not used as the
+    reference: it misses the ballistic start and Enskog's D0 sits below EDMD's."""
+    t_max = 100.0 if not quick else 10.0
+    t_fit = t_max / 10
+    times = _times(t_max)
+    law = Viscoelastic.from_restitution(VISCO_EPS, math.sqrt(4 * T0))
+    c = theory.viscoelastic_langevin_coefficients(1000, R, 1.0, law.a_kappa, T0)
+    ref_runs = 64 if not quick else 4
+    ref, ref_cost = _edmd_msd(1000, law, ref_runs, times, seed=99)
+    th = theory.msd_viscoelastic(times, c.D0, c.tau0)
+    slope_ref, slope_th = _loglog_slope(times, ref, t_fit), _loglog_slope(times, th, t_fit)
+    ref_info = dict(
+        times=times.tolist(),
+        msd=ref.tolist(),
+        theory=th.tolist(),
+        runs=ref_runs,
+        seconds=ref_cost,
+        slope=slope_ref,
+        law=repr(law),
+        a_kappa=law.a_kappa,
+        tau0=c.tau0,
+    )
+    points = []
+
+    def add(method, label, msd, seconds, at=times, **extra):
+        ok = at > 0
+        e_ref = float(np.max(np.abs(msd[ok] / _loglog_interp(at[ok], times, ref) - 1)))
+        th_at = theory.msd_viscoelastic(at[ok], c.D0, c.tau0)
+        slope = _loglog_slope(at, msd, t_fit)
+        points.append(
+            dict(
+                gas="viscoelastic",
+                xi=None,
+                method=method,
+                label=label,
+                seconds=seconds,
+                msd_error=e_ref,
+                slope_error=abs(slope / slope_ref - 1),
+                msd_error_theory=float(np.max(np.abs(msd[ok] / th_at - 1))),
+                slope_error_theory=abs(slope / slope_th - 1),
+                **extra,
+            )
+        )
+
+    for n, runs in [(250, 1), (1000, 1), (1000, 4), (4000, 1)] if not quick else [(125, 1)]:
+        msd, sec = _edmd_msd(n, law, runs, times, seed=n + runs)
+        add("edmd", f"N={n}, runs={runs}", msd, sec, n=n, runs=runs)
+    n_sde = 4000 if not quick else 500
+    dts = ([1e-2, 0.05, 0.1] if not quick else [1e-2]) + [1.9 / c.gamma0]
+    for scheme in ("em", "exact"):
+        for dt in dts:
+            t0 = clock()
+            r = langevin.run(
+                n_sde,
+                gamma0=c.gamma0,
+                D0=c.D0,
+                tau0=c.tau0,
+                exponent=VISCO_A,
+                dt=dt,
+                t_stop=t_max,
+                scheme=scheme,
+                sample_times=times,
+                seed=5,
+            )
+            sec = clock() - t0
+            add(
+                scheme,
+                f"UDSBM a=5/6 {scheme}, dt={dt:.3g}",
+                r.msd(),
+                sec,
+                at=r.times,
+                dt=dt,
+                n=n_sde,
+                gamma_dt=c.gamma0 * dt,
+            )
+    return points, ref_info
+
+
 def em_stability(quick=False):
     """MSD error of Euler-Maruyama and of the exact scheme against the Langevin theory as
     gamma0*dt grows, for the molecular gas' coefficients; EM refused at >= 2."""
@@ -240,29 +338,102 @@ def em_stability(quick=False):
     return rows
 
 
-def collapse_map(quick=False, contact_durations=(0.0, 1e-4), events_per_particle=4000):
+# The viscoelastic law's series holds for eps >= 0.76 only (granular.restitution.DELTA_MAX):
+# a constant xi is matched by a law only if at most this share of the initial collisions
+# would be faster than the law's max_speed (and get the clamped eps).
+MATCH_CLAMPED_SHARE = 0.01
+
+
+def matched_viscoelastic(xi, temperature, mass=1.0):
+    """The viscoelastic law with the same mean restitution as a constant xi, or None.
+
+    "Same mean restitution" as in tests/test_restitution.py's no-collapse test: eps(g)
+    averaged over the initial collisions of a gas at ``temperature``, whose normal relative
+    speeds g have the Rayleigh density g / s^2 exp(-g^2 / 2 s^2), s^2 = 2 T / m (collisions
+    weight the Gaussian normal relative velocity by g).  The mean falls with the damping
+    (bisection), down to about 0.76, the law's clamp: a xi whose matched law would send
+    more than ``MATCH_CLAMPED_SHARE`` of the initial collisions past ``max_speed`` is
+    outside the law's range, and None is returned with the reason.
+
+    Returns
+    -------
+    (law or None, dict)
+        The law (kappa = 1, the damping found) and {"mean_eps", "clamped_share"}; or None
+        and the share the closest law reached.
+    """
+    sd = math.sqrt(2.0 * temperature / mass)
+    g = np.linspace(0.0, 12 * sd, 20_001)
+    weight = g / sd**2 * np.exp(-(g**2) / (2 * sd**2))
+
+    def mean_eps(damping):
+        return float(np.trapezoid(Viscoelastic(damping, 1.0)(g) * weight, g))
+
+    def clamped(law):
+        return math.exp(-(law.max_speed**2) / (2 * sd**2))  # Rayleigh tail beyond max_speed
+
+    lo, hi = 1e-6, 10.0
+    if mean_eps(hi) > xi:  # even the strongest damping keeps the mean above xi
+        law = Viscoelastic(hi, 1.0)
+        return None, dict(mean_eps=mean_eps(hi), clamped_share=clamped(law))
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if mean_eps(mid) > xi else (lo, mid)
+    law = Viscoelastic(lo, 1.0)
+    info = dict(mean_eps=mean_eps(lo), clamped_share=clamped(law))
+    return (law if info["clamped_share"] <= MATCH_CLAMPED_SHARE else None), info
+
+
+# The collapse map's goal: at 100 collisions per particle constant xi = 0.8 does not yet
+# collapse anywhere, at 400 it does in the dense cells -- where the viscoelastic law of the
+# same mean restitution (the lowest xi it can match) is put to the test.
+COLLAPSE_GOAL = 400
+
+
+def collapse_map(
+    quick=False, contact_durations=(0.0, 1e-4), events_per_particle=4000, viscoelastic=True
+):
     """2D disks between walls (where the thesis met collapse): for each restitution and area
-    fraction, run to 100 collisions per particle (bounded by a budget of
+    fraction, run to ``COLLAPSE_GOAL`` collisions per particle (bounded by a budget of
     ``events_per_particle`` events per particle) and record 'collapse' (with time and
     particles), 'budget' (the budget ran out first: the run did not reach its goal), 'tc'
-    (it did, with the TC model acting) or 'ok'."""
+    (it did, with the TC model acting) or 'ok'.  Cells carry ``law``: "constant" (xi) or,
+    with ``viscoelastic``, "viscoelastic": the same scenes (no TC model) with the law of
+    the same mean restitution (``matched_viscoelastic``), or status 'n/a' where the law
+    cannot represent that xi."""
     n = 500 if not quick else 150
-    xis = (0.9, 0.7, 0.5, 0.3, 0.1) if not quick else (0.9, 0.3)
+    xis = (0.9, 0.8, 0.7, 0.5, 0.3, 0.1) if not quick else (0.9, 0.3)
     etas = (0.05, 0.2, 0.4, 0.6, 0.7) if not quick else (0.1, 0.5)
+    cases = [("constant", tc) for tc in contact_durations]
+    if viscoelastic:
+        cases.append(("viscoelastic", 0.0))
     cells = []
-    for tc in contact_durations:
+    for law_kind, tc in cases:
         for eta in etas:
             r = math.sqrt(eta / (n * math.pi))
             for xi in xis:
                 s = Scene.random(
                     n, r, dim=2, boundary="walls", restitution=xi, contact_duration=tc, seed=1
                 )
+                cell = dict(law=law_kind, contact_duration=tc, eta=eta, xi=xi)
+                if law_kind == "viscoelastic":
+                    law, info = matched_viscoelastic(xi, s.temperature)
+                    cell.update(info)
+                    if law is None:
+                        cell.update(status="n/a", seconds=0.0)
+                        cells.append(cell)
+                        continue
+                    s = s.replace(restitution=law)
                 sim = Simulation(s)
                 t0 = clock()
-                cell = dict(contact_duration=tc, eta=eta, xi=xi)
                 try:
-                    goal = {"collisions_per_particle": 100, "events": events_per_particle * n}
-                    tr = sim.run(stop_when=goal, store=())
+                    goal = {
+                        "collisions_per_particle": COLLAPSE_GOAL,
+                        "events": events_per_particle * n,
+                    }
+                    with warnings.catch_warnings():
+                        # a hot start's few collisions past the law's range: counted below
+                        warnings.simplefilter("ignore", RuntimeWarning)
+                        tr = sim.run(stop_when=goal, store=())
                     status = (
                         "budget"
                         if tr.stop_reason == "events"
@@ -276,6 +447,8 @@ def collapse_map(quick=False, contact_durations=(0.0, 1e-4), events_per_particle
                 cell.update(
                     seconds=clock() - t0,
                     tc_elastic_collisions=sim.stats["tc_elastic_collisions"],
+                    law_clamped_collisions=sim.stats["law_clamped_collisions"],
+                    pair_collisions=sim.stats["pair_collisions"],
                     collisions_per_particle=sim.stats["collisions_per_particle"],
                 )
                 cells.append(cell)
@@ -426,26 +599,31 @@ def scene_costs(quick=False):
 
 # the collapse map's outcomes, in legend order, with their colours and meanings
 COLLAPSE_STATUS = {
-    "ok": ("tab:green", "ok: reached 100 collisions per particle"),
+    "ok": ("tab:green", f"ok: reached {COLLAPSE_GOAL} collisions per particle"),
     "tc": ("tab:blue", "tc: reached it, TC model acting"),
     "budget": ("tab:orange", "budget: event budget ran out first"),
     "collapse": ("tab:red", "collapse: inelastic collapse"),
+    "n/a": ("0.6", "n/a: the viscoelastic law cannot reach this mean restitution"),
 }
 
 
 def _collapse_map(plt, cells):
-    """One panel per contact duration: a grid of cells (area fraction x restitution), each
+    """One panel per law and contact duration (constant xi without and with the TC model,
+    then the viscoelastic law): a grid of cells (area fraction x restitution), each
     coloured and labelled by its outcome; the legend lists only the outcomes that occur."""
     from matplotlib.patches import Patch, Rectangle
 
-    tcs = sorted({c["contact_duration"] for c in cells})
+    def panel(c):
+        return (c.get("law", "constant") != "constant", c["contact_duration"])
+
+    panels = sorted({panel(c) for c in cells})
     etas = sorted({c["eta"] for c in cells})
     xis = sorted({c["xi"] for c in cells})
     fig, axes = plt.subplots(
-        1, len(tcs), figsize=(4.5 * len(tcs) + 1.5, 4.2), layout="constrained", squeeze=False
+        1, len(panels), figsize=(4.5 * len(panels) + 1.5, 4.2), layout="constrained", squeeze=False
     )
-    for ax, tc in zip(axes[0], tcs, strict=True):
-        for c in (c for c in cells if c["contact_duration"] == tc):
+    for ax, (visco, tc) in zip(axes[0], panels, strict=True):
+        for c in (c for c in cells if panel(c) == (visco, tc)):
             x, y = etas.index(c["eta"]), xis.index(c["xi"])
             ax.add_patch(
                 Rectangle((x - 0.45, y - 0.45), 0.9, 0.9, color=COLLAPSE_STATUS[c["status"]][0])
@@ -455,10 +633,23 @@ def _collapse_map(plt, cells):
         ax.set_ylim(-0.5, len(xis) - 0.5)
         ax.set_xticks(range(len(etas)), [f"{e:g}" for e in etas])
         ax.set_yticks(range(len(xis)), [f"{x:g}" for x in xis])
-        ax.set_xlabel("area fraction")
-        ax.set_ylabel(r"restitution $\xi$")
+        ax.set_xlabel(
+            "area fraction"
+            if not visco
+            else "area fraction\n"
+            r"$\varepsilon(g)$ averaged over the initial collisions (Rayleigh density of the"
+            "\n"
+            r"normal impact speed $g$) equals $\xi$; the law's series holds for"
+            "\n"
+            r"$\varepsilon \geq 0.76$ only: $\xi \leq 0.7$ cannot be matched (n/a)",
+            fontsize=None if not visco else 8,
+        )
+        ax.set_ylabel(r"restitution $\xi$" if not visco else r"mean $\varepsilon$ = $\xi$")
         ax.set_title(
-            "2D disks, walls, " + ("no TC model" if tc == 0 else rf"TC model $t_c$ = {tc:g}")
+            "2D disks, walls, "
+            + ("no TC model" if tc == 0 else rf"TC model $t_c$ = {tc:g}")
+            + ("" if not visco else "\nviscoelastic law, same mean restitution"),
+            fontsize=10,
         )
     seen = {c["status"] for c in cells}
     fig.legend(
@@ -480,10 +671,16 @@ def _charts(out, points, refs, stab, cells, dense):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 2, figsize=(12, 9), layout="constrained")
-    for col, gas in enumerate(("granular", "molecular")):
+    gases = [
+        g for g in ("granular", "molecular", "viscoelastic") if any(p["gas"] == g for p in points)
+    ]
+    fig, axes = plt.subplots(
+        2, len(gases), figsize=(6 * len(gases), 9), layout="constrained", squeeze=False
+    )
+    for col, gas in enumerate(gases):
         for row, key in enumerate(("msd_error", "slope_error")):
             ax = axes[row, col]
+            model = "power-law UDSBM a = 5/6" if gas == "viscoelastic" else "Langevin/UDSBM"
             for method, marker in (("edmd", "o"), ("em", "s"), ("exact", "^")):
                 pts = [p for p in points if p["gas"] == gas and p["method"] == method]
                 if not pts:
@@ -499,8 +696,8 @@ def _charts(out, points, refs, stab, cells, dense):
                     marker,
                     label={
                         "edmd": "EDMD (N, runs)",
-                        "em": r"Langevin/UDSBM, Euler-Maruyama ($\Delta t$)",
-                        "exact": r"Langevin/UDSBM, exact scheme ($\Delta t$)",
+                        "em": rf"{model}, Euler-Maruyama ($\Delta t$)",
+                        "exact": rf"{model}, exact scheme ($\Delta t$)",
                     }[method],
                 )
                 for p in pts if method == "edmd" else (pts[0], pts[-1]):
@@ -515,9 +712,18 @@ def _charts(out, points, refs, stab, cells, dense):
             ax.set_ylabel(
                 "max relative MSD error vs EDMD reference"
                 if key == "msd_error"
+                else "relative error of the late exponent d ln MSD / d ln t"
+                if gas == "viscoelastic"
                 else "relative error of the long-time slope"
             )
-            ax.set_title(f"{gas} gas" + (r", $\xi$ = 0.8" if gas == "granular" else ""))
+            ax.set_title(
+                f"{gas} gas"
+                + {
+                    "granular": r", $\xi$ = 0.8",
+                    "molecular": "",
+                    "viscoelastic": rf", $\varepsilon$ = {VISCO_EPS} at $g = \sqrt{{4T_0/m}}$",
+                }[gas]
+            )
             ax.legend(fontsize=7)
     fig.savefig(os.path.join(out, "speed_accuracy.png"), dpi=110)
     plt.close(fig)
@@ -562,6 +768,8 @@ def main(out="speed-accuracy", quick=False):
     os.makedirs(out, exist_ok=True)
     started = time.perf_counter()
     points, refs = speed_accuracy_points(quick)
+    visco_points, refs["viscoelastic"] = viscoelastic_points(quick)
+    points += visco_points
     print(
         f"  speed/accuracy points: {len(points)}  ({time.perf_counter() - started:.0f} s)",
         flush=True,
