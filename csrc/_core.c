@@ -496,17 +496,22 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     static char *names[] = {"dim", "model", "scheme", "gamma0", "D0", "tau0", "dt", "key",
                             "n", "first", "step_from", "step_to", "n_steps", "x", "v",
                             "sample_steps", "x2", "v2", "positions", "lags", "tamsd", "ring",
-                            NULL};
+                            "carry", "threads", NULL};
     gr_sde_config cfg;
     unsigned long long key;
     long long n, first, step_from, step_to, n_steps;
-    PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO", names, &cfg.dim,
+    PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring, *ocarry = Py_None;
+    int threads = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO|Oi", names, &cfg.dim,
                                      &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0, &cfg.tau0,
                                      &cfg.dt, &key, &n, &first, &step_from, &step_to, &n_steps,
                                      &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags, &otamsd,
-                                     &oring))
+                                     &oring, &ocarry, &threads))
         return NULL;
+    if (threads < 1) {
+        PyErr_Format(PyExc_ValueError, "threads must be >= 1, got %d", threads);
+        return NULL;
+    }
     cfg.key = key;
     if (cfg.dim < 1 || cfg.dim > 3 || n < 0 || first < 0) {
         PyErr_SetString(PyExc_ValueError, "dim must be 1..3 and n, first non-negative");
@@ -567,6 +572,10 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     if (!out.ring) return NULL;
     if (opos != Py_None && !(out.positions = inout(opos, "positions", NPY_FLOAT64, tnd)))
         return NULL;
+    npy_intp tdd;
+    if (ocarry != Py_None && (!mul_size(td, 2, &tdd, "carry") ||
+                              !(out.carry = inout(ocarry, "carry", NPY_FLOAT64, tdd))))
+        return NULL;
     for (npy_intp k = 0; k < T; k++)
         if (out.sample_steps[k] < 0 || (k > 0 && out.sample_steps[k] <= out.sample_steps[k - 1])) {
             PyErr_SetString(PyExc_ValueError, "sample_steps must be increasing and >= 0");
@@ -596,7 +605,8 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
     int status;
     Py_BEGIN_ALLOW_THREADS
-    status = gr_sde_run(&cfg, n, first, count, step_from, step_to, n_steps, x, v, &out, &err);
+    status = gr_sde_run(&cfg, n, first, count, step_from, step_to, n_steps, x, v, &out, threads,
+                        &err);
     Py_END_ALLOW_THREADS
     PyMem_Free(ints);
     PyMem_Free(coef);
@@ -650,10 +660,12 @@ static PyMethodDef core_methods[] = {
     /* ==== SDE methods begin ==== */
     {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
      "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
-     " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring): advance particles"
-     " first..first+len(x) over the steps [step_from, step_to) of a run of n_steps,"
-     " accumulating into the given arrays; ring (sde_ring_size doubles) carries one particle"
-     " from segment to segment (internal: use granular.langevin)."},
+     " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring, carry=None,"
+     " threads=1): advance particles first..first+len(x) over the steps [step_from, step_to)"
+     " of a run of n_steps on `threads` threads, accumulating into the given arrays; ring"
+     " (sde_ring_size doubles) carries one particle from segment to segment, carry"
+     " (2 x len(sample_steps) x dim doubles) the sums of a block of particles left open"
+     " (internal: use granular.langevin)."},
     {"sde_lag_stride", sde_lag_stride, METH_O, "spacing of TAMSD window starts for a lag (steps)"},
     {"sde_ring_size", sde_ring_size, METH_VARARGS,
      "sde_ring_size(dim, lags): doubles of sde_run's ring for these lags (steps, each >= 1)"},

@@ -8,6 +8,8 @@
  * O(N x steps)).  Invariant: a particle's random numbers depend only on (key, step,
  * particle), never on the order of work. */
 #include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rng.h"
@@ -137,9 +139,138 @@ static int64_t first_sample_from(const gr_sde_output *out, int64_t step)
     return lo;
 }
 
+/* Everything one particle's run over the call's segment reads or writes besides its own
+ * state: shared read-only setup, and the scratch and sums of the thread that runs it. */
+typedef struct {
+    const gr_sde_config *cfg;
+    const step_params *sp;
+    const gr_sde_output *out;
+    int64_t n, step_from, step_to, n_steps, ks0;
+} run_shared;
+
+/* Particle i over the segment: x, v its state (d values each) in and out; the samples'
+ * squares are added to x2, v2 (n_samples x d each: its block's sums), its TAMSD windows
+ * to out->tamsd; ring and lag_work are the running thread's scratch (the ring carries
+ * over between segments).  Returns GR_OK or GR_ERR_NONFINITE. */
+static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, double *x2,
+                        double *v2, double *ring, int64_t *lag_work)
+{
+    const gr_sde_output *out = rs->out;
+    const int d = rs->cfg->dim;
+    const int64_t n = rs->n, step_from = rs->step_from, step_to = rs->step_to;
+    const int64_t n_steps = rs->n_steps;
+    double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0};
+    for (int a = 0; a < d; a++) {
+        xi[a] = x[a];
+        vi[a] = v[a];
+    }
+    int64_t ks = rs->ks0;
+    /* Per lag: next window end, next store, their ring slots (no divisions per step).
+     * The k-th store (k = 0, 1, ...) is at step k stride into slot k mod len, the k-th
+     * window ends at lag + k stride and reads that slot: so the counters at step_from
+     * follow from step_from alone, and only the ring carries over between segments. */
+    int64_t *next_end = lag_work, *next_store = next_end + out->n_lags;
+    int64_t *slot_end = next_store + out->n_lags, *slot_store = slot_end + out->n_lags;
+    for (int64_t l = 0; l < out->n_lags; l++) {
+        const int64_t lag = out->lags[l], stride = out->lag_stride[l], len = out->lag_len[l];
+        int64_t k = step_from / stride + (step_from % stride != 0);
+        next_store[l] = k * stride;
+        slot_store[l] = k % len;
+        k = step_from <= lag ? 0 : (step_from - lag - 1) / stride + 1;
+        next_end[l] = lag + k * stride;
+        slot_end[l] = k % len;
+    }
+    /* Bookkeeping (samples, TAMSD windows) happens at few steps; between them the
+     * particle is stepped in a tight loop.  Step 0, the start, is a sample and a
+     * window start for every lag. */
+    for (int64_t step = step_from;;) {
+        if (step == step_to && step_to < n_steps) break; /* booked by the next segment */
+        while (ks < out->n_samples && out->sample_steps[ks] == step) {
+            for (int a = 0; a < d; a++) {
+                x2[ks * d + a] += xi[a] * xi[a];
+                v2[ks * d + a] += vi[a] * vi[a];
+                if (out->positions) out->positions[(ks * n + i) * d + a] = xi[a];
+            }
+            ks++;
+        }
+        int64_t next = step_to; /* the next step that needs bookkeeping */
+        if (ks < out->n_samples && out->sample_steps[ks] < next) next = out->sample_steps[ks];
+        double *r = ring;
+        for (int64_t l = 0; l < out->n_lags; l++) {
+            const int64_t stride = out->lag_stride[l], len = out->lag_len[l];
+            if (step == next_end[l]) {
+                const double *old = r + slot_end[l] * d;
+                double sum = 0.0;
+                for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
+                out->tamsd[i * out->n_lags + l] += sum;
+                next_end[l] += stride;
+                if (++slot_end[l] == len) slot_end[l] = 0;
+            }
+            if (step == next_store[l]) {
+                memcpy(r + slot_store[l] * d, xi, (size_t)d * sizeof(double));
+                next_store[l] += stride;
+                if (++slot_store[l] == len) slot_store[l] = 0;
+            }
+            if (next_end[l] < next) next = next_end[l];
+            if (next_store[l] < next) next = next_store[l];
+            r += len * d;
+        }
+        if (step == n_steps) break;
+        /* steps step+1 .. next, each with its own dimension so that the axis loops
+         * unroll */
+        switch (d) {
+        case 1: run_steps(1, rs->sp, i, step, next, xi, vi); break;
+        case 2: run_steps(2, rs->sp, i, step, next, xi, vi); break;
+        default: run_steps(3, rs->sp, i, step, next, xi, vi); break;
+        }
+        step = next;
+    }
+    for (int a = 0; a < d; a++) {
+        if (!isfinite(xi[a]) || !isfinite(vi[a])) return GR_ERR_NONFINITE;
+        x[a] = xi[a];
+        v[a] = vi[a];
+    }
+    return GR_OK;
+}
+
+/* One thread's share of a call: particles [lo, hi) (whole blocks, but for the call's
+ * first and last), their sample sums into the blocks' rows of `sums`. */
+typedef struct {
+    const run_shared *rs;
+    int64_t lo, hi;       /* global particle indices */
+    int64_t first;        /* the call's first particle: x, v and sums start there */
+    double *x, *v;        /* the call's state arrays */
+    double *sums;         /* the call's block sums, row 0 for the block of `first` */
+    double *ring;         /* this thread's scratch */
+    int64_t *lag_work;
+    int status;
+    int64_t bad;          /* the particle that failed, or -1 */
+} worker;
+
+static void *work(void *arg)
+{
+    worker *w = arg;
+    const int d = w->rs->cfg->dim;
+    const int64_t row = 2 * w->rs->out->n_samples * d, b0 = w->first / GR_SDE_BLOCK;
+    w->status = GR_OK;
+    w->bad = -1;
+    for (int64_t i = w->lo; i < w->hi; i++) {
+        double *s = w->sums + (i / GR_SDE_BLOCK - b0) * row;
+        const int64_t at = (i - w->first) * d;
+        int st = run_particle(w->rs, i, w->x + at, w->v + at, s,
+                              s + w->rs->out->n_samples * d, w->ring, w->lag_work);
+        if (st != GR_OK) {
+            w->status = st;
+            w->bad = i;
+            break;
+        }
+    }
+    return NULL;
+}
+
 int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
                int64_t step_from, int64_t step_to, int64_t n_steps, double *x, double *v,
-               gr_sde_output *out, gr_error *err)
+               gr_sde_output *out, int threads, gr_error *err)
 {
     const int d = cfg->dim;
     const double dt = cfg->dt, g0 = cfg->gamma0, D0 = cfg->D0, tau0 = cfg->tau0;
@@ -148,7 +279,8 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
     if (d < 1 || d > 3 || !(dt > 0.0) || !(g0 > 0.0) || !(D0 > 0.0) || !(tau0 > 0.0) ||
         n_steps < 0 || n_steps > GR_SDE_MAX_STEPS || step_from < 0 || step_from > step_to ||
         step_to > n_steps || first < 0 || count < 0 || first > n || count > n - first ||
-        (!whole && count > 1)) {
+        (!whole && count > 1) || threads < 1 || out->n_samples < 0 ||
+        out->n_samples > INT64_MAX / 6) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, "invalid SDE parameters");
         return GR_ERR_VALUE;
     }
@@ -158,6 +290,7 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
                      "exact scheme (scheme='exact'), stable at any step");
         return GR_ERR_UNSTABLE;
     }
+    if (count == 0) return GR_OK;
     if (!gr_rng_ready) gr_rng_init();
     const double sq_dt = sqrt(dt), b0 = sqrt(2.0 * D0) * g0 * sq_dt;
     const exact_coef ex0 = exact_for(g0, D0, dt);
@@ -169,87 +302,91 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
             table[st - step_from] = exact_for(g0 * s, D0 * s, dt);
         }
     }
-
     const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, udsbm, cfg->scheme == GR_SDE_EM,
                             ex0, table, step_from};
-    /* where the segment starts among the samples */
-    const int64_t ks0 = first_sample_from(out, step_from);
-    for (int64_t local = 0; local < count; local++) {
-        const int64_t i = first + local;
-        double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0};
-        for (int a = 0; a < d; a++) {
-            xi[a] = x[local * d + a];
-            vi[a] = v[local * d + a];
+    const run_shared rs = {cfg, &sp, out, n, step_from, step_to, n_steps,
+                           first_sample_from(out, step_from)};
+
+    /* The ensemble sums, the same bits for any split: each block of GR_SDE_BLOCK particles
+     * (by global index) sums its particles in index order from zero (or from the carry a
+     * previous call left for a block it began), and complete blocks are added to x2, v2
+     * in block order after every thread is done.  A thread takes whole blocks. */
+    const int64_t T = out->n_samples, row = 2 * T * d;
+    const int64_t b_first = first / GR_SDE_BLOCK, b_last = (first + count - 1) / GR_SDE_BLOCK;
+    const int64_t nb = b_last - b_first + 1;
+    if (row > 0 && nb > (int64_t)(SIZE_MAX / sizeof(double)) / row) {
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "the block sums' size overflows");
+        return GR_ERR_NOMEM;
+    }
+    double *sums = calloc((size_t)(nb * row) + 1, sizeof(double));
+    if (!sums) {
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "no memory for the block sums");
+        return GR_ERR_NOMEM;
+    }
+    if (out->carry) memcpy(sums, out->carry, (size_t)row * sizeof(double));
+    int64_t nt = threads < nb ? threads : nb;
+    /* scratch per extra thread: its ring and lag counters (thread 0 has out's) */
+    const int64_t ring_n = gr_sde_ring_size(d, out->n_lags, out->lags);
+    const int64_t work_n = 4 * out->n_lags;
+    double *rings = NULL;
+    int64_t *works = NULL;
+    worker *ws = calloc((size_t)nt, sizeof(worker));
+    pthread_t *tid = calloc((size_t)nt, sizeof(pthread_t));
+    int *started = calloc((size_t)nt, sizeof(int));
+    if (nt > 1) {
+        rings = calloc((size_t)((nt - 1) * ring_n) + 1, sizeof(double));
+        works = calloc((size_t)((nt - 1) * work_n) + 1, sizeof(int64_t));
+    }
+    if (!ws || !tid || !started || (nt > 1 && (!rings || !works)) || ring_n < 0) {
+        free(sums), free(ws), free(tid), free(started), free(rings), free(works);
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "no memory for the SDE threads");
+        return GR_ERR_NOMEM;
+    }
+    for (int64_t t = 0; t < nt; t++) {
+        /* thread t takes blocks [b_first + nb t / nt, b_first + nb (t+1) / nt) */
+        const int64_t lo = (b_first + nb * t / nt) * GR_SDE_BLOCK;
+        const int64_t hi = (b_first + nb * (t + 1) / nt) * GR_SDE_BLOCK;
+        ws[t] = (worker){&rs, lo > first ? lo : first, hi < first + count ? hi : first + count,
+                         first, x, v, sums,
+                         t == 0 ? out->ring : rings + (t - 1) * ring_n,
+                         t == 0 ? out->lag_work : works + (t - 1) * work_n, GR_OK, -1};
+    }
+    /* threads 1.. run beside this one; one that cannot be started runs here afterwards
+     * (the same numbers, later) */
+    for (int64_t t = 1; t < nt; t++) started[t] = pthread_create(&tid[t], NULL, work, &ws[t]) == 0;
+    work(&ws[0]);
+    for (int64_t t = 1; t < nt; t++) {
+        if (started[t]) pthread_join(tid[t], NULL);
+        else work(&ws[t]);
+    }
+    int status = GR_OK;
+    for (int64_t t = 0; t < nt; t++)
+        if (ws[t].status != GR_OK) { /* the first failure in particle order */
+            status = ws[t].status;
+            gr_error_set(err, status, ws[t].bad, -1, NAN, NAN, "in the SDE state");
+            break;
         }
-        int64_t ks = ks0;
-        /* Per lag: next window end, next store, their ring slots (no divisions per step).
-         * The k-th store (k = 0, 1, ...) is at step k stride into slot k mod len, the k-th
-         * window ends at lag + k stride and reads that slot: so the counters at step_from
-         * follow from step_from alone, and only the ring carries over between segments. */
-        int64_t *next_end = out->lag_work, *next_store = next_end + out->n_lags;
-        int64_t *slot_end = next_store + out->n_lags, *slot_store = slot_end + out->n_lags;
-        for (int64_t l = 0; l < out->n_lags; l++) {
-            const int64_t lag = out->lags[l], stride = out->lag_stride[l], len = out->lag_len[l];
-            int64_t k = step_from / stride + (step_from % stride != 0);
-            next_store[l] = k * stride;
-            slot_store[l] = k % len;
-            k = step_from <= lag ? 0 : (step_from - lag - 1) / stride + 1;
-            next_end[l] = lag + k * stride;
-            slot_end[l] = k % len;
-        }
-        /* Bookkeeping (samples, TAMSD windows) happens at few steps; between them the
-         * particle is stepped in a tight loop.  Step 0, the start, is a sample and a
-         * window start for every lag. */
-        for (int64_t step = step_from;;) {
-            if (step == step_to && step_to < n_steps) break; /* booked by the next segment */
-            while (ks < out->n_samples && out->sample_steps[ks] == step) {
-                for (int a = 0; a < d; a++) {
-                    out->x2[ks * d + a] += xi[a] * xi[a];
-                    out->v2[ks * d + a] += vi[a] * vi[a];
-                    if (out->positions) out->positions[(ks * n + i) * d + a] = xi[a];
-                }
-                ks++;
+    if (status == GR_OK) {
+        /* Blocks complete in this call go to x2, v2 in order; the last, if a later call
+         * continues it (more of its particles, or more of this particle's steps), stays
+         * in the carry.  Without a carry the call ends the sums. */
+        const int64_t end = first + count;
+        const int done = step_to == n_steps;
+        for (int64_t b = 0; b < nb; b++) {
+            const double *s = sums + b * row;
+            int64_t block_end = (b_first + b + 1) * GR_SDE_BLOCK;
+            if (block_end > n) block_end = n;
+            if (out->carry && (!done || end < block_end)) {
+                memcpy(out->carry, s, (size_t)row * sizeof(double));
+                break; /* only the last block can be open */
             }
-            int64_t next = step_to; /* the next step that needs bookkeeping */
-            if (ks < out->n_samples && out->sample_steps[ks] < next) next = out->sample_steps[ks];
-            double *r = out->ring;
-            for (int64_t l = 0; l < out->n_lags; l++) {
-                const int64_t stride = out->lag_stride[l], len = out->lag_len[l];
-                if (step == next_end[l]) {
-                    const double *old = r + slot_end[l] * d;
-                    double sum = 0.0;
-                    for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
-                    out->tamsd[i * out->n_lags + l] += sum;
-                    next_end[l] += stride;
-                    if (++slot_end[l] == len) slot_end[l] = 0;
-                }
-                if (step == next_store[l]) {
-                    memcpy(r + slot_store[l] * d, xi, (size_t)d * sizeof(double));
-                    next_store[l] += stride;
-                    if (++slot_store[l] == len) slot_store[l] = 0;
-                }
-                if (next_end[l] < next) next = next_end[l];
-                if (next_store[l] < next) next = next_store[l];
-                r += len * d;
+            for (int64_t k = 0; k < T * d; k++) {
+                out->x2[k] += s[k];
+                out->v2[k] += s[T * d + k];
             }
-            if (step == n_steps) break;
-            /* steps step+1 .. next, each with its own dimension so that the axis loops
-             * unroll */
-            switch (d) {
-            case 1: run_steps(1, &sp, i, step, next, xi, vi); break;
-            case 2: run_steps(2, &sp, i, step, next, xi, vi); break;
-            default: run_steps(3, &sp, i, step, next, xi, vi); break;
-            }
-            step = next;
-        }
-        for (int a = 0; a < d; a++) {
-            if (!isfinite(xi[a]) || !isfinite(vi[a])) {
-                gr_error_set(err, GR_ERR_NONFINITE, i, -1, NAN, NAN, "in the SDE state");
-                return GR_ERR_NONFINITE;
-            }
-            x[local * d + a] = xi[a];
-            v[local * d + a] = vi[a];
+            if (out->carry) memset(out->carry, 0, (size_t)row * sizeof(double));
         }
     }
-    return GR_OK;
+    free(sums), free(ws), free(tid), free(started), free(rings), free(works);
+    return status;
 }

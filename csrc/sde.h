@@ -7,7 +7,9 @@
  * Schemes: Euler-Maruyama exactly as the thesis' (2.92)/(2.110), or the exact update of
  * the Ornstein-Uhlenbeck process over a step (coefficients frozen at the step's midpoint
  * for UDSBM).  Random numbers come from rng.h, keyed by (step, particle): results do not
- * depend on chunking.  The caller owns every buffer; nothing is allocated here. */
+ * depend on chunking or threads.  The caller owns the inputs, outputs and the carried
+ * scratch; a call allocates only its threads' scratch and the block sums (freed before
+ * it returns). */
 #ifndef GR_SDE_H
 #define GR_SDE_H
 
@@ -30,9 +32,14 @@ typedef struct {
  * INT64_MAX (a stride is at most lag/16 and lags beyond the run are never reached). */
 #define GR_SDE_MAX_STEPS ((int64_t)1 << 62)
 
+/* Particles per block of the ensemble sums: x2 and v2 are sums, in block order, of each
+ * block's sum over its particles in index order -- an order fixed by the particles'
+ * indices alone, so the bits are the same however the particles are split into calls and
+ * threads. */
+#define GR_SDE_BLOCK 32
+
 /* What a run accumulates.  Sample k is taken after step sample_steps[k] (0 = the start);
- * lags are in steps.  Sums run over particles in index order, so they are the same
- * however the particles and steps are chunked. */
+ * lags are in steps. */
 typedef struct {
     int64_t n_samples;
     const int64_t *sample_steps; /* increasing, >= 0 */
@@ -48,6 +55,11 @@ typedef struct {
     double *ring;                /* gr_sde_ring_size doubles: one particle's past positions
                                     per lag.  Scratch for a whole run; carried from call to
                                     call when a run is split into step segments */
+    double *carry;               /* 2 x n_samples x dim (x2's then v2's), or NULL: the sums
+                                    of a block a call leaves open (its last particles, or
+                                    the rest of its particle's steps, come in a later call);
+                                    zero at the start of a run.  NULL: the call ends the
+                                    sums (its last block is added to x2, v2) */
     double *step_coef;           /* optional scratch, 5 x (step_to - step_from): the exact
                                     scheme's UDSBM coefficients per step, computed once per
                                     call instead of once per particle and step; NULL
@@ -69,10 +81,12 @@ int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags);
  * and at n_steps when step_to = n_steps, so a run is one call over [0, n_steps] or calls
  * over consecutive segments [s0 = 0, s1), [s1, s2), ..., ending at n_steps, with the same
  * results to the bit.  A segment that is not the whole run takes one particle (count <= 1)
- * and the ring its previous segment left.  Returns GR_OK, GR_ERR_VALUE, GR_ERR_NONFINITE
- * or GR_ERR_UNSTABLE (Euler-Maruyama with gamma0 dt >= 2). */
+ * and the ring its previous segment left.  The particles are split into `threads` (>= 1)
+ * POSIX threads by whole blocks; the results are the same to the bit for any count.
+ * Returns GR_OK, GR_ERR_VALUE, GR_ERR_NOMEM, GR_ERR_NONFINITE or GR_ERR_UNSTABLE
+ * (Euler-Maruyama with gamma0 dt >= 2). */
 int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
                int64_t step_from, int64_t step_to, int64_t n_steps, double *x, double *v,
-               gr_sde_output *out, gr_error *err);
+               gr_sde_output *out, int threads, gr_error *err);
 
 #endif

@@ -36,6 +36,7 @@ max(1, lag/16) steps, so each particle needs at most 32 past positions per lag).
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -377,6 +378,18 @@ def theory_tamsd(
     return np.array(out)
 
 
+def _threads(threads: int | None) -> int:
+    """The number of threads asked for, checked; None: the cores this process may use."""
+    if threads is None:
+        try:
+            return max(1, len(os.sched_getaffinity(0)))
+        except AttributeError:  # not on Linux
+            return max(1, os.cpu_count() or 1)
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ValueError(f"threads must be a whole number >= 1 or None, got {threads!r}")
+    return min(int(threads), 1024)
+
+
 def _positive(name: str, value: float) -> float:
     value = float(value)
     if not (value > 0 and math.isfinite(value)):
@@ -402,6 +415,7 @@ def run(
     store_positions: bool = False,
     seed: Any = None,
     progress: bool = False,
+    threads: int | None = None,
 ) -> LangevinResult:
     """Integrate N independent particles from a common start at the origin.
 
@@ -429,10 +443,23 @@ def run(
     store_positions : keep (T, N, d) positions at the sample times
     seed : anything ``numpy.random.SeedSequence`` takes
     progress : tqdm bar over particle-steps
+    threads : how many threads step the particles (None: one per core this process may
+        run on).  The results are the same to the bit for any number: each particle's
+        random numbers depend on (seed, step, particle) only, and the ensemble sums add
+        fixed blocks of particles in a fixed order.  A run of fewer particles than
+        threads, or so long that one particle is stepped at a time, uses fewer.
+
+    Raises
+    ------
+    ValueError
+        For a parameter out of its range (named in the message).
+    UnstableStepError
+        Euler-Maruyama with gamma0 dt >= 2.
     """
     n = int(n)
     if n < 1:
         raise ValueError(f"n must be >= 1, got {n}")
+    threads = _threads(threads)
     if dim not in (1, 2, 3):
         raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
     gamma0, D0, dt, t_stop = (
@@ -537,10 +564,13 @@ def run(
     # else one particle at a time over segments of its steps (the C core carries such a
     # particle's past positions from segment to segment in `ring`).  The same numbers to
     # the bit either way.
+    # A call of blocks of particles takes `threads` times the work (the threads share it);
+    # a segment of one particle's steps runs on one thread.
     work = max(1, _CHUNK_PARTICLE_STEPS)
-    per_call = max(1, work // n_steps)
     steps_per_call = min(n_steps, work)
+    per_call = max(1, work * threads // n_steps) if steps_per_call == n_steps else 1
     ring = np.zeros(_core.sde_ring_size(dim, lags))
+    carry = np.zeros((2, T, dim))  # the ensemble sums of a block of particles left open
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -575,6 +605,8 @@ def run(
                     lags,
                     tamsd_sum,
                     ring,
+                    carry,
+                    threads,
                 )
                 if bar is not None:
                     bar.update(len(xs) * (step_to - step_from))
