@@ -310,6 +310,56 @@ def test_same_seed_same_result_whatever_the_chunking(monkeypatch, model, tau0, s
     assert not np.array_equal(a.positions, c.positions)
 
 
+@pytest.mark.parametrize("model,tau0", [("langevin", math.inf), ("udsbm", TAU0)])
+@pytest.mark.parametrize("scheme", ["em", "exact"])
+@pytest.mark.parametrize("dim", [1, 2, 3])
+@pytest.mark.parametrize("lags", [None, [0.01, 0.05, 0.13, 0.5]])
+def test_same_bits_for_any_number_of_threads(monkeypatch, model, tau0, scheme, dim, lags):
+    """threads = 1, 2, 3, 7 give the same bits (np.array_equal) -- the ensemble sums too,
+    whose blocks of 32 particles are added in order whatever thread summed them.  250
+    particles are 8 blocks, the last one short, so 7 threads split them unevenly; then
+    the same with calls of 45 x threads particles, so that calls begin and end inside
+    blocks and a thread's first and last blocks are partial (the carry)."""
+    kw = dict(
+        gamma0=G0,
+        D0=D0,
+        tau0=tau0,
+        model=model,
+        scheme=scheme,
+        dim=dim,
+        dt=0.01,
+        t_stop=0.5,
+        sample_times=np.arange(0, 51, 5) * 0.01,
+        tamsd_lags=lags,
+        store_positions=True,
+        seed=11,
+    )
+    names = (
+        "msd_per_dimension",
+        "v2",
+        "tamsd_per_particle",
+        "positions",
+        "final_positions",
+        "final_velocities",
+    )
+    a = langevin.run(250, threads=1, **kw)
+    for chunked in (False, True):
+        if chunked:
+            monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", 45 * 50)
+        for threads in (1, 2, 3, 7):
+            b = langevin.run(250, threads=threads, **kw)
+            for name in names:
+                assert np.array_equal(getattr(a, name), getattr(b, name)), (threads, name)
+    # the sums are not all zeros or copies: a particle's noise is its own
+    assert a.msd_total[-1] > 0 and not np.array_equal(a.final_positions[0], a.final_positions[1])
+
+
+@pytest.mark.parametrize("threads", [0, -1, 1.5, "2", True])
+def test_refuses_a_bad_thread_count(threads):
+    with pytest.raises(ValueError, match="threads must be"):
+        langevin.run(10, gamma0=G0, D0=D0, dt=0.01, t_stop=0.1, threads=threads)
+
+
 def test_ctrl_c_stops_a_long_run_of_one_particle():
     """SIGINT reaches a run of one particle and many steps between calls into C: the work
     is chunked by particle-steps, not by particles.  The run is 2e9 Euler-Maruyama steps,
