@@ -115,8 +115,9 @@ def run(quick=False, large=False, langevin=True, out=print):
                 results.append(r)
                 out(
                     f"{r['name']:<28} N={r['n']:>8}  {r['particle_steps_per_second'] / 1e6:8.1f} M "
-                    f"particle-steps/s  (NumPy: {r['numpy_particle_steps_per_second'] / 1e6:.1f} "
-                    f"M/s; peak {r['peak_memory_mb']:.1f} MB)"
+                    f"particle-steps/s on {r['threads']} thread(s)  (NumPy: "
+                    f"{r['numpy_particle_steps_per_second'] / 1e6:.1f} M/s; peak "
+                    f"{r['peak_memory_mb']:.1f} MB; load {r['load_average']:.1f})"
                 )
     return results
 
