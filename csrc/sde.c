@@ -4,9 +4,10 @@
  *
  * Each particle is independent, so the loop runs over particles outside and steps
  * inside: a particle's state stays in registers for the whole run, and the TAMSD needs
- * only the ring of one particle's recent positions at a time (O(lags) memory, not
- * O(N x steps)).  Invariant: a particle's random numbers depend only on (key, step,
- * particle), never on the order of work. */
+ * only the rings of one particle's past positions at a time (tamsd.h: O(levels) memory,
+ * not O(N x steps)).  The particles are split over threads by blocks (sde.h).
+ * Invariant: a particle's random numbers depend only on (key, step, particle), never on
+ * the order of work. */
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -14,31 +15,7 @@
 
 #include "rng.h"
 #include "sde.h"
-
-#define GR_TAMSD_WINDOWS_PER_LAG 16
-
-int64_t gr_sde_lag_stride(int64_t lag)
-{
-    int64_t s = lag / GR_TAMSD_WINDOWS_PER_LAG;
-    return s < 1 ? 1 : s;
-}
-
-int64_t gr_sde_ring_len(int64_t lag)
-{
-    /* ceil(lag / s) + 1, written so that no intermediate exceeds lag */
-    return (lag - 1) / gr_sde_lag_stride(lag) + 2;
-}
-
-int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags)
-{
-    int64_t total = 0;
-    for (int64_t l = 0; l < n_lags; l++) {
-        const int64_t need = gr_sde_ring_len(lags[l]) * dim; /* <= 32 x 3 */
-        if (total > INT64_MAX - need) return -1;
-        total += need;
-    }
-    return total;
-}
+#include "tamsd.h"
 
 /* x-noise variance of the exact step in units of D/gamma, minus the part explained by the
  * velocity noise: g(h) = 2 f(h) - (1-c)^3/(1+c), c = exp(-h), with
@@ -145,15 +122,56 @@ typedef struct {
     const gr_sde_config *cfg;
     const step_params *sp;
     const gr_sde_output *out;
+    const gr_tamsd_plan *plan;
     int64_t n, step_from, step_to, n_steps, ks0;
 } run_shared;
 
+/* The TAMSD's bookkeeping at step t of a particle at xi (tamsd.h): first the windows
+ * ending at t, read from the rings (before t's own stores, which may reuse a slot), then
+ * the stores of the levels whose stride divides t. */
+static GR_ALWAYS_INLINE void tamsd_book(const int d, const gr_tamsd_plan *p, int64_t t,
+                                        const double *xi, double *ring, double *acc,
+                                        int64_t *slow_next, int64_t *next_slow)
+{
+    const int64_t ph = t & p->phase_mask;
+    for (int64_t k = p->phase_off[ph]; k < p->phase_off[ph + 1]; k++) {
+        const int64_t l = p->phase_lag[k], lag = p->lags[l];
+        if (t < lag) continue; /* the window would start before step 0 */
+        const double *old =
+            ring + p->lag_off[l] + (((t - lag) >> p->lag_level[l]) & p->lag_mask[l]) * d;
+        double sum = 0.0;
+        for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
+        acc[l] += sum;
+    }
+    if (t == *next_slow) {
+        int64_t soonest = INT64_MAX;
+        for (int64_t j = 0; j < p->n_slow; j++) {
+            const int64_t l = p->slow[j], e = p->lag_level[l];
+            if (slow_next[j] == t) {
+                const double *old =
+                    ring + p->lag_off[l] + (((t - p->lags[l]) >> e) & p->lag_mask[l]) * d;
+                double sum = 0.0;
+                for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
+                acc[l] += sum;
+                slow_next[j] += (int64_t)1 << e;
+            }
+            if (slow_next[j] < soonest) soonest = slow_next[j];
+        }
+        *next_slow = soonest;
+    }
+    /* level e stores at multiples of 2^e: levels 0 .. (trailing zeros of t) */
+    for (int e = 0; e <= p->top && (e == 0 || (t & (((int64_t)1 << e) - 1)) == 0); e++)
+        if (p->used >> e & 1)
+            memcpy(ring + p->level_off[e] + ((t >> e) & p->level_mask[e]) * d, xi,
+                   (size_t)d * sizeof(double));
+}
+
 /* Particle i over the segment: x, v its state (d values each) in and out; the samples'
  * squares are added to x2, v2 (n_samples x d each: its block's sums), its TAMSD windows
- * to out->tamsd; ring and lag_work are the running thread's scratch (the ring carries
- * over between segments).  Returns GR_OK or GR_ERR_NONFINITE. */
+ * to out->tamsd; ring and slow_next (a step per slow lag) are the running thread's
+ * scratch (the ring carries over between segments).  Returns GR_OK or GR_ERR_NONFINITE. */
 static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, double *x2,
-                        double *v2, double *ring, int64_t *lag_work)
+                        double *v2, double *ring, int64_t *slow_next)
 {
     const gr_sde_output *out = rs->out;
     const int d = rs->cfg->dim;
@@ -165,23 +183,17 @@ static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, d
         vi[a] = v[a];
     }
     int64_t ks = rs->ks0;
-    /* Per lag: next window end, next store, their ring slots (no divisions per step).
-     * The k-th store (k = 0, 1, ...) is at step k stride into slot k mod len, the k-th
-     * window ends at lag + k stride and reads that slot: so the counters at step_from
-     * follow from step_from alone, and only the ring carries over between segments. */
-    int64_t *next_end = lag_work, *next_store = next_end + out->n_lags;
-    int64_t *slot_end = next_store + out->n_lags, *slot_store = slot_end + out->n_lags;
-    for (int64_t l = 0; l < out->n_lags; l++) {
-        const int64_t lag = out->lags[l], stride = out->lag_stride[l], len = out->lag_len[l];
-        int64_t k = step_from / stride + (step_from % stride != 0);
-        next_store[l] = k * stride;
-        slot_store[l] = k % len;
-        k = step_from <= lag ? 0 : (step_from - lag - 1) / stride + 1;
-        next_end[l] = lag + k * stride;
-        slot_end[l] = k % len;
+    const gr_tamsd_plan *tp = rs->plan;
+    double *acc = out->tamsd + i * tp->n_lags; /* the particle's window sums, in time order */
+    /* the slow lags' next window ends after step_from: k + j s >= step_from */
+    int64_t next_slow = INT64_MAX;
+    for (int64_t j = 0; j < tp->n_slow; j++) {
+        const int64_t l = tp->slow[j], lag = tp->lags[l], s = (int64_t)1 << tp->lag_level[l];
+        slow_next[j] = step_from <= lag ? lag : lag + ((step_from - lag - 1) / s + 1) * s;
+        if (slow_next[j] < next_slow) next_slow = slow_next[j];
     }
-    /* Bookkeeping (samples, TAMSD windows) happens at few steps; between them the
-     * particle is stepped in a tight loop.  Step 0, the start, is a sample and a
+    /* Bookkeeping (samples, TAMSD windows) happens at the steps that need it; between
+     * them the particle is stepped in a tight loop.  Step 0, the start, is a sample and a
      * window start for every lag. */
     for (int64_t step = step_from;;) {
         if (step == step_to && step_to < n_steps) break; /* booked by the next segment */
@@ -195,25 +207,15 @@ static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, d
         }
         int64_t next = step_to; /* the next step that needs bookkeeping */
         if (ks < out->n_samples && out->sample_steps[ks] < next) next = out->sample_steps[ks];
-        double *r = ring;
-        for (int64_t l = 0; l < out->n_lags; l++) {
-            const int64_t stride = out->lag_stride[l], len = out->lag_len[l];
-            if (step == next_end[l]) {
-                const double *old = r + slot_end[l] * d;
-                double sum = 0.0;
-                for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
-                out->tamsd[i * out->n_lags + l] += sum;
-                next_end[l] += stride;
-                if (++slot_end[l] == len) slot_end[l] = 0;
+        if (tp->n_lags) {
+            switch (d) {
+            case 1: tamsd_book(1, tp, step, xi, ring, acc, slow_next, &next_slow); break;
+            case 2: tamsd_book(2, tp, step, xi, ring, acc, slow_next, &next_slow); break;
+            default: tamsd_book(3, tp, step, xi, ring, acc, slow_next, &next_slow); break;
             }
-            if (step == next_store[l]) {
-                memcpy(r + slot_store[l] * d, xi, (size_t)d * sizeof(double));
-                next_store[l] += stride;
-                if (++slot_store[l] == len) slot_store[l] = 0;
-            }
-            if (next_end[l] < next) next = next_end[l];
-            if (next_store[l] < next) next = next_store[l];
-            r += len * d;
+            const int64_t busy = step + 1 + tp->gap[(step + 1) & tp->phase_mask];
+            if (busy < next) next = busy;
+            if (next_slow < next) next = next_slow;
         }
         if (step == n_steps) break;
         /* steps step+1 .. next, each with its own dimension so that the axis loops
@@ -242,7 +244,7 @@ typedef struct {
     double *x, *v;        /* the call's state arrays */
     double *sums;         /* the call's block sums, row 0 for the block of `first` */
     double *ring;         /* this thread's scratch */
-    int64_t *lag_work;
+    int64_t *slow_next;
     int status;
     int64_t bad;          /* the particle that failed, or -1 */
 } worker;
@@ -258,7 +260,7 @@ static void *work(void *arg)
         double *s = w->sums + (i / GR_SDE_BLOCK - b0) * row;
         const int64_t at = (i - w->first) * d;
         int st = run_particle(w->rs, i, w->x + at, w->v + at, s,
-                              s + w->rs->out->n_samples * d, w->ring, w->lag_work);
+                              s + w->rs->out->n_samples * d, w->ring, w->slow_next);
         if (st != GR_OK) {
             w->status = st;
             w->bad = i;
@@ -304,8 +306,6 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
     }
     const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, udsbm, cfg->scheme == GR_SDE_EM,
                             ex0, table, step_from};
-    const run_shared rs = {cfg, &sp, out, n, step_from, step_to, n_steps,
-                           first_sample_from(out, step_from)};
 
     /* The ensemble sums, the same bits for any split: each block of GR_SDE_BLOCK particles
      * (by global index) sums its particles in index order from zero (or from the carry a
@@ -314,42 +314,42 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
     const int64_t T = out->n_samples, row = 2 * T * d;
     const int64_t b_first = first / GR_SDE_BLOCK, b_last = (first + count - 1) / GR_SDE_BLOCK;
     const int64_t nb = b_last - b_first + 1;
-    if (row > 0 && nb > (int64_t)(SIZE_MAX / sizeof(double)) / row) {
-        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "the block sums' size overflows");
+    const int64_t nt = threads < nb ? threads : nb;
+    /* scratch per extra thread: its ring and slow lags' steps (thread 0 has out's ring) */
+    const int64_t ring_n = gr_tamsd_ring_size(d, out->n_lags, out->lags, out->estimator);
+    if (ring_n < 0 || (row > 0 && nb > (int64_t)(SIZE_MAX / sizeof(double) / 2) / row) ||
+        (nt > 1 && ring_n > (int64_t)(SIZE_MAX / sizeof(double) / 2) / (nt - 1))) {
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "the SDE scratch's size overflows");
         return GR_ERR_NOMEM;
     }
+    gr_tamsd_plan plan;
+    if (gr_tamsd_plan_init(&plan, d, out->n_lags, out->lags, out->estimator) != GR_OK) {
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "no memory for the TAMSD plan");
+        return GR_ERR_NOMEM;
+    }
+    const run_shared rs = {cfg, &sp, out, &plan, n, step_from, step_to, n_steps,
+                           first_sample_from(out, step_from)};
     double *sums = calloc((size_t)(nb * row) + 1, sizeof(double));
-    if (!sums) {
-        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "no memory for the block sums");
-        return GR_ERR_NOMEM;
-    }
-    if (out->carry) memcpy(sums, out->carry, (size_t)row * sizeof(double));
-    int64_t nt = threads < nb ? threads : nb;
-    /* scratch per extra thread: its ring and lag counters (thread 0 has out's) */
-    const int64_t ring_n = gr_sde_ring_size(d, out->n_lags, out->lags);
-    const int64_t work_n = 4 * out->n_lags;
-    double *rings = NULL;
-    int64_t *works = NULL;
     worker *ws = calloc((size_t)nt, sizeof(worker));
     pthread_t *tid = calloc((size_t)nt, sizeof(pthread_t));
     int *started = calloc((size_t)nt, sizeof(int));
-    if (nt > 1) {
-        rings = calloc((size_t)((nt - 1) * ring_n) + 1, sizeof(double));
-        works = calloc((size_t)((nt - 1) * work_n) + 1, sizeof(int64_t));
-    }
-    if (!ws || !tid || !started || (nt > 1 && (!rings || !works)) || ring_n < 0) {
-        free(sums), free(ws), free(tid), free(started), free(rings), free(works);
+    double *rings = calloc((size_t)((nt - 1) * ring_n) + 1, sizeof(double));
+    int64_t *slow = calloc((size_t)(nt * plan.n_slow) + 1, sizeof(int64_t));
+    int status = GR_OK;
+    if (!sums || !ws || !tid || !started || !rings || !slow) {
         gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "no memory for the SDE threads");
-        return GR_ERR_NOMEM;
+        status = GR_ERR_NOMEM;
+        goto done;
     }
+    if (out->carry) memcpy(sums, out->carry, (size_t)row * sizeof(double));
     for (int64_t t = 0; t < nt; t++) {
         /* thread t takes blocks [b_first + nb t / nt, b_first + nb (t+1) / nt) */
         const int64_t lo = (b_first + nb * t / nt) * GR_SDE_BLOCK;
         const int64_t hi = (b_first + nb * (t + 1) / nt) * GR_SDE_BLOCK;
         ws[t] = (worker){&rs, lo > first ? lo : first, hi < first + count ? hi : first + count,
                          first, x, v, sums,
-                         t == 0 ? out->ring : rings + (t - 1) * ring_n,
-                         t == 0 ? out->lag_work : works + (t - 1) * work_n, GR_OK, -1};
+                         t == 0 ? out->ring : rings + (t - 1) * ring_n, slow + t * plan.n_slow,
+                         GR_OK, -1};
     }
     /* threads 1.. run beside this one; one that cannot be started runs here afterwards
      * (the same numbers, later) */
@@ -359,7 +359,6 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
         if (started[t]) pthread_join(tid[t], NULL);
         else work(&ws[t]);
     }
-    int status = GR_OK;
     for (int64_t t = 0; t < nt; t++)
         if (ws[t].status != GR_OK) { /* the first failure in particle order */
             status = ws[t].status;
@@ -387,6 +386,8 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
             if (out->carry) memset(out->carry, 0, (size_t)row * sizeof(double));
         }
     }
-    free(sums), free(ws), free(tid), free(started), free(rings), free(works);
+done:
+    free(sums), free(ws), free(tid), free(started), free(rings), free(slow);
+    gr_tamsd_plan_free(&plan);
     return status;
 }

@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "common.h"
+#include "tamsd.h"
 
 enum { GR_SDE_LANGEVIN = 0, GR_SDE_UDSBM = 1 };
 enum { GR_SDE_EM = 0, GR_SDE_EXACT = 1 };
@@ -29,7 +30,7 @@ typedef struct {
 } gr_sde_config;
 
 /* Largest step count of a run: step counters plus a lag's stride then stay far from
- * INT64_MAX (a stride is at most lag/16 and lags beyond the run are never reached). */
+ * INT64_MAX (a stride is at most lag/4 and lags beyond the run are never reached). */
 #define GR_SDE_MAX_STEPS ((int64_t)1 << 62)
 
 /* Particles per block of the ensemble sums: x2 and v2 are sums, in block order, of each
@@ -48,12 +49,10 @@ typedef struct {
     double *positions;           /* n_samples x n x dim, or NULL */
     int64_t n_lags;
     const int64_t *lags;         /* increasing, >= 1 */
-    const int64_t *lag_stride;   /* per lag: spacing of window starts (gr_sde_lag_stride) */
-    const int64_t *lag_len;      /* per lag: ring length (gr_sde_ring_len) */
-    int64_t *lag_work;           /* scratch: 4 x n_lags */
+    int estimator;               /* GR_TAMSD_STRIDED or GR_TAMSD_ALL (tamsd.h) */
     double *tamsd;               /* n x n_lags: per particle, sum over windows of |dx|^2 */
-    double *ring;                /* gr_sde_ring_size doubles: one particle's past positions
-                                    per lag.  Scratch for a whole run; carried from call to
+    double *ring;                /* gr_tamsd_ring_size doubles: one particle's stored window
+                                    starts.  Scratch for a whole run; carried from call to
                                     call when a run is split into step segments */
     double *carry;               /* 2 x n_samples x dim (x2's then v2's), or NULL: the sums
                                     of a block a call leaves open (its last particles, or
@@ -65,14 +64,6 @@ typedef struct {
                                     call instead of once per particle and step; NULL
                                     computes them inline (the same numbers) */
 } gr_sde_output;
-
-/* Stride of TAMSD window starts for a lag: windows start every max(1, lag/16) steps, so
- * each particle keeps at most 32 past positions per lag (lag 31, stride 1). */
-int64_t gr_sde_lag_stride(int64_t lag);
-/* Past positions one particle keeps for a lag (>= 1): lag/stride rounded up, plus one. */
-int64_t gr_sde_ring_len(int64_t lag);
-/* Doubles of ring needed for the lags (each >= 1), or -1 if that overflows int64. */
-int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags);
 
 /* Advance particles [first, first + count) of n over the steps [step_from, step_to) of a
  * run of n_steps <= GR_SDE_MAX_STEPS steps: positions x and velocities v (count x dim)

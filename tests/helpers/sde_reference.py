@@ -168,6 +168,8 @@ def engine(
     first=0,
     n=None,
     sample_steps=None,
+    estimator="strided",
+    threads=1,
 ):
     """The C engine's raw entry point (``_core.sde_run``) over a whole run, with fresh
     buffers, for comparison with ``run``: samples at every step unless ``sample_steps``.
@@ -188,7 +190,8 @@ def engine(
     x2, v2 = np.zeros((len(steps), d)), np.zeros((len(steps), d))
     positions = np.zeros((len(steps), n, d))
     tamsd = np.zeros((n, len(lags)))
-    ring = np.zeros(_core.sde_ring_size(d, lags))
+    code = ("strided", "all").index(estimator)
+    ring = np.zeros(_core.sde_ring_size(d, lags, code))
     _core.sde_run(
         d,
         ("langevin", "udsbm").index(model),
@@ -212,5 +215,8 @@ def engine(
         lags,
         tamsd,
         ring,
+        None,
+        threads,
+        code,
     )
     return positions[:, first : first + count], v, x2, tamsd[first : first + count]
