@@ -574,6 +574,104 @@ def test_the_engine_is_the_reference_integrator_to_rounding(model, scheme, dim):
         )
 
 
+# lags (in steps) of every kind the strided bookkeeping has: stride 1 (below 8), each
+# power of two, lags not multiples of their stride, and past the 4096-step phase table
+# (stride 8192 from lag 32768: the "slow" lags)
+BOOK_LAGS = [1, 2, 3, 5, 7, 8, 9, 13, 31, 64, 100, 1001, 5000, 16383, 32768, 40000, 65537]
+
+
+@pytest.mark.parametrize("estimator", ["strided", "all"])
+@pytest.mark.parametrize("dim", [1, 3])
+def test_tamsd_is_the_mean_over_its_windows_of_the_stored_path(monkeypatch, estimator, dim):
+    """The TAMSD the engine books on the fly is, to summation rounding, the mean over the
+    windows of the estimator (starting every reference `stride` steps, written from the
+    definition in tamsd.h) of |x(t + lag) - x(t)|^2 computed from the positions stored at
+    every step -- in one call, on 3 threads, and one particle at a time in segments of
+    7919 steps (a prime: segment ends fall everywhere in the strides' cycles, and the
+    stored starts carry over in the ring).  The windows are summed in time order by both,
+    in different association (d terms first here): 1e-12 relative covers it."""
+    n, n_steps = 3, 70_000
+    kw = dict(
+        gamma0=G0,
+        D0=D0,
+        dt=0.01,
+        t_stop=n_steps * 0.01,
+        scheme="em",
+        dim=dim,
+        sample_times=np.arange(n_steps + 1) * 0.01,
+        tamsd_lags=np.array(BOOK_LAGS) * 0.01,
+        store_positions=True,
+        tamsd_estimator=estimator,
+        seed=5,
+    )
+    runs = [langevin.run(n, threads=1, **kw), langevin.run(n, threads=3, **kw)]
+    monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", 7919)
+    runs.append(langevin.run(n, threads=2, **kw))
+    xs = runs[0].positions
+    want = np.array(
+        [
+            sde_reference.tamsd_per_particle(xs, lag, sde_reference.stride(lag, estimator))
+            for lag in BOOK_LAGS
+        ]
+    ).T
+    for r in runs:
+        np.testing.assert_allclose(r.tamsd(per_particle=True), want, rtol=1e-12, atol=0)
+        assert np.array_equal(r.tamsd(per_particle=True), runs[0].tamsd(per_particle=True))
+    assert [granular._core.sde_lag_stride(k, ("strided", "all").index(estimator)) for k in
+            BOOK_LAGS] == [sde_reference.stride(k, estimator) for k in BOOK_LAGS]
+
+
+def _brownian_tamsd_rel_var(lag, stride, n_steps, dim):
+    """Var / mean^2 of one particle's TAMSD for Brownian motion, windows [j s, j s + lag]
+    ending by n_steps: (2 / (d M^2)) sum_ij (overlap_ij / lag)^2 -- Gaussian increments
+    give Cov(dx_i^2, dx_j^2) = 2 Cov(dx_i, dx_j)^2 per axis (tamsd.h)."""
+    starts = np.arange(0, n_steps - lag + 1, stride)
+    gap = np.abs(starts[:, None] - starts[None, :])
+    overlap = np.clip(1 - gap / lag, 0, None)
+    return 2 / (dim * len(starts) ** 2) * np.sum(overlap**2)
+
+
+def test_strided_tamsd_costs_the_stated_variance():
+    """The strided estimator's variance against every window's, on the same paths (same
+    seed, only the windows differ): each one's Var / mean^2 over particles against the
+    Brownian formula above, and their ratio against (2 + 1/W^2)/(2 + 1/k^2) <= 1.031.
+    Brownian increments: gamma0 dt = 2 with the exact scheme, so velocities decorrelate
+    within a step or two and lags of 48-160 steps see a random walk with D0 (its
+    per-step correction, ~1/(gamma0 lag) = 1-2% of the MSD, cancels in Var / mean^2 to
+    first order).  Tolerances: 5 standard errors from the particles (the variance's SE
+    from the sample fourth moment; the ratio's from a jackknife over 40 groups, small
+    because both estimators see the same paths)."""
+    n, n_steps, lags = 4000, 1500, [48, 80, 160]
+    kw = dict(gamma0=200.0, D0=0.01, dt=0.01, t_stop=n_steps * 0.01, scheme="exact",
+              dim=1, sample_times=[0.0], tamsd_lags=np.array(lags) * 0.01, seed=13)
+    per = {e: langevin.run(n, tamsd_estimator=e, **kw).tamsd(per_particle=True)
+           for e in ("strided", "all")}
+    for e, p in per.items():
+        for m, lag in enumerate(lags):
+            a = p[:, m] / p[:, m].mean()
+            var = a.var(ddof=1)
+            se = math.sqrt(np.mean((a - 1) ** 4) - var**2) / math.sqrt(n)
+            want = _brownian_tamsd_rel_var(lag, sde_reference.stride(lag, e), n_steps, 1)
+            assert abs(var - want) < 5 * se, (e, lag, var, want, se)
+    groups = np.array_split(np.arange(n), 40)
+
+    def ratio(keep):
+        s, a = per["strided"][keep], per["all"][keep]
+        return (s / s.mean(0)).var(0, ddof=1) / (a / a.mean(0)).var(0, ddof=1)
+
+    full = ratio(np.arange(n))
+    jack = np.array([ratio(np.setdiff1d(np.arange(n), g)) for g in groups])
+    se = np.sqrt((len(groups) - 1) * np.mean((jack - jack.mean(0)) ** 2, axis=0))
+    for m, lag in enumerate(lags):
+        s = sde_reference.stride(lag)
+        want = _brownian_tamsd_rel_var(lag, s, n_steps, 1) / _brownian_tamsd_rel_var(
+            lag, 1, n_steps, 1
+        )
+        asymptotic = (2 + (s / lag) ** 2) / (2 + 1 / lag**2)  # W = lag / s
+        assert abs(want - asymptotic) < 0.02 and want < 1.032  # the formula in tamsd.h
+        assert abs(full[m] - want) < 5 * se[m], (lag, full[m], want, se[m])
+
+
 def test_the_reference_covers_the_ziggurat_tail_and_wedges():
     """300 particles x 10 steps x 3 axes x 2 normals: draws from the rare paths of the
     ziggurat (beyond r = 3.44 and in the layers' wedges) are among them, and match."""

@@ -145,6 +145,17 @@ def run(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, first=0):
     return xs, vs
 
 
+def stride(lag, estimator="strided"):
+    """The spacing of window starts, from csrc/tamsd.h's definition: every step for "all";
+    for "strided" the largest power of two <= max(1, lag // 4)."""
+    if estimator == "all":
+        return 1
+    s = 1
+    while 2 * s <= lag // 4:
+        s *= 2
+    return s
+
+
 def tamsd_per_particle(xs, lag, stride):
     """(N,) time-averaged MSD at a lag (in steps) over the windows the engine averages:
     starting at steps 0, stride, 2 stride, ... while they end by the last step."""
