@@ -55,20 +55,25 @@ def log_lags(count, t_max, dt):
 
 
 def _measure(fn):
-    """fn's result, its wall-clock seconds and its peak traced memory in MiB."""
+    """fn's result, its wall-clock seconds, its peak traced memory in MiB and its CPU
+    seconds (every thread of the process: on a loaded machine the wall time grows, the
+    CPU time much less)."""
     tracemalloc.start()
+    c0 = time.process_time()
     t0 = time.perf_counter()
     result = fn()
     seconds = time.perf_counter() - t0
+    cpu = time.process_time() - c0
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
-    return result, seconds, peak / 2**20
+    return result, seconds, peak / 2**20, cpu
 
 
-def _record(name, r, seconds, peak, numpy_rate, threads, rates=None, estimator=None):
-    """One row; with several rounds (``rates``), the median rate and its range."""
+def _record(name, r, peak, numpy_rate, threads, rates, cpu_rates, estimator=None):
+    """One row: the median rate over the rounds (``rates``, wall clock) and its range, and
+    the median rate per CPU-second (``cpu_rates``: all threads' CPU time)."""
     steps = round(r.t_stop / r.dt)
-    rate = r.n * steps / seconds if rates is None else float(np.median(rates))
+    rate = float(np.median(rates))
     return dict(
         name=name,
         engine="langevin",
@@ -84,8 +89,9 @@ def _record(name, r, seconds, peak, numpy_rate, threads, rates=None, estimator=N
         threads=threads,
         seconds=r.n * steps / rate,
         particle_steps_per_second=rate,
-        particle_steps_per_second_range=[min(rates or [rate]), max(rates or [rate])],
-        rounds=len(rates or [rate]),
+        particle_steps_per_second_range=[min(rates), max(rates)],
+        particle_steps_per_cpu_second=float(np.median(cpu_rates)),
+        rounds=len(rates),
         peak_memory_mb=peak,
         numpy_particle_steps_per_second=numpy_rate,
         load_average=os.getloadavg()[0],
@@ -97,16 +103,17 @@ def _size(n):
 
 
 def _rounds(configs, rounds):
-    """Each config's (last result, peak MiB, rates over the rounds): the configs run in
-    turn, forwards in even rounds and backwards in odd ones, so that a machine whose load
-    drifts during the bench favours none of them."""
-    got = {k: [None, 0.0, []] for k in configs}
+    """Each config's (last result, peak MiB, wall rates, CPU rates over the rounds): the
+    configs run in turn, forwards in even rounds and backwards in odd ones, so that a
+    machine whose load drifts during the bench favours none of them."""
+    got = {k: [None, 0.0, [], []] for k in configs}
     for i in range(rounds):
         for k in list(configs)[:: 1 if i % 2 == 0 else -1]:
             fn, work = configs[k]
-            r, seconds, peak = _measure(fn)
+            r, seconds, peak, cpu = _measure(fn)
             got[k][0], got[k][1] = r, max(got[k][1], peak)
             got[k][2].append(work / seconds)
+            got[k][3].append(work / max(cpu, 1e-9))
     return got
 
 
@@ -140,51 +147,55 @@ def workloads(quick=False, rounds=1):
                     n * steps,
                 )
         got = _rounds(configs, rounds)
-        numpy_rate = float(np.median(got.pop("numpy")[2]))
-        for (scheme, t), (r, peak, rates) in got.items():
+        numpy_rate = float(np.median(got.pop("numpy")[2]))  # wall clock: one thread
+        for (scheme, t), (r, peak, rates, cpu_rates) in got.items():
             out.append(
                 _record(
                     f"langevin-3d-{scheme}-{_size(n)}-threads{t}",
                     r,
-                    None,
                     peak,
                     numpy_rate,
                     t,
                     rates,
+                    cpu_rates,
                 )
             )
-    # the issue's memory case: N = 1000, t = 1000, dt = 0.01, MSD and 30 TAMSD lags
+    # the issue's memory case: N = 1000, t = 1000, dt = 0.01, MSD and 30 TAMSD lags, each
+    # TAMSD estimator beside the same run without lags (the "plain" rate it is a share of)
     n, t_stop = (1_000, 1000.0) if not quick else (200, 20.0)
     lags = log_lags(30, t_stop / 2, 0.01)
-    configs = {
-        t: (
-            functools.partial(
-                langevin.run,
-                n,
-                gamma0=G0,
-                D0=D0,
-                tau0=0.972,
-                dt=0.01,
-                t_stop=t_stop,
-                scheme="em",
-                tamsd_lags=lags,
-                seed=1,
-                threads=t,
-            ),
-            n * round(t_stop / 0.01),
-        )
-        for t in counts
-    }
-    for t, (r, peak, rates) in _rounds(configs, rounds).items():
+    configs = {}
+    for estimator in (None, "strided", "all"):
+        for t in counts:
+            configs[estimator, t] = (
+                functools.partial(
+                    langevin.run,
+                    n,
+                    gamma0=G0,
+                    D0=D0,
+                    tau0=0.972,
+                    dt=0.01,
+                    t_stop=t_stop,
+                    scheme="em",
+                    tamsd_lags=None if estimator is None else lags,
+                    tamsd_estimator=estimator or "strided",
+                    seed=1,
+                    threads=t,
+                ),
+                n * round(t_stop / 0.01),
+            )
+    for (estimator, t), (r, peak, rates, cpu_rates) in _rounds(configs, rounds).items():
+        tag = f"{len(lags)}lags-{estimator}" if estimator else "nolags"
         out.append(
             _record(
-                f"udsbm-3d-em-{_size(n)}-t{t_stop:g}-{len(r.tamsd_lags)}lags-threads{t}",
+                f"udsbm-3d-em-{_size(n)}-t{t_stop:g}-{tag}-threads{t}",
                 r,
-                None,
                 peak,
                 float("nan"),
                 t,
                 rates,
+                cpu_rates,
+                estimator,
             )
         )
     return out
