@@ -133,12 +133,20 @@ static GR_ALWAYS_INLINE void tamsd_book(const int d, const gr_tamsd_plan *p, int
                                         const double *xi, double *ring, double *acc,
                                         int64_t *slow_next, int64_t *next_slow)
 {
+    /* stride 1: the first n_every lags, ascending, at every step once t reaches them */
+    const double *r0 = ring; /* level 0's ring comes first */
+    for (int64_t l = 0; l < p->n_every && p->lag[l].lag <= t; l++) {
+        const double *old = r0 + ((t - p->lag[l].lag) & p->lag[l].mask) * d;
+        double sum = 0.0;
+        for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
+        acc[l] += sum;
+    }
     const int64_t ph = t & p->phase_mask;
     for (int64_t k = p->phase_off[ph]; k < p->phase_off[ph + 1]; k++) {
-        const int64_t l = p->phase_lag[k], lag = p->lags[l];
-        if (t < lag) continue; /* the window would start before step 0 */
-        const double *old =
-            ring + p->lag_off[l] + (((t - lag) >> p->lag_level[l]) & p->lag_mask[l]) * d;
+        const int64_t l = p->phase_lag[k];
+        const gr_tamsd_lag g = p->lag[l];
+        if (t < g.lag) continue; /* the window would start before step 0 */
+        const double *old = ring + g.off + (((t - g.lag) >> g.level) & g.mask) * d;
         double sum = 0.0;
         for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
         acc[l] += sum;
@@ -146,14 +154,13 @@ static GR_ALWAYS_INLINE void tamsd_book(const int d, const gr_tamsd_plan *p, int
     if (t == *next_slow) {
         int64_t soonest = INT64_MAX;
         for (int64_t j = 0; j < p->n_slow; j++) {
-            const int64_t l = p->slow[j], e = p->lag_level[l];
+            const gr_tamsd_lag g = p->lag[p->slow[j]];
             if (slow_next[j] == t) {
-                const double *old =
-                    ring + p->lag_off[l] + (((t - p->lags[l]) >> e) & p->lag_mask[l]) * d;
+                const double *old = ring + g.off + (((t - g.lag) >> g.level) & g.mask) * d;
                 double sum = 0.0;
                 for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
-                acc[l] += sum;
-                slow_next[j] += (int64_t)1 << e;
+                acc[p->slow[j]] += sum;
+                slow_next[j] += (int64_t)1 << g.level;
             }
             if (slow_next[j] < soonest) soonest = slow_next[j];
         }
@@ -188,7 +195,7 @@ static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, d
     /* the slow lags' next window ends after step_from: k + j s >= step_from */
     int64_t next_slow = INT64_MAX;
     for (int64_t j = 0; j < tp->n_slow; j++) {
-        const int64_t l = tp->slow[j], lag = tp->lags[l], s = (int64_t)1 << tp->lag_level[l];
+        const int64_t lag = tp->lag[tp->slow[j]].lag, s = (int64_t)1 << tp->lag[tp->slow[j]].level;
         slow_next[j] = step_from <= lag ? lag : lag + ((step_from - lag - 1) / s + 1) * s;
         if (slow_next[j] < next_slow) next_slow = slow_next[j];
     }

@@ -48,7 +48,7 @@ int64_t gr_tamsd_ring_size(int dim, int64_t n_lags, const int64_t *lags, int est
 
 void gr_tamsd_plan_free(gr_tamsd_plan *p)
 {
-    free(p->lag_level), free(p->lag_off), free(p->lag_mask);
+    free(p->lag);
     free(p->phase_off), free(p->phase_lag), free(p->gap), free(p->slow);
     memset(p, 0, sizeof *p);
 }
@@ -71,7 +71,7 @@ int gr_tamsd_plan_init(gr_tamsd_plan *p, int dim, int64_t n_lags, const int64_t 
         }
         off += len * dim;
     }
-    /* the period: the largest stride up to 2^GR_TAMSD_MAX_PHASE_BITS (1 without lags) */
+    /* the period: the largest stride up to 2^GR_TAMSD_MAX_PHASE_BITS (1 if none > 1) */
     int q = 0;
     for (int64_t l = 0; l < n_lags; l++) {
         const int e = gr_tamsd_level(lags[l], estimator);
@@ -80,21 +80,20 @@ int gr_tamsd_plan_init(gr_tamsd_plan *p, int dim, int64_t n_lags, const int64_t 
     const int64_t period = (int64_t)1 << q;
     p->phase_mask = period - 1;
     const size_t nl = (size_t)n_lags + 1; /* + 1: never 0 bytes */
-    p->lag_level = malloc(nl * sizeof(int));
-    p->lag_off = malloc(nl * sizeof(int64_t));
-    p->lag_mask = malloc(nl * sizeof(int64_t));
+    p->lag = malloc(nl * sizeof(gr_tamsd_lag));
     p->slow = malloc(nl * sizeof(int64_t));
     p->phase_off = calloc((size_t)period + 1, sizeof(int64_t));
     p->gap = malloc((size_t)period * sizeof(int64_t));
-    if (!p->lag_level || !p->lag_off || !p->lag_mask || !p->slow || !p->phase_off || !p->gap)
-        goto nomem;
+    if (!p->lag || !p->slow || !p->phase_off || !p->gap) goto nomem;
     /* count the table's entries per phase: lag k (stride s <= period) ends a window at
      * the steps k + j s, i.e. at the phases = k (mod s) */
     for (int64_t l = 0; l < n_lags; l++) {
         const int e = gr_tamsd_level(lags[l], estimator);
-        p->lag_level[l] = e;
-        p->lag_off[l] = p->level_off[e];
-        p->lag_mask[l] = p->level_mask[e];
+        p->lag[l] = (gr_tamsd_lag){lags[l], p->level_off[e], p->level_mask[e], e};
+        if (e == 0) {
+            p->n_every = l + 1;
+            continue;
+        }
         if (e > q) {
             p->slow[p->n_slow++] = l;
             continue;
@@ -108,8 +107,8 @@ int gr_tamsd_plan_init(gr_tamsd_plan *p, int dim, int64_t n_lags, const int64_t 
     {
         int64_t *fill = p->gap; /* as scratch: the next free entry per phase */
         memcpy(fill, p->phase_off, (size_t)period * sizeof(int64_t));
-        for (int64_t l = 0; l < n_lags; l++) {
-            const int e = p->lag_level[l];
+        for (int64_t l = p->n_every; l < n_lags; l++) {
+            const int e = (int)p->lag[l].level;
             if (e > q) continue;
             const int64_t s = (int64_t)1 << e;
             for (int64_t ph = lags[l] & (s - 1); ph < period; ph += s) p->phase_lag[fill[ph]++] = l;
@@ -119,7 +118,8 @@ int gr_tamsd_plan_init(gr_tamsd_plan *p, int dim, int64_t n_lags, const int64_t 
      * 2^e; levels above the period at multiples of it, phase 0); gap: steps from a phase
      * to the next busy one, cyclically (phase 0 is busy whenever there are lags) */
     for (int64_t ph = period - 1, next = period; ph >= 0; ph--) {
-        int busy = p->phase_off[ph + 1] > p->phase_off[ph] || (ph == 0 && n_lags > 0);
+        int busy = p->phase_off[ph + 1] > p->phase_off[ph] || (ph == 0 && n_lags > 0) ||
+                   p->n_every > 0;
         for (int e = 0; e <= q && !busy; e++)
             busy = (p->used >> e & 1) && (ph & (((int64_t)1 << e) - 1)) == 0;
         if (busy) next = ph;

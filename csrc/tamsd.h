@@ -52,13 +52,21 @@ int64_t gr_tamsd_ring_size(int dim, int64_t n_lags, const int64_t *lags, int est
 
 /* The bookkeeping of a set of lags, the same for every particle: built once per call,
  * read by every thread. */
+/* What a window end of one lag reads: the lag, its stride 2^level, and its level's ring. */
+typedef struct {
+    int64_t lag, off, mask; /* ring offset (doubles) and length - 1 */
+    int64_t level;
+} gr_tamsd_lag;
+
 typedef struct {
     int64_t n_lags;
     const int64_t *lags;        /* increasing, >= 1 */
-    int *lag_level;             /* per lag: e, its stride 2^e */
-    int64_t *lag_off;           /* per lag: offset (doubles) of its level's ring */
-    int64_t *lag_mask;          /* per lag: its level's ring length - 1 */
-    int64_t phase_mask;         /* the phase table's period - 1 (a power of two) */
+    gr_tamsd_lag *lag;          /* per lag */
+    int64_t n_every;            /* lags 0 .. n_every-1 have stride 1 (a prefix: strides
+                                   grow with the lag): booked at every step, not listed
+                                   in the phase table */
+    int64_t phase_mask;         /* the phase table's period - 1 (a power of two; the
+                                   largest stride from 2 to 2^GR_TAMSD_MAX_PHASE_BITS) */
     int64_t *phase_off;         /* period + 1: phase p's lags are phase_lag[off[p]..off[p+1]) */
     int64_t *phase_lag;         /* lags (indices) ending a window at steps of each phase */
     int64_t *gap;               /* per phase: steps to the next phase with any bookkeeping */
