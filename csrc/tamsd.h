@@ -26,9 +26,14 @@
  * one particle's TAMSD over a run of T steps is, for k << T,
  *     Var / mean^2 = (2 k / (d T)) (2 + 1/W^2) / 3
  * (sum of squared overlaps of the windows: Cov(dx_i^2, dx_j^2) = 2 Cov(dx_i, dx_j)^2
- * per axis for Gaussian increments), so the strided estimator's variance is
- * (2 + 1/W^2) / (2 + 1/k^2) that of "all": 1.031 at most for W = 4 (std +1.5%), 1 for
- * lags < 2W, which use every window.  tests/test_langevin.py measures the ratio. */
+ * per axis for Gaussian increments).  Every window (W = k) gives 4k/(3dT), the
+ * ergodicity-breaking parameter of Brownian motion (Deng & Barkai, Phys. Rev. E 79,
+ * 011112 (2009): EB = k(H) lag/T with k(1/2) = 4/3, in 1D).  So the strided estimator's
+ * variance is (2 + 1/W^2) / (2 + 1/k^2) that of "all": 1.031 at most for W = 4 (std
+ * +1.5%), 1 for lags < 2W, which use every window.  tests/test_langevin.py measures the
+ * ratio.  Where it stops: the formula takes increments independent beyond the lag (lag
+ * >> 1/gamma); at shorter lags the velocity correlates windows over 1/gamma > lag, which
+ * strides of lag/4 to lag/8 sample far more finely than that time. */
 #ifndef GR_TAMSD_H
 #define GR_TAMSD_H
 
