@@ -364,9 +364,10 @@ def theory_tamsd(
 ) -> NDArray[np.float64]:
     """The expected time-averaged MSD of a run, total over ``dim``: for each lag the mean,
     over the windows the engine averages (starting every ``sde_lag_stride`` steps from 0
-    while they end by ``t_stop``; ``tamsd_estimator`` as in ``run``), of the mean squared displacement over the window --
-    ``theory.msd_langevin`` from the velocity variance reached at the window's start for
-    the Langevin model (tau0 = inf), ``theory.udsbm_increment_msd`` for UDSBM.
+    while they end by ``t_stop``; ``tamsd_estimator`` as in ``run``), of the mean squared
+    displacement over the window -- ``theory.msd_langevin`` from the velocity variance
+    reached at the window's start for the Langevin model (tau0 = inf),
+    ``theory.udsbm_increment_msd`` for UDSBM.
     ``v0_sq`` is the initial mean squared velocity per component (None: thermal, or App.
     C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD."""
     from . import theory

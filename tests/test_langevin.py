@@ -617,8 +617,9 @@ def test_tamsd_is_the_mean_over_its_windows_of_the_stored_path(monkeypatch, esti
     for r in runs:
         np.testing.assert_allclose(r.tamsd(per_particle=True), want, rtol=1e-12, atol=0)
         assert np.array_equal(r.tamsd(per_particle=True), runs[0].tamsd(per_particle=True))
-    assert [granular._core.sde_lag_stride(k, ("strided", "all").index(estimator)) for k in
-            BOOK_LAGS] == [sde_reference.stride(k, estimator) for k in BOOK_LAGS]
+    assert [
+        granular._core.sde_lag_stride(k, ("strided", "all").index(estimator)) for k in BOOK_LAGS
+    ] == [sde_reference.stride(k, estimator) for k in BOOK_LAGS]
 
 
 def _brownian_tamsd_rel_var(lag, stride, n_steps, dim):
@@ -642,10 +643,21 @@ def test_strided_tamsd_costs_the_stated_variance():
     from the sample fourth moment; the ratio's from a jackknife over 40 groups, small
     because both estimators see the same paths)."""
     n, n_steps, lags = 4000, 1500, [48, 80, 160]
-    kw = dict(gamma0=200.0, D0=0.01, dt=0.01, t_stop=n_steps * 0.01, scheme="exact",
-              dim=1, sample_times=[0.0], tamsd_lags=np.array(lags) * 0.01, seed=13)
-    per = {e: langevin.run(n, tamsd_estimator=e, **kw).tamsd(per_particle=True)
-           for e in ("strided", "all")}
+    kw = dict(
+        gamma0=200.0,
+        D0=0.01,
+        dt=0.01,
+        t_stop=n_steps * 0.01,
+        scheme="exact",
+        dim=1,
+        sample_times=[0.0],
+        tamsd_lags=np.array(lags) * 0.01,
+        seed=13,
+    )
+    per = {
+        e: langevin.run(n, tamsd_estimator=e, **kw).tamsd(per_particle=True)
+        for e in ("strided", "all")
+    }
     for e, p in per.items():
         for m, lag in enumerate(lags):
             a = p[:, m] / p[:, m].mean()
