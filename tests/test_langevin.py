@@ -519,6 +519,11 @@ def test_from_scene_uses_the_thesis_coefficients():
         (dict(sample_times=[0.0, 1e300]), "past t_stop"),
         (dict(tamsd_lags=[1e300]), "tamsd_lags must be at least dt and at most t_stop"),
         (dict(tamsd_lags=[float("nan")]), "tamsd_lags must be at least dt and at most t_stop"),
+        (dict(tamsd_estimator="some"), "tamsd_estimator must be one of"),
+        (
+            dict(t_stop=2.0**31 * 0.01, tamsd_lags=[2.0**31 * 0.01], tamsd_estimator="all"),
+            "every-window TAMSD keeps the last lag's worth",
+        ),
     ],
 )
 def test_bad_input(kwargs, match):
@@ -526,6 +531,21 @@ def test_bad_input(kwargs, match):
     base.update(kwargs)
     with pytest.raises(ValueError, match=match):
         langevin.run(10, **base)
+
+
+def test_every_window_of_a_huge_lag_is_refused_before_allocating():
+    """Every window of a lag of 2**30 steps needs a ring of 2**31 positions (48 GiB in 3D)
+    per thread: refused with the size and the way out, before anything is allocated."""
+    with pytest.raises(MemoryError, match="GiB of past positions per thread.*'strided'"):
+        langevin.run(
+            10,
+            gamma0=G0,
+            D0=D0,
+            dt=0.01,
+            t_stop=2.0**30 * 0.01,
+            tamsd_lags=[2.0**30 * 0.01],
+            tamsd_estimator="all",
+        )
 
 
 # -- the engine against a slow NumPy reference fed the same random numbers ------------------
