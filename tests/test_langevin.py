@@ -536,7 +536,7 @@ def test_bad_input(kwargs, match):
 def test_every_window_of_a_huge_lag_is_refused_before_allocating():
     """Every window of a lag of 2**30 steps needs a ring of 2**31 positions (48 GiB in 3D)
     per thread: refused with the size and the way out, before anything is allocated."""
-    with pytest.raises(MemoryError, match="GiB of past positions per thread.*'strided'"):
+    with pytest.raises(MemoryError, match=r"GiB of past positions per thread.*'strided'"):
         langevin.run(
             10,
             gamma0=G0,
