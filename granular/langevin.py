@@ -472,7 +472,12 @@ def run(
         run on).  The results are the same to the bit for any number: each particle's
         random numbers depend on (seed, step, particle) only, and the ensemble sums add
         fixed blocks of particles in a fixed order.  A run of fewer particles than
-        threads, or so long that one particle is stepped at a time, uses fewer.
+        threads, or so long that one particle is stepped at a time, uses fewer (at most
+        1024 are started).
+
+    Returns
+    -------
+    LangevinResult
 
     Raises
     ------
@@ -480,6 +485,8 @@ def run(
         For a parameter out of its range (named in the message).
     UnstableStepError
         Euler-Maruyama with gamma0 dt >= 2.
+    MemoryError
+        Stored positions or the every-window TAMSD's rings that would not fit.
     """
     n = int(n)
     if n < 1:
