@@ -716,6 +716,10 @@ PyMODINIT_FUNC PyInit__core(void)
         return NULL;
     }
     Py_DECREF(max_steps);
+    if (PyModule_AddIntConstant(m, "SDE_BLOCK", GR_SDE_BLOCK) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
     gr_rng_init();
     return m;
 }

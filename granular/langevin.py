@@ -602,6 +602,12 @@ def run(
     work = max(1, _CHUNK_PARTICLE_STEPS)
     steps_per_call = min(n_steps, work)
     per_call = max(1, work * threads // n_steps) if steps_per_call == n_steps else 1
+    # whole blocks of particles for every thread (the C core gives each thread whole blocks
+    # of SDE_BLOCK, the ensemble sums' unit): 100 particles on 2 threads would be 64 + 36
+    for unit in (_core.SDE_BLOCK * threads, _core.SDE_BLOCK):
+        if per_call >= unit:
+            per_call -= per_call % unit
+            break
     ring_size = _core.sde_ring_size(dim, lags, estimator)
     if 8.0 * ring_size * threads > 2**31:
         raise MemoryError(

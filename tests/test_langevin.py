@@ -318,8 +318,9 @@ def test_same_bits_for_any_number_of_threads(monkeypatch, model, tau0, scheme, d
     """threads = 1, 2, 3, 7 give the same bits (np.array_equal) -- the ensemble sums too,
     whose blocks of 32 particles are added in order whatever thread summed them.  250
     particles are 8 blocks, the last one short, so 7 threads split them unevenly; then
-    the same with calls of 45 x threads particles, so that calls begin and end inside
-    blocks and a thread's first and last blocks are partial (the carry)."""
+    the same in calls of 45 x threads particles (rounded down to whole blocks per
+    thread), and of 3 x threads (below a block: calls begin and end inside blocks, a
+    thread's first and last blocks are partial, the carry takes them to the next call)."""
     kw = dict(
         gamma0=G0,
         D0=D0,
@@ -343,9 +344,9 @@ def test_same_bits_for_any_number_of_threads(monkeypatch, model, tau0, scheme, d
         "final_velocities",
     )
     a = langevin.run(250, threads=1, **kw)
-    for chunked in (False, True):
-        if chunked:
-            monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", 45 * 50)
+    for per_thread in (None, 45, 3):
+        if per_thread:
+            monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", per_thread * 50)
         for threads in (1, 2, 3, 7):
             b = langevin.run(250, threads=threads, **kw)
             for name in names:
