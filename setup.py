@@ -9,7 +9,7 @@ import os
 import numpy
 from setuptools import Extension, setup
 
-extra = ["-O3", "-g", "-std=c99", "-Wall", "-Wextra", "-Wno-unused-parameter"]
+extra = ["-O3", "-g", "-std=c99", "-pthread", "-Wall", "-Wextra", "-Wno-unused-parameter"]
 if os.environ.get("GRANULAR_ASAN"):
     extra += ["-fsanitize=address", "-fno-omit-frame-pointer", "-O1", "-g"]
 
@@ -21,7 +21,10 @@ setup(
             include_dirs=[numpy.get_include(), "csrc"],
             define_macros=[("NPY_NO_DEPRECATED_API", "NPY_2_0_API_VERSION")],
             extra_compile_args=extra,
-            extra_link_args=["-fsanitize=address"] if os.environ.get("GRANULAR_ASAN") else [],
+            # POSIX threads for the Langevin engine (csrc/sde.c); in glibc >= 2.34 they are in
+            # libc itself, and -pthread is harmless there
+            extra_link_args=["-pthread"]
+            + (["-fsanitize=address"] if os.environ.get("GRANULAR_ASAN") else []),
             depends=sorted(glob.glob("csrc/*.h")),
         )
     ]

@@ -569,16 +569,24 @@ static void *inout(PyObject *obj, const char *name, int type, npy_intp size)
     return out_buffer(obj, name, type, size, &data) ? data : NULL;
 }
 
-/* Doubles of ring for the lags (each >= 1), or -1 with an exception set. */
-static int64_t ring_size_of(int dim, npy_intp L, const int64_t *lags)
+/* Doubles of ring for the lags (each >= 1, increasing), or -1 with an exception set. */
+static int64_t ring_size_of(int dim, npy_intp L, const int64_t *lags, int estimator)
 {
     for (npy_intp l = 0; l < L; l++)
-        if (lags[l] < 1) {
-            PyErr_SetString(PyExc_ValueError, "lags must be >= 1 step");
+        if (lags[l] < 1 || (l > 0 && lags[l] <= lags[l - 1])) {
+            PyErr_SetString(PyExc_ValueError, "lags must be increasing and >= 1 step");
             return -1;
         }
-    int64_t size = gr_sde_ring_size(dim, L, lags);
-    if (size < 0) PyErr_SetString(PyExc_OverflowError, "the ring of past positions for these lags overflows");
+    if (estimator != GR_TAMSD_STRIDED && estimator != GR_TAMSD_ALL) {
+        PyErr_Format(PyExc_ValueError, "tamsd_estimator must be 0 (strided) or 1 (all), got %d",
+                     estimator);
+        return -1;
+    }
+    int64_t size = gr_tamsd_ring_size(dim, L, lags, estimator);
+    if (size < 0)
+        PyErr_Format(PyExc_ValueError, "the every-window TAMSD keeps the last lag's worth of "
+                     "positions: lags up to %lld steps (take the strided estimator)",
+                     (long long)GR_TAMSD_ALL_MAX_LAG);
     return size;
 }
 
@@ -587,20 +595,25 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     static char *names[] = {"dim", "model", "scheme", "gamma0", "D0", "tau0", "dt", "key",
                             "n", "first", "step_from", "step_to", "n_steps", "x", "v",
                             "sample_steps", "x2", "v2", "positions", "lags", "tamsd", "ring",
-                            "exponent", NULL};
+                            "carry", "threads", "tamsd_estimator", "exponent", NULL};
     gr_sde_config cfg;
     cfg.exponent = 1.0; /* UDSBM's (1 + t/tau0)^-exponent: optional, the thesis' 1 */
     unsigned long long key;
     long long n, first, step_from, step_to, n_steps;
-    PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO|d", names, &cfg.dim,
+    PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring, *ocarry = Py_None;
+    int threads = 1, estimator = GR_TAMSD_STRIDED;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO|Oiid", names, &cfg.dim,
                                      &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0, &cfg.tau0,
                                      &cfg.dt, &key, &n, &first, &step_from, &step_to, &n_steps,
                                      &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags, &otamsd,
-                                     &oring, &cfg.exponent))
+                                     &oring, &ocarry, &threads, &estimator, &cfg.exponent))
         return NULL;
     if (!(cfg.exponent > 0.0 && cfg.exponent < INFINITY)) {
         PyErr_SetString(PyExc_ValueError, "exponent must be positive and finite");
+        return NULL;
+    }
+    if (threads < 1) {
+        PyErr_Format(PyExc_ValueError, "threads must be >= 1, got %d", threads);
         return NULL;
     }
     cfg.key = key;
@@ -652,7 +665,8 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     out.sample_steps = PyArray_DATA((PyArrayObject *)osteps);
     out.n_lags = L;
     out.lags = PyArray_DATA((PyArrayObject *)olags);
-    const int64_t ring_size = ring_size_of(cfg.dim, L, out.lags);
+    out.estimator = estimator;
+    const int64_t ring_size = ring_size_of(cfg.dim, L, out.lags, estimator);
     if (ring_size < 0) return NULL;
     double *x = inout(ox, "x", NPY_FLOAT64, count * d);
     double *v = x ? inout(ov, "v", NPY_FLOAT64, count * d) : NULL;
@@ -663,23 +677,15 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     if (!out.ring) return NULL;
     if (opos != Py_None && !(out.positions = inout(opos, "positions", NPY_FLOAT64, tnd)))
         return NULL;
+    npy_intp tdd;
+    if (ocarry != Py_None && (!mul_size(td, 2, &tdd, "carry") ||
+                              !(out.carry = inout(ocarry, "carry", NPY_FLOAT64, tdd))))
+        return NULL;
     for (npy_intp k = 0; k < T; k++)
         if (out.sample_steps[k] < 0 || (k > 0 && out.sample_steps[k] <= out.sample_steps[k - 1])) {
             PyErr_SetString(PyExc_ValueError, "sample_steps must be increasing and >= 0");
             return NULL;
         }
-    /* scratch: per-lag strides, ring lengths and counters (6 per lag; +1: never 0 bytes) */
-    npy_intp n_ints;
-    if (!mul_size(L, 6, &n_ints, "the lags' scratch")) return NULL;
-    int64_t *ints = PyMem_Calloc((size_t)n_ints + 1, sizeof(int64_t));
-    if (!ints) return PyErr_NoMemory();
-    for (npy_intp l = 0; l < L; l++) {
-        ints[l] = gr_sde_lag_stride(out.lags[l]);
-        ints[L + l] = gr_sde_ring_len(out.lags[l]);
-    }
-    out.lag_stride = ints;
-    out.lag_len = ints + L;
-    out.lag_work = ints + 2 * L;
     /* the per-step coefficient table of exact UDSBM (and of EM for an exponent != 1),
      * shared by the call's particles: only worth it for several, and only when not too
      * large (else, or if the allocation fails, the core computes the coefficients inline:
@@ -693,9 +699,9 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
     int status;
     Py_BEGIN_ALLOW_THREADS
-    status = gr_sde_run(&cfg, n, first, count, step_from, step_to, n_steps, x, v, &out, &err);
+    status = gr_sde_run(&cfg, n, first, count, step_from, step_to, n_steps, x, v, &out, threads,
+                        &err);
     Py_END_ALLOW_THREADS
-    PyMem_Free(ints);
     PyMem_Free(coef);
     if (status != GR_OK) return raise_status(status, &err);
     Py_RETURN_NONE;
@@ -703,29 +709,34 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
 
 static PyObject *sde_ring_size(PyObject *Py_UNUSED(module), PyObject *args)
 {
-    int dim;
+    int dim, estimator = GR_TAMSD_STRIDED;
     PyObject *olags;
-    if (!PyArg_ParseTuple(args, "iO", &dim, &olags)) return NULL;
+    if (!PyArg_ParseTuple(args, "iO|i", &dim, &olags, &estimator)) return NULL;
     if (dim < 1 || dim > 3) {
         PyErr_SetString(PyExc_ValueError, "dim must be 1..3");
         return NULL;
     }
     PyArrayObject *lags = (PyArrayObject *)PyArray_FROMANY(olags, NPY_INT64, 1, 1, NPY_ARRAY_IN_ARRAY);
     if (!lags) return NULL;
-    int64_t size = ring_size_of(dim, PyArray_SIZE(lags), PyArray_DATA(lags));
+    int64_t size = ring_size_of(dim, PyArray_SIZE(lags), PyArray_DATA(lags), estimator);
     Py_DECREF(lags);
     return size < 0 ? NULL : PyLong_FromLongLong(size);
 }
 
-static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *arg)
+static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *args)
 {
-    long long lag = PyLong_AsLongLong(arg);
-    if (lag == -1 && PyErr_Occurred()) return NULL;
+    long long lag;
+    int estimator = GR_TAMSD_STRIDED;
+    if (!PyArg_ParseTuple(args, "L|i", &lag, &estimator)) return NULL;
     if (lag < 1) {
         PyErr_SetString(PyExc_ValueError, "lag must be >= 1");
         return NULL;
     }
-    return PyLong_FromLongLong(gr_sde_lag_stride(lag));
+    if (estimator != GR_TAMSD_STRIDED && estimator != GR_TAMSD_ALL) {
+        PyErr_SetString(PyExc_ValueError, "tamsd_estimator must be 0 (strided) or 1 (all)");
+        return NULL;
+    }
+    return PyLong_FromLongLong(gr_tamsd_stride(lag, estimator));
 }
 
 /* ==== SDE binding end =============================================================== */
@@ -747,14 +758,18 @@ static PyMethodDef core_methods[] = {
     /* ==== SDE methods begin ==== */
     {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
      "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
-     " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring, exponent=1.0):"
-     " advance particles"
-     " first..first+len(x) over the steps [step_from, step_to) of a run of n_steps,"
+     " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring, carry=None,"
+     " threads=1, tamsd_estimator=0, exponent=1.0): advance particles first..first+len(x)"
+     " over the steps [step_from, step_to) of a run of n_steps on `threads` threads,"
      " accumulating into the given arrays; ring (sde_ring_size doubles) carries one particle"
-     " from segment to segment (internal: use granular.langevin)."},
-    {"sde_lag_stride", sde_lag_stride, METH_O, "spacing of TAMSD window starts for a lag (steps)"},
+     " from segment to segment, carry (2 x len(sample_steps) x dim doubles) the sums of a"
+     " block of particles left open (internal: use granular.langevin)."},
+    {"sde_lag_stride", sde_lag_stride, METH_VARARGS,
+     "sde_lag_stride(lag, tamsd_estimator=0): spacing of TAMSD window starts for a lag (steps;"
+     " estimator 0 strided, 1 every window)"},
     {"sde_ring_size", sde_ring_size, METH_VARARGS,
-     "sde_ring_size(dim, lags): doubles of sde_run's ring for these lags (steps, each >= 1)"},
+     "sde_ring_size(dim, lags, tamsd_estimator=0): doubles of sde_run's ring for these lags"
+     " (steps, increasing, each >= 1)"},
     /* ==== SDE methods end ==== */
     {NULL, NULL, 0, NULL}
 };
@@ -805,6 +820,10 @@ PyMODINIT_FUNC PyInit__core(void)
         return NULL;
     }
     Py_DECREF(max_steps);
+    if (PyModule_AddIntConstant(m, "SDE_BLOCK", GR_SDE_BLOCK) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
     gr_rng_init();
     return m;
 }

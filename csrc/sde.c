@@ -4,39 +4,18 @@
  *
  * Each particle is independent, so the loop runs over particles outside and steps
  * inside: a particle's state stays in registers for the whole run, and the TAMSD needs
- * only the ring of one particle's recent positions at a time (O(lags) memory, not
- * O(N x steps)).  Invariant: a particle's random numbers depend only on (key, step,
- * particle), never on the order of work. */
+ * only the rings of one particle's past positions at a time (tamsd.h: O(levels) memory,
+ * not O(N x steps)).  The particles are split over threads by blocks (sde.h).
+ * Invariant: a particle's random numbers depend only on (key, step, particle), never on
+ * the order of work. */
 #include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "rng.h"
 #include "sde.h"
-
-#define GR_TAMSD_WINDOWS_PER_LAG 16
-
-int64_t gr_sde_lag_stride(int64_t lag)
-{
-    int64_t s = lag / GR_TAMSD_WINDOWS_PER_LAG;
-    return s < 1 ? 1 : s;
-}
-
-int64_t gr_sde_ring_len(int64_t lag)
-{
-    /* ceil(lag / s) + 1, written so that no intermediate exceeds lag */
-    return (lag - 1) / gr_sde_lag_stride(lag) + 2;
-}
-
-int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags)
-{
-    int64_t total = 0;
-    for (int64_t l = 0; l < n_lags; l++) {
-        const int64_t need = gr_sde_ring_len(lags[l]) * dim; /* <= 32 x 3 */
-        if (total > INT64_MAX - need) return -1;
-        total += need;
-    }
-    return total;
-}
+#include "tamsd.h"
 
 /* x-noise variance of the exact step in units of D/gamma, minus the part explained by the
  * velocity noise: g(h) = 2 f(h) - (1-c)^3/(1+c), c = exp(-h), with
@@ -150,9 +129,170 @@ static int64_t first_sample_from(const gr_sde_output *out, int64_t step)
     return lo;
 }
 
+/* Everything one particle's run over the call's segment reads or writes besides its own
+ * state: shared read-only setup, and the scratch and sums of the thread that runs it. */
+typedef struct {
+    const gr_sde_config *cfg;
+    const step_params *sp;
+    const gr_sde_output *out;
+    const gr_tamsd_plan *plan;
+    int64_t n, step_from, step_to, n_steps, ks0;
+} run_shared;
+
+/* The TAMSD's bookkeeping at step t of a particle at xi (tamsd.h): first the windows
+ * ending at t, read from the rings (before t's own stores, which may reuse a slot), then
+ * the stores of the levels whose stride divides t. */
+static GR_ALWAYS_INLINE void tamsd_book(const int d, const gr_tamsd_plan *p, int64_t t,
+                                        const double *xi, double *ring, double *acc,
+                                        int64_t *slow_next, int64_t *next_slow)
+{
+    /* stride 1: the first n_every lags, ascending, at every step once t reaches them */
+    const double *r0 = ring; /* level 0's ring comes first */
+    for (int64_t l = 0; l < p->n_every && p->lag[l].lag <= t; l++) {
+        const double *old = r0 + ((t - p->lag[l].lag) & p->lag[l].mask) * d;
+        double sum = 0.0;
+        for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
+        acc[l] += sum;
+    }
+    const int64_t ph = t & p->phase_mask;
+    for (int64_t k = p->phase_off[ph]; k < p->phase_off[ph + 1]; k++) {
+        const int64_t l = p->phase_lag[k];
+        const gr_tamsd_lag g = p->lag[l];
+        if (t < g.lag) continue; /* the window would start before step 0 */
+        const double *old = ring + g.off + (((t - g.lag) >> g.level) & g.mask) * d;
+        double sum = 0.0;
+        for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
+        acc[l] += sum;
+    }
+    if (t == *next_slow) {
+        int64_t soonest = INT64_MAX;
+        for (int64_t j = 0; j < p->n_slow; j++) {
+            const gr_tamsd_lag g = p->lag[p->slow[j]];
+            if (slow_next[j] == t) {
+                const double *old = ring + g.off + (((t - g.lag) >> g.level) & g.mask) * d;
+                double sum = 0.0;
+                for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
+                acc[p->slow[j]] += sum;
+                slow_next[j] += (int64_t)1 << g.level;
+            }
+            if (slow_next[j] < soonest) soonest = slow_next[j];
+        }
+        *next_slow = soonest;
+    }
+    /* level e stores at multiples of 2^e: levels 0 .. (trailing zeros of t) */
+    for (int e = 0; e <= p->top && (e == 0 || (t & (((int64_t)1 << e) - 1)) == 0); e++)
+        if (p->used >> e & 1)
+            memcpy(ring + p->level_off[e] + ((t >> e) & p->level_mask[e]) * d, xi,
+                   (size_t)d * sizeof(double));
+}
+
+/* Particle i over the segment: x, v its state (d values each) in and out; the samples'
+ * squares are added to x2, v2 (n_samples x d each: its block's sums), its TAMSD windows
+ * to out->tamsd; ring and slow_next (a step per slow lag) are the running thread's
+ * scratch (the ring carries over between segments).  Returns GR_OK or GR_ERR_NONFINITE. */
+static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, double *x2,
+                        double *v2, double *ring, int64_t *slow_next)
+{
+    const gr_sde_output *out = rs->out;
+    const int d = rs->cfg->dim;
+    const int64_t n = rs->n, step_from = rs->step_from, step_to = rs->step_to;
+    const int64_t n_steps = rs->n_steps;
+    double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0};
+    for (int a = 0; a < d; a++) {
+        xi[a] = x[a];
+        vi[a] = v[a];
+    }
+    int64_t ks = rs->ks0;
+    const gr_tamsd_plan *tp = rs->plan;
+    double *acc = out->tamsd + i * tp->n_lags; /* the particle's window sums, in time order */
+    /* the slow lags' next window ends after step_from: k + j s >= step_from */
+    int64_t next_slow = INT64_MAX;
+    for (int64_t j = 0; j < tp->n_slow; j++) {
+        const int64_t lag = tp->lag[tp->slow[j]].lag, s = (int64_t)1 << tp->lag[tp->slow[j]].level;
+        slow_next[j] = step_from <= lag ? lag : lag + ((step_from - lag - 1) / s + 1) * s;
+        if (slow_next[j] < next_slow) next_slow = slow_next[j];
+    }
+    /* Bookkeeping (samples, TAMSD windows) happens at the steps that need it; between
+     * them the particle is stepped in a tight loop.  Step 0, the start, is a sample and a
+     * window start for every lag. */
+    for (int64_t step = step_from;;) {
+        if (step == step_to && step_to < n_steps) break; /* booked by the next segment */
+        while (ks < out->n_samples && out->sample_steps[ks] == step) {
+            for (int a = 0; a < d; a++) {
+                x2[ks * d + a] += xi[a] * xi[a];
+                v2[ks * d + a] += vi[a] * vi[a];
+                if (out->positions) out->positions[(ks * n + i) * d + a] = xi[a];
+            }
+            ks++;
+        }
+        int64_t next = step_to; /* the next step that needs bookkeeping */
+        if (ks < out->n_samples && out->sample_steps[ks] < next) next = out->sample_steps[ks];
+        if (tp->n_lags) {
+            switch (d) {
+            case 1: tamsd_book(1, tp, step, xi, ring, acc, slow_next, &next_slow); break;
+            case 2: tamsd_book(2, tp, step, xi, ring, acc, slow_next, &next_slow); break;
+            default: tamsd_book(3, tp, step, xi, ring, acc, slow_next, &next_slow); break;
+            }
+            const int64_t busy = step + 1 + tp->gap[(step + 1) & tp->phase_mask];
+            if (busy < next) next = busy;
+            if (next_slow < next) next = next_slow;
+        }
+        if (step == n_steps) break;
+        /* steps step+1 .. next, each with its own dimension so that the axis loops
+         * unroll */
+        switch (d) {
+        case 1: run_steps(1, rs->sp, i, step, next, xi, vi); break;
+        case 2: run_steps(2, rs->sp, i, step, next, xi, vi); break;
+        default: run_steps(3, rs->sp, i, step, next, xi, vi); break;
+        }
+        step = next;
+    }
+    for (int a = 0; a < d; a++) {
+        if (!isfinite(xi[a]) || !isfinite(vi[a])) return GR_ERR_NONFINITE;
+        x[a] = xi[a];
+        v[a] = vi[a];
+    }
+    return GR_OK;
+}
+
+/* One thread's share of a call: particles [lo, hi) (whole blocks, but for the call's
+ * first and last), their sample sums into the blocks' rows of `sums`. */
+typedef struct {
+    const run_shared *rs;
+    int64_t lo, hi;       /* global particle indices */
+    int64_t first;        /* the call's first particle: x, v and sums start there */
+    double *x, *v;        /* the call's state arrays */
+    double *sums;         /* the call's block sums, row 0 for the block of `first` */
+    double *ring;         /* this thread's scratch */
+    int64_t *slow_next;
+    int status;
+    int64_t bad;          /* the particle that failed, or -1 */
+} worker;
+
+static void *work(void *arg)
+{
+    worker *w = arg;
+    const int d = w->rs->cfg->dim;
+    const int64_t row = 2 * w->rs->out->n_samples * d, b0 = w->first / GR_SDE_BLOCK;
+    w->status = GR_OK;
+    w->bad = -1;
+    for (int64_t i = w->lo; i < w->hi; i++) {
+        double *s = w->sums + (i / GR_SDE_BLOCK - b0) * row;
+        const int64_t at = (i - w->first) * d;
+        int st = run_particle(w->rs, i, w->x + at, w->v + at, s,
+                              s + w->rs->out->n_samples * d, w->ring, w->slow_next);
+        if (st != GR_OK) {
+            w->status = st;
+            w->bad = i;
+            break;
+        }
+    }
+    return NULL;
+}
+
 int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
                int64_t step_from, int64_t step_to, int64_t n_steps, double *x, double *v,
-               gr_sde_output *out, gr_error *err)
+               gr_sde_output *out, int threads, gr_error *err)
 {
     const int d = cfg->dim;
     const double dt = cfg->dt, g0 = cfg->gamma0, D0 = cfg->D0, tau0 = cfg->tau0;
@@ -163,7 +303,8 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
         !(expo > 0.0 && expo < INFINITY) || n_steps < 0 || n_steps > GR_SDE_MAX_STEPS ||
         step_from < 0 || step_from > step_to ||
         step_to > n_steps || first < 0 || count < 0 || first > n || count > n - first ||
-        (!whole && count > 1)) {
+        (!whole && count > 1) || threads < 1 || out->n_samples < 0 ||
+        out->n_samples > INT64_MAX / 6) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, "invalid SDE parameters");
         return GR_ERR_VALUE;
     }
@@ -173,6 +314,7 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
                      "exact scheme (scheme='exact'), stable at any step");
         return GR_ERR_UNSTABLE;
     }
+    if (count == 0) return GR_OK;
     if (!gr_rng_ready) gr_rng_init();
     const double sq_dt = sqrt(dt), b0 = sqrt(2.0 * D0) * g0 * sq_dt;
     const exact_coef ex0 = exact_for(g0, D0, dt);
@@ -199,84 +341,88 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
 
     const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, expo, udsbm, cfg->scheme == GR_SDE_EM,
                             ex0, table, step_from, em_table};
-    /* where the segment starts among the samples */
-    const int64_t ks0 = first_sample_from(out, step_from);
-    for (int64_t local = 0; local < count; local++) {
-        const int64_t i = first + local;
-        double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0};
-        for (int a = 0; a < d; a++) {
-            xi[a] = x[local * d + a];
-            vi[a] = v[local * d + a];
+
+    /* The ensemble sums, the same bits for any split: each block of GR_SDE_BLOCK particles
+     * (by global index) sums its particles in index order from zero (or from the carry a
+     * previous call left for a block it began), and complete blocks are added to x2, v2
+     * in block order after every thread is done.  A thread takes whole blocks. */
+    const int64_t T = out->n_samples, row = 2 * T * d;
+    const int64_t b_first = first / GR_SDE_BLOCK, b_last = (first + count - 1) / GR_SDE_BLOCK;
+    const int64_t nb = b_last - b_first + 1;
+    const int64_t nt = threads < nb ? threads : nb;
+    /* scratch per extra thread: its ring and slow lags' steps (thread 0 has out's ring) */
+    const int64_t ring_n = gr_tamsd_ring_size(d, out->n_lags, out->lags, out->estimator);
+    if (ring_n < 0 || (row > 0 && nb > (int64_t)(SIZE_MAX / sizeof(double) / 2) / row) ||
+        (nt > 1 && ring_n > (int64_t)(SIZE_MAX / sizeof(double) / 2) / (nt - 1))) {
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "the SDE scratch's size overflows");
+        return GR_ERR_NOMEM;
+    }
+    gr_tamsd_plan plan;
+    if (gr_tamsd_plan_init(&plan, d, out->n_lags, out->lags, out->estimator) != GR_OK) {
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "no memory for the TAMSD plan");
+        return GR_ERR_NOMEM;
+    }
+    const run_shared rs = {cfg, &sp, out, &plan, n, step_from, step_to, n_steps,
+                           first_sample_from(out, step_from)};
+    double *sums = calloc((size_t)(nb * row) + 1, sizeof(double));
+    worker *ws = calloc((size_t)nt, sizeof(worker));
+    pthread_t *tid = calloc((size_t)nt, sizeof(pthread_t));
+    int *started = calloc((size_t)nt, sizeof(int));
+    double *rings = calloc((size_t)((nt - 1) * ring_n) + 1, sizeof(double));
+    int64_t *slow = calloc((size_t)(nt * plan.n_slow) + 1, sizeof(int64_t));
+    int status = GR_OK;
+    if (!sums || !ws || !tid || !started || !rings || !slow) {
+        gr_error_set(err, GR_ERR_NOMEM, -1, -1, NAN, NAN, "no memory for the SDE threads");
+        status = GR_ERR_NOMEM;
+        goto done;
+    }
+    if (out->carry) memcpy(sums, out->carry, (size_t)row * sizeof(double));
+    for (int64_t t = 0; t < nt; t++) {
+        /* thread t takes blocks [b_first + nb t / nt, b_first + nb (t+1) / nt) */
+        const int64_t lo = (b_first + nb * t / nt) * GR_SDE_BLOCK;
+        const int64_t hi = (b_first + nb * (t + 1) / nt) * GR_SDE_BLOCK;
+        ws[t] = (worker){&rs, lo > first ? lo : first, hi < first + count ? hi : first + count,
+                         first, x, v, sums,
+                         t == 0 ? out->ring : rings + (t - 1) * ring_n, slow + t * plan.n_slow,
+                         GR_OK, -1};
+    }
+    /* threads 1.. run beside this one; one that cannot be started runs here afterwards
+     * (the same numbers, later) */
+    for (int64_t t = 1; t < nt; t++) started[t] = pthread_create(&tid[t], NULL, work, &ws[t]) == 0;
+    work(&ws[0]);
+    for (int64_t t = 1; t < nt; t++) {
+        if (started[t]) pthread_join(tid[t], NULL);
+        else work(&ws[t]);
+    }
+    for (int64_t t = 0; t < nt; t++)
+        if (ws[t].status != GR_OK) { /* the first failure in particle order */
+            status = ws[t].status;
+            gr_error_set(err, status, ws[t].bad, -1, NAN, NAN, "in the SDE state");
+            break;
         }
-        int64_t ks = ks0;
-        /* Per lag: next window end, next store, their ring slots (no divisions per step).
-         * The k-th store (k = 0, 1, ...) is at step k stride into slot k mod len, the k-th
-         * window ends at lag + k stride and reads that slot: so the counters at step_from
-         * follow from step_from alone, and only the ring carries over between segments. */
-        int64_t *next_end = out->lag_work, *next_store = next_end + out->n_lags;
-        int64_t *slot_end = next_store + out->n_lags, *slot_store = slot_end + out->n_lags;
-        for (int64_t l = 0; l < out->n_lags; l++) {
-            const int64_t lag = out->lags[l], stride = out->lag_stride[l], len = out->lag_len[l];
-            int64_t k = step_from / stride + (step_from % stride != 0);
-            next_store[l] = k * stride;
-            slot_store[l] = k % len;
-            k = step_from <= lag ? 0 : (step_from - lag - 1) / stride + 1;
-            next_end[l] = lag + k * stride;
-            slot_end[l] = k % len;
-        }
-        /* Bookkeeping (samples, TAMSD windows) happens at few steps; between them the
-         * particle is stepped in a tight loop.  Step 0, the start, is a sample and a
-         * window start for every lag. */
-        for (int64_t step = step_from;;) {
-            if (step == step_to && step_to < n_steps) break; /* booked by the next segment */
-            while (ks < out->n_samples && out->sample_steps[ks] == step) {
-                for (int a = 0; a < d; a++) {
-                    out->x2[ks * d + a] += xi[a] * xi[a];
-                    out->v2[ks * d + a] += vi[a] * vi[a];
-                    if (out->positions) out->positions[(ks * n + i) * d + a] = xi[a];
-                }
-                ks++;
+    if (status == GR_OK) {
+        /* Blocks complete in this call go to x2, v2 in order; the last, if a later call
+         * continues it (more of its particles, or more of this particle's steps), stays
+         * in the carry.  Without a carry the call ends the sums. */
+        const int64_t end = first + count;
+        const int done = step_to == n_steps;
+        for (int64_t b = 0; b < nb; b++) {
+            const double *s = sums + b * row;
+            int64_t block_end = (b_first + b + 1) * GR_SDE_BLOCK;
+            if (block_end > n) block_end = n;
+            if (out->carry && (!done || end < block_end)) {
+                memcpy(out->carry, s, (size_t)row * sizeof(double));
+                break; /* only the last block can be open */
             }
-            int64_t next = step_to; /* the next step that needs bookkeeping */
-            if (ks < out->n_samples && out->sample_steps[ks] < next) next = out->sample_steps[ks];
-            double *r = out->ring;
-            for (int64_t l = 0; l < out->n_lags; l++) {
-                const int64_t stride = out->lag_stride[l], len = out->lag_len[l];
-                if (step == next_end[l]) {
-                    const double *old = r + slot_end[l] * d;
-                    double sum = 0.0;
-                    for (int a = 0; a < d; a++) sum += (xi[a] - old[a]) * (xi[a] - old[a]);
-                    out->tamsd[i * out->n_lags + l] += sum;
-                    next_end[l] += stride;
-                    if (++slot_end[l] == len) slot_end[l] = 0;
-                }
-                if (step == next_store[l]) {
-                    memcpy(r + slot_store[l] * d, xi, (size_t)d * sizeof(double));
-                    next_store[l] += stride;
-                    if (++slot_store[l] == len) slot_store[l] = 0;
-                }
-                if (next_end[l] < next) next = next_end[l];
-                if (next_store[l] < next) next = next_store[l];
-                r += len * d;
+            for (int64_t k = 0; k < T * d; k++) {
+                out->x2[k] += s[k];
+                out->v2[k] += s[T * d + k];
             }
-            if (step == n_steps) break;
-            /* steps step+1 .. next, each with its own dimension so that the axis loops
-             * unroll */
-            switch (d) {
-            case 1: run_steps(1, &sp, i, step, next, xi, vi); break;
-            case 2: run_steps(2, &sp, i, step, next, xi, vi); break;
-            default: run_steps(3, &sp, i, step, next, xi, vi); break;
-            }
-            step = next;
-        }
-        for (int a = 0; a < d; a++) {
-            if (!isfinite(xi[a]) || !isfinite(vi[a])) {
-                gr_error_set(err, GR_ERR_NONFINITE, i, -1, NAN, NAN, "in the SDE state");
-                return GR_ERR_NONFINITE;
-            }
-            x[local * d + a] = xi[a];
-            v[local * d + a] = vi[a];
+            if (out->carry) memset(out->carry, 0, (size_t)row * sizeof(double));
         }
     }
-    return GR_OK;
+done:
+    free(sums), free(ws), free(tid), free(started), free(rings), free(slow);
+    gr_tamsd_plan_free(&plan);
+    return status;
 }

@@ -8,14 +8,17 @@
  *
  * Schemes: Euler-Maruyama exactly as the thesis' (2.92)/(2.110), or the exact update of
  * the Ornstein-Uhlenbeck process over a step (coefficients frozen at the step's midpoint
- * for UDSBM: exact for the OU step, O((dt/tau0)^2) per step for the time dependence).  Random numbers come from rng.h, keyed by (step, particle): results do not
- * depend on chunking.  The caller owns every buffer; nothing is allocated here. */
+ * for UDSBM: exact for the OU step, O((dt/tau0)^2) per step for the time dependence).
+ * Random numbers come from rng.h, keyed by (step, particle): results do not depend on
+ * chunking or threads.  The caller owns the inputs, outputs and the carried scratch; a
+ * call allocates only its threads' scratch and the block sums (freed before it returns). */
 #ifndef GR_SDE_H
 #define GR_SDE_H
 
 #include <stdint.h>
 
 #include "common.h"
+#include "tamsd.h"
 
 enum { GR_SDE_LANGEVIN = 0, GR_SDE_UDSBM = 1 };
 enum { GR_SDE_EM = 0, GR_SDE_EXACT = 1 };
@@ -31,12 +34,17 @@ typedef struct {
 } gr_sde_config;
 
 /* Largest step count of a run: step counters plus a lag's stride then stay far from
- * INT64_MAX (a stride is at most lag/16 and lags beyond the run are never reached). */
+ * INT64_MAX (a stride is at most lag/4 and lags beyond the run are never reached). */
 #define GR_SDE_MAX_STEPS ((int64_t)1 << 62)
 
+/* Particles per block of the ensemble sums: x2 and v2 are sums, in block order, of each
+ * block's sum over its particles in index order -- an order fixed by the particles'
+ * indices alone, so the bits are the same however the particles are split into calls and
+ * threads. */
+#define GR_SDE_BLOCK 32
+
 /* What a run accumulates.  Sample k is taken after step sample_steps[k] (0 = the start);
- * lags are in steps.  Sums run over particles in index order, so they are the same
- * however the particles and steps are chunked. */
+ * lags are in steps. */
 typedef struct {
     int64_t n_samples;
     const int64_t *sample_steps; /* increasing, >= 0 */
@@ -45,27 +53,22 @@ typedef struct {
     double *positions;           /* n_samples x n x dim, or NULL */
     int64_t n_lags;
     const int64_t *lags;         /* increasing, >= 1 */
-    const int64_t *lag_stride;   /* per lag: spacing of window starts (gr_sde_lag_stride) */
-    const int64_t *lag_len;      /* per lag: ring length (gr_sde_ring_len) */
-    int64_t *lag_work;           /* scratch: 4 x n_lags */
+    int estimator;               /* GR_TAMSD_STRIDED or GR_TAMSD_ALL (tamsd.h) */
     double *tamsd;               /* n x n_lags: per particle, sum over windows of |dx|^2 */
-    double *ring;                /* gr_sde_ring_size doubles: one particle's past positions
-                                    per lag.  Scratch for a whole run; carried from call to
+    double *ring;                /* gr_tamsd_ring_size doubles: one particle's stored window
+                                    starts.  Scratch for a whole run; carried from call to
                                     call when a run is split into step segments */
+    double *carry;               /* 2 x n_samples x dim (x2's then v2's), or NULL: the sums
+                                    of a block a call leaves open (its last particles, or
+                                    the rest of its particle's steps, come in a later call);
+                                    zero at the start of a run.  NULL: the call ends the
+                                    sums (its last block is added to x2, v2) */
     double *step_coef;           /* optional scratch, 5 x (step_to - step_from): the exact
                                     scheme's UDSBM coefficients per step (Euler-Maruyama's,
                                     2 a step, for an exponent != 1), computed once per
                                     call instead of once per particle and step; NULL
                                     computes them inline (the same numbers) */
 } gr_sde_output;
-
-/* Stride of TAMSD window starts for a lag: windows start every max(1, lag/16) steps, so
- * each particle keeps at most 32 past positions per lag (lag 31, stride 1). */
-int64_t gr_sde_lag_stride(int64_t lag);
-/* Past positions one particle keeps for a lag (>= 1): lag/stride rounded up, plus one. */
-int64_t gr_sde_ring_len(int64_t lag);
-/* Doubles of ring needed for the lags (each >= 1), or -1 if that overflows int64. */
-int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags);
 
 /* Advance particles [first, first + count) of n over the steps [step_from, step_to) of a
  * run of n_steps <= GR_SDE_MAX_STEPS steps: positions x and velocities v (count x dim)
@@ -74,10 +77,12 @@ int64_t gr_sde_ring_size(int dim, int64_t n_lags, const int64_t *lags);
  * and at n_steps when step_to = n_steps, so a run is one call over [0, n_steps] or calls
  * over consecutive segments [s0 = 0, s1), [s1, s2), ..., ending at n_steps, with the same
  * results to the bit.  A segment that is not the whole run takes one particle (count <= 1)
- * and the ring its previous segment left.  Returns GR_OK, GR_ERR_VALUE, GR_ERR_NONFINITE
- * or GR_ERR_UNSTABLE (Euler-Maruyama with gamma0 dt >= 2). */
+ * and the ring its previous segment left.  The particles are split into `threads` (>= 1)
+ * POSIX threads by whole blocks; the results are the same to the bit for any count.
+ * Returns GR_OK, GR_ERR_VALUE, GR_ERR_NOMEM, GR_ERR_NONFINITE or GR_ERR_UNSTABLE
+ * (Euler-Maruyama with gamma0 dt >= 2). */
 int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
                int64_t step_from, int64_t step_to, int64_t n_steps, double *x, double *v,
-               gr_sde_output *out, gr_error *err);
+               gr_sde_output *out, int threads, gr_error *err);
 
 #endif

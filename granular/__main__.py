@@ -42,6 +42,12 @@ def main(argv=None):
     bench.add_argument("--quick", action="store_true", help="tiny workloads (seconds)")
     bench.add_argument("--large", action="store_true", help="add N = 1e6")
     bench.add_argument(
+        "--rounds",
+        type=int,
+        default=None,
+        help="interleaved rounds of the Langevin runs, medians reported (default 3; 1 --quick)",
+    )
+    bench.add_argument(
         "--speed-accuracy",
         action="store_true",
         help="chart error against cost and map where methods fail",
@@ -76,7 +82,9 @@ def main(argv=None):
         else:
             from .cli import bench as bench_module
 
-            bench_module.main(json_path=args.json, quick=args.quick, large=args.large)
+            bench_module.main(
+                json_path=args.json, quick=args.quick, large=args.large, rounds=args.rounds
+            )
     return 0
 
 

@@ -594,8 +594,9 @@ def ensemble(
           ``functools.partial(Scene.random, 1000, 0.025, restitution=0.8)``): a new scene
           per run, then EDMD as above;
         - a function ``f(seed=SeedSequence)`` returning anything else (e.g.
-          ``functools.partial(granular.langevin.run, ...)``): its NumPy arrays and numbers
-          are the quantities (``run_kwargs`` must then be empty);
+          ``functools.partial(granular.langevin.run, ..., threads=1)``, one thread per run
+          since the workers already share the cores): its NumPy arrays and numbers are the
+          quantities (``run_kwargs`` must then be empty);
         - a list or tuple of P such models, the points of a sweep: all P x ``runs`` runs
           are scheduled together, so the backend's workers stay busy across points.
 

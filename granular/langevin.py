@@ -34,14 +34,20 @@ The exact scheme is the default; Euler-Maruyama, the thesis' scheme, is one keyw
 
 Random numbers are counter-based (see ``csrc/rng.h``): each particle's noise at each step
 is a function of (seed, step, particle) only, so results are bit-identical whatever the
-chunking.  Nothing of size N x steps is stored: the ensemble MSD at the sample times and
-the time-averaged MSD at the requested lags are accumulated on the fly (window starts every
-max(1, lag/16) steps, so each particle needs at most 32 past positions per lag).
+chunking or the number of threads.  Nothing of size N x steps is stored: the ensemble MSD
+at the sample times and the time-averaged MSD at the requested lags are accumulated on the
+fly.  The TAMSD averages, for each lag, the windows starting every ``s`` steps:
+``tamsd_estimator="strided"`` (the default) takes s the largest power of two <= max(1,
+lag/4), so that 4 to 8 windows overlap any one -- its variance is at most 3.1% above that
+of every window for Brownian increments, at a cost per step that no longer grows with the
+number of long lags; ``"all"`` takes every window (s = 1), the textbook estimator, at one
+window per lag per step.  See docs/performance.md.
 """
 
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -57,6 +63,9 @@ if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but st
     from .theory import LangevinCoefficients
 
 MODELS = ("langevin", "udsbm")
+# the TAMSD's windows (csrc/tamsd.h): "strided" starts a lag's windows every power of
+# two <= max(1, lag/4) steps, "all" at every step
+TAMSD_ESTIMATORS = ("strided", "all")
 SCHEMES = ("em", "exact")
 INITIAL = ("thermal", "udsbm", "fixed")
 # Work per call into C, in particle-steps: a block of particles over the whole run, or one
@@ -186,6 +195,7 @@ class LangevinResult:
     tamsd_lags : (L,) lags in time at which the TAMSD was accumulated
     tamsd_mean : (L,) particle-averaged time-averaged MSD (``tamsd()`` returns it)
     tamsd_per_particle : (N, L)
+    tamsd_estimator : "strided" or "all", the windows the TAMSD averages (see ``run``)
     positions : (T, N, d) positions at the sample times, or None (``store_positions``)
     final_positions, final_velocities : (N, d) the state at ``t_stop``
     model, scheme : as given to ``run``
@@ -208,6 +218,7 @@ class LangevinResult:
     final_velocities: NDArray[np.float64]
     model: str
     scheme: str
+    tamsd_estimator: str
     gamma0: float
     D0: float
     tau0: float
@@ -353,6 +364,7 @@ class LangevinResult:
             t_stop=self.t_stop,
             dim=self.dim,
             v0_sq=self.v0_sq,
+            tamsd_estimator=self.tamsd_estimator,
             exponent=self.exponent,
         )
 
@@ -378,7 +390,14 @@ class LangevinResult:
         out = []
         for lag in lag_t:
             k = round(lag / self.dt)
-            starts = np.arange(0, n_steps - k + 1, _core.sde_lag_stride(k)) * self.dt
+            starts = (
+                np.arange(
+                    0,
+                    n_steps - k + 1,
+                    _core.sde_lag_stride(k, _estimator_code(self.tamsd_estimator)),
+                )
+                * self.dt
+            )
             out.append(
                 theory.udsbm_ergodicity_breaking(
                     k * self.dt,
@@ -411,13 +430,15 @@ def theory_tamsd(
     tau0: float = math.inf,
     dim: int = 3,
     v0_sq: float | None = None,
+    tamsd_estimator: str = "strided",
     exponent: float = 1.0,
 ) -> NDArray[np.float64]:
     """The expected time-averaged MSD of a run, total over ``dim``: for each lag the mean,
     over the windows the engine averages (starting every ``sde_lag_stride`` steps from 0
-    while they end by ``t_stop``), of the mean squared displacement over the window --
-    ``theory.msd_langevin`` from the velocity variance reached at the window's start for
-    the Langevin model (tau0 = inf), ``theory.udsbm_increment_msd`` for UDSBM.
+    while they end by ``t_stop``; ``tamsd_estimator`` as in ``run``), of the mean squared
+    displacement over the window -- ``theory.msd_langevin`` from the velocity variance
+    reached at the window's start for the Langevin model (tau0 = inf),
+    ``theory.udsbm_increment_msd`` for UDSBM.
     ``v0_sq`` is the initial mean squared velocity per component (None: thermal, or App.
     C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD.  For UDSBM
     with ``exponent`` a != 1, ``theory.powerlaw_udsbm_increment_msd`` (numerical moments;
@@ -428,7 +449,8 @@ def theory_tamsd(
     out = []
     for lag in np.atleast_1d(np.asarray(lags, dtype=np.float64)):
         k = round(lag / dt)
-        starts = np.arange(0, n_steps - k + 1, _core.sde_lag_stride(k)) * dt
+        stride = _core.sde_lag_stride(k, _estimator_code(tamsd_estimator))
+        starts = np.arange(0, n_steps - k + 1, stride) * dt
         if math.isinf(tau0):
             thermal = D0 * gamma0
             v_sq = (
@@ -447,6 +469,24 @@ def theory_tamsd(
             incr = theory.udsbm_increment_msd(lag, starts, D0, gamma0, tau0, dim, v0_sq=v0_sq)
         out.append(float(np.mean(incr)))
     return np.array(out)
+
+
+def _estimator_code(name: str) -> int:
+    if name not in TAMSD_ESTIMATORS:
+        raise ValueError(f"tamsd_estimator must be one of {TAMSD_ESTIMATORS}, got {name!r}")
+    return TAMSD_ESTIMATORS.index(name)
+
+
+def _threads(threads: int | None) -> int:
+    """The number of threads asked for, checked; None: the cores this process may use."""
+    if threads is None:
+        try:
+            return max(1, len(os.sched_getaffinity(0)))
+        except AttributeError:  # not on Linux
+            return max(1, os.cpu_count() or 1)
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ValueError(f"threads must be a whole number >= 1 or None, got {threads!r}")
+    return min(int(threads), 1024)
 
 
 def _positive(name: str, value: float) -> float:
@@ -475,6 +515,8 @@ def run(
     store_positions: bool = False,
     seed: Any = None,
     progress: bool = False,
+    threads: int | None = None,
+    tamsd_estimator: str = "strided",
 ) -> LangevinResult:
     """Integrate N independent particles from a common start at the origin.
 
@@ -497,6 +539,10 @@ def run(
         times used); default 60 log-spaced times and 0
     tamsd_lags : increasing lags (in time) of the time-averaged MSD over [0, t_stop],
         rounded to whole steps like the sample times (``result.tamsd_lags``)
+    tamsd_estimator : "strided" (default) or "all": which windows the TAMSD averages --
+        starting every power of two <= max(1, lag/4) steps, or at every step (exact, but
+        one window per lag per step, and a ring of lag positions per thread; lags up to
+        2**30 steps).  See the module docstring for their statistical difference.
     initial : "thermal" -- Gaussian velocities with <v_a^2> = T0/m = D0 gamma0;
         "udsbm" -- Gaussian with App. C's "correct" <v_a^2> = D0 gamma0 a/(a - 1),
         a = gamma0 tau0, for which the UDSBM MSD is exactly (2.113) (exponent 1 only:
@@ -506,10 +552,31 @@ def run(
     store_positions : keep (T, N, d) positions at the sample times
     seed : anything ``numpy.random.SeedSequence`` takes
     progress : tqdm bar over particle-steps
+    threads : how many threads step the particles (None: one per core this process may
+        run on).  The results are the same to the bit for any number: each particle's
+        random numbers depend on (seed, step, particle) only, and the ensemble sums add
+        fixed blocks of particles in a fixed order.  A run of fewer particles than
+        threads, or so long that one particle is stepped at a time, uses fewer (at most
+        1024 are started).
+
+    Returns
+    -------
+    LangevinResult
+
+    Raises
+    ------
+    ValueError
+        For a parameter out of its range (named in the message).
+    UnstableStepError
+        Euler-Maruyama with gamma0 dt >= 2.
+    MemoryError
+        Stored positions or the every-window TAMSD's rings that would not fit.
     """
     n = int(n)
     if n < 1:
         raise ValueError(f"n must be >= 1, got {n}")
+    threads = _threads(threads)
+    estimator = _estimator_code(tamsd_estimator)
     if dim not in (1, 2, 3):
         raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
     gamma0, D0, dt, t_stop = (
@@ -630,10 +697,26 @@ def run(
     # else one particle at a time over segments of its steps (the C core carries such a
     # particle's past positions from segment to segment in `ring`).  The same numbers to
     # the bit either way.
+    # A call of blocks of particles takes `threads` times the work (the threads share it);
+    # a segment of one particle's steps runs on one thread.
     work = max(1, _CHUNK_PARTICLE_STEPS)
-    per_call = max(1, work // n_steps)
     steps_per_call = min(n_steps, work)
-    ring = np.zeros(_core.sde_ring_size(dim, lags))
+    per_call = max(1, work * threads // n_steps) if steps_per_call == n_steps else 1
+    # whole blocks of particles for every thread (the C core gives each thread whole blocks
+    # of SDE_BLOCK, the ensemble sums' unit): 100 particles on 2 threads would be 64 + 36
+    for unit in (_core.SDE_BLOCK * threads, _core.SDE_BLOCK):
+        if per_call >= unit:
+            per_call -= per_call % unit
+            break
+    ring_size = _core.sde_ring_size(dim, lags, estimator)
+    if 8.0 * ring_size * threads > 2**31:
+        raise MemoryError(
+            f"tamsd_estimator={tamsd_estimator!r} keeps {8.0 * ring_size / 2**30:.1f} GiB of "
+            f"past positions per thread for lags up to {int(lags[-1])} steps; take "
+            "tamsd_estimator='strided' (a few kB) or fewer threads"
+        )
+    ring = np.zeros(ring_size)
+    carry = np.zeros((2, T, dim))  # the ensemble sums of a block of particles left open
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -668,6 +751,9 @@ def run(
                     lags,
                     tamsd_sum,
                     ring,
+                    carry,
+                    threads,
+                    estimator,
                     exponent=exponent,
                 )
                 if bar is not None:
@@ -678,7 +764,7 @@ def run(
         if bar is not None:
             bar.close()
 
-    strides = np.array([_core.sde_lag_stride(int(k)) for k in lags], dtype=np.int64)
+    strides = np.array([_core.sde_lag_stride(int(k), estimator) for k in lags], dtype=np.int64)
     windows = (n_steps - lags) // np.maximum(strides, 1) + 1
     per_particle = tamsd_sum / windows if L else tamsd_sum
     return LangevinResult(
@@ -695,6 +781,7 @@ def run(
         final_velocities=v,
         model=model,
         scheme=scheme,
+        tamsd_estimator=tamsd_estimator,
         gamma0=gamma0,
         D0=D0,
         tau0=tau0,

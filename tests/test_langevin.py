@@ -310,6 +310,57 @@ def test_same_seed_same_result_whatever_the_chunking(monkeypatch, model, tau0, s
     assert not np.array_equal(a.positions, c.positions)
 
 
+@pytest.mark.parametrize("model,tau0", [("langevin", math.inf), ("udsbm", TAU0)])
+@pytest.mark.parametrize("scheme", ["em", "exact"])
+@pytest.mark.parametrize("dim", [1, 2, 3])
+@pytest.mark.parametrize("lags", [None, [0.01, 0.05, 0.13, 0.5]])
+def test_same_bits_for_any_number_of_threads(monkeypatch, model, tau0, scheme, dim, lags):
+    """threads = 1, 2, 3, 7 give the same bits (np.array_equal) -- the ensemble sums too,
+    whose blocks of 32 particles are added in order whatever thread summed them.  250
+    particles are 8 blocks, the last one short, so 7 threads split them unevenly; then
+    the same in calls of 45 x threads particles (rounded down to whole blocks per
+    thread), and of 3 x threads (below a block: calls begin and end inside blocks, a
+    thread's first and last blocks are partial, the carry takes them to the next call)."""
+    kw = dict(
+        gamma0=G0,
+        D0=D0,
+        tau0=tau0,
+        model=model,
+        scheme=scheme,
+        dim=dim,
+        dt=0.01,
+        t_stop=0.5,
+        sample_times=np.arange(0, 51, 5) * 0.01,
+        tamsd_lags=lags,
+        store_positions=True,
+        seed=11,
+    )
+    names = (
+        "msd_per_dimension",
+        "v2",
+        "tamsd_per_particle",
+        "positions",
+        "final_positions",
+        "final_velocities",
+    )
+    a = langevin.run(250, threads=1, **kw)
+    for per_thread in (None, 45, 3):
+        if per_thread:
+            monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", per_thread * 50)
+        for threads in (1, 2, 3, 7):
+            b = langevin.run(250, threads=threads, **kw)
+            for name in names:
+                assert np.array_equal(getattr(a, name), getattr(b, name)), (threads, name)
+    # the sums are not all zeros or copies: a particle's noise is its own
+    assert a.msd_total[-1] > 0 and not np.array_equal(a.final_positions[0], a.final_positions[1])
+
+
+@pytest.mark.parametrize("threads", [0, -1, 1.5, "2", True])
+def test_refuses_a_bad_thread_count(threads):
+    with pytest.raises(ValueError, match="threads must be"):
+        langevin.run(10, gamma0=G0, D0=D0, dt=0.01, t_stop=0.1, threads=threads)
+
+
 def test_ctrl_c_stops_a_long_run_of_one_particle():
     """SIGINT reaches a run of one particle and many steps between calls into C: the work
     is chunked by particle-steps, not by particles.  The run is 2e9 Euler-Maruyama steps,
@@ -469,6 +520,11 @@ def test_from_scene_uses_the_thesis_coefficients():
         (dict(sample_times=[0.0, 1e300]), "past t_stop"),
         (dict(tamsd_lags=[1e300]), "tamsd_lags must be at least dt and at most t_stop"),
         (dict(tamsd_lags=[float("nan")]), "tamsd_lags must be at least dt and at most t_stop"),
+        (dict(tamsd_estimator="some"), "tamsd_estimator must be one of"),
+        (
+            dict(t_stop=2.0**31 * 0.01, tamsd_lags=[2.0**31 * 0.01], tamsd_estimator="all"),
+            "every-window TAMSD keeps the last lag's worth",
+        ),
     ],
 )
 def test_bad_input(kwargs, match):
@@ -476,6 +532,21 @@ def test_bad_input(kwargs, match):
     base.update(kwargs)
     with pytest.raises(ValueError, match=match):
         langevin.run(10, **base)
+
+
+def test_every_window_of_a_huge_lag_is_refused_before_allocating():
+    """Every window of a lag of 2**30 steps needs a ring of 2**31 positions (48 GiB in 3D)
+    per thread: refused with the size and the way out, before anything is allocated."""
+    with pytest.raises(MemoryError, match=r"GiB of past positions per thread.*'strided'"):
+        langevin.run(
+            10,
+            gamma0=G0,
+            D0=D0,
+            dt=0.01,
+            t_stop=2.0**30 * 0.01,
+            tamsd_lags=[2.0**30 * 0.01],
+            tamsd_estimator="all",
+        )
 
 
 # -- the engine against a slow NumPy reference fed the same random numbers ------------------
@@ -507,21 +578,132 @@ def _assert_rounding_close(got, want):
 )
 def test_the_engine_is_the_reference_integrator_to_rounding(model, scheme, dim):
     """Every position at every step, the final velocities, the ensemble MSD sums and the
-    TAMSD over the engine's windows (lags 1 and 33 and 60 steps: strides 1, 2, 3)."""
+    TAMSD over the strided estimator's windows (lags 1, 13, 33 and 60 steps: strides 1, 2,
+    8, 8)."""
     v0 = np.random.default_rng(1).normal(scale=0.8, size=(4, dim))
     kw = dict(model=model, scheme=scheme, gamma0=G0, D0=D0, tau0=TAU0, dt=0.05, n_steps=60)
-    key, lags = 0xDEADBEEF12345678, [1, 33, 60]
+    key, lags = 0xDEADBEEF12345678, [1, 13, 33, 60]
     pos, v, x2, tamsd = sde_reference.engine(v0, key, lags=lags, **kw)
     xs, vs = sde_reference.run(v0, key, **kw)
     _assert_rounding_close(pos, xs)
     _assert_rounding_close(v, vs[-1])
     _assert_rounding_close(x2, (xs * xs).sum(axis=1))
     for m, lag in enumerate(lags):
-        stride = granular._core.sde_lag_stride(lag)
+        stride = sde_reference.stride(lag)
         windows = len(range(0, 61 - lag, stride))
         _assert_rounding_close(
             tamsd[:, m] / windows, sde_reference.tamsd_per_particle(xs, lag, stride)
         )
+
+
+# lags (in steps) of every kind the strided bookkeeping has: stride 1 (below 8), each
+# power of two, lags not multiples of their stride, and past the 4096-step phase table
+# (stride 8192 from lag 32768: the "slow" lags)
+BOOK_LAGS = [1, 2, 3, 5, 7, 8, 9, 13, 31, 64, 100, 1001, 5000, 16383, 32768, 40000, 65537]
+
+
+@pytest.mark.parametrize("estimator", ["strided", "all"])
+@pytest.mark.parametrize("dim", [1, 3])
+def test_tamsd_is_the_mean_over_its_windows_of_the_stored_path(monkeypatch, estimator, dim):
+    """The TAMSD the engine books on the fly is, to summation rounding, the mean over the
+    windows of the estimator (starting every reference `stride` steps, written from the
+    definition in tamsd.h) of |x(t + lag) - x(t)|^2 computed from the positions stored at
+    every step -- in one call, on 3 threads, and one particle at a time in segments of
+    7919 steps (a prime: segment ends fall everywhere in the strides' cycles, and the
+    stored starts carry over in the ring).  The windows are summed in time order by both,
+    in different association (d terms first here): 1e-12 relative covers it."""
+    n, n_steps = 3, 70_000
+    kw = dict(
+        gamma0=G0,
+        D0=D0,
+        dt=0.01,
+        t_stop=n_steps * 0.01,
+        scheme="em",
+        dim=dim,
+        sample_times=np.arange(n_steps + 1) * 0.01,
+        tamsd_lags=np.array(BOOK_LAGS) * 0.01,
+        store_positions=True,
+        tamsd_estimator=estimator,
+        seed=5,
+    )
+    runs = [langevin.run(n, threads=1, **kw), langevin.run(n, threads=3, **kw)]
+    monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", 7919)
+    runs.append(langevin.run(n, threads=2, **kw))
+    xs = runs[0].positions
+    want = np.array(
+        [
+            sde_reference.tamsd_per_particle(xs, lag, sde_reference.stride(lag, estimator))
+            for lag in BOOK_LAGS
+        ]
+    ).T
+    for r in runs:
+        np.testing.assert_allclose(r.tamsd(per_particle=True), want, rtol=1e-12, atol=0)
+        assert np.array_equal(r.tamsd(per_particle=True), runs[0].tamsd(per_particle=True))
+    assert [
+        granular._core.sde_lag_stride(k, ("strided", "all").index(estimator)) for k in BOOK_LAGS
+    ] == [sde_reference.stride(k, estimator) for k in BOOK_LAGS]
+
+
+def _brownian_tamsd_rel_var(lag, stride, n_steps, dim):
+    """Var / mean^2 of one particle's TAMSD for Brownian motion, windows [j s, j s + lag]
+    ending by n_steps: (2 / (d M^2)) sum_ij (overlap_ij / lag)^2 -- Gaussian increments
+    give Cov(dx_i^2, dx_j^2) = 2 Cov(dx_i, dx_j)^2 per axis (tamsd.h)."""
+    starts = np.arange(0, n_steps - lag + 1, stride)
+    gap = np.abs(starts[:, None] - starts[None, :])
+    overlap = np.clip(1 - gap / lag, 0, None)
+    return 2 / (dim * len(starts) ** 2) * np.sum(overlap**2)
+
+
+def test_strided_tamsd_costs_the_stated_variance():
+    """The strided estimator's variance against every window's, on the same paths (same
+    seed, only the windows differ): each one's Var / mean^2 over particles against the
+    Brownian formula above, and their ratio against (2 + 1/W^2)/(2 + 1/k^2) <= 1.031.
+    Brownian increments: gamma0 dt = 2 with the exact scheme, so velocities decorrelate
+    within a step or two and lags of 48-160 steps see a random walk with D0 (its
+    per-step correction, ~1/(gamma0 lag) = 1-2% of the MSD, cancels in Var / mean^2 to
+    first order).  Tolerances: 5 standard errors from the particles (the variance's SE
+    from the sample fourth moment; the ratio's from a jackknife over 40 groups, small
+    because both estimators see the same paths)."""
+    n, n_steps, lags = 4000, 1500, [48, 80, 160]
+    kw = dict(
+        gamma0=200.0,
+        D0=0.01,
+        dt=0.01,
+        t_stop=n_steps * 0.01,
+        scheme="exact",
+        dim=1,
+        sample_times=[0.0],
+        tamsd_lags=np.array(lags) * 0.01,
+        seed=13,
+    )
+    per = {
+        e: langevin.run(n, tamsd_estimator=e, **kw).tamsd(per_particle=True)
+        for e in ("strided", "all")
+    }
+    for e, p in per.items():
+        for m, lag in enumerate(lags):
+            a = p[:, m] / p[:, m].mean()
+            var = a.var(ddof=1)
+            se = math.sqrt(np.mean((a - 1) ** 4) - var**2) / math.sqrt(n)
+            want = _brownian_tamsd_rel_var(lag, sde_reference.stride(lag, e), n_steps, 1)
+            assert abs(var - want) < 5 * se, (e, lag, var, want, se)
+    groups = np.array_split(np.arange(n), 40)
+
+    def ratio(keep):
+        s, a = per["strided"][keep], per["all"][keep]
+        return (s / s.mean(0)).var(0, ddof=1) / (a / a.mean(0)).var(0, ddof=1)
+
+    full = ratio(np.arange(n))
+    jack = np.array([ratio(np.setdiff1d(np.arange(n), g)) for g in groups])
+    se = np.sqrt((len(groups) - 1) * np.mean((jack - jack.mean(0)) ** 2, axis=0))
+    for m, lag in enumerate(lags):
+        s = sde_reference.stride(lag)
+        want = _brownian_tamsd_rel_var(lag, s, n_steps, 1) / _brownian_tamsd_rel_var(
+            lag, 1, n_steps, 1
+        )
+        asymptotic = (2 + (s / lag) ** 2) / (2 + 1 / lag**2)  # W = lag / s
+        assert abs(want - asymptotic) < 0.02 and want < 1.032  # the formula in tamsd.h
+        assert abs(full[m] - want) < 5 * se[m], (lag, full[m], want, se[m])
 
 
 def test_the_reference_covers_the_ziggurat_tail_and_wedges():

@@ -14,7 +14,7 @@ from granular.ensemble import RunFailure
 
 N, DIM, T = 20, 3, 41  # particles, dimensions, samples (uniform: every step)
 DT = 0.01
-LAG_STEPS = [1, 3, 10]  # below 16 steps the engine starts a TAMSD window every step
+LAG_STEPS = [1, 3, 10]  # the engine's TAMSD over every window (tamsd_estimator="all")
 LAGS = [k * DT for k in LAG_STEPS]
 
 
@@ -36,6 +36,7 @@ def _langevin(seed=None, store_positions=True):
         dim=DIM,
         sample_times=np.arange(T) * DT,
         tamsd_lags=LAGS,
+        tamsd_estimator="all",
         store_positions=store_positions,
         seed=seed,
     )
@@ -93,8 +94,9 @@ def test_tamsd_has_the_same_shapes_on_all_three(traj, sde, ens):
 
 
 def test_the_engine_tamsd_is_the_trajectory_tamsd_of_its_positions(sde):
-    """Below 16 steps the engine averages over a window at every step: exactly what
-    ``analysis.tamsd`` does with the positions at every step (to rounding: other sums)."""
+    """With tamsd_estimator="all" the engine averages over a window at every step: exactly
+    what ``analysis.tamsd`` does with the positions at every step (to rounding: other
+    sums)."""
     direct = analysis.tamsd(
         sde.positions, lag_samples=LAG_STEPS, method="direct", per_particle=True
     )

@@ -88,8 +88,9 @@ def edmd_workload(
     )
 
 
-def run(quick=False, large=False, langevin=True, out=print):
-    """Run the workloads; `quick` shrinks them to seconds (for tests)."""
+def run(quick=False, large=False, langevin=True, out=print, rounds=None):
+    """Run the workloads; `quick` shrinks them to seconds (for tests); `rounds` of the
+    Langevin runs, interleaved (default 3, 1 when quick)."""
     results = []
     workloads = EDMD_WORKLOADS + (LARGE_WORKLOADS if large else [])
     for name, dim, n, eta, coll in workloads:
@@ -111,18 +112,24 @@ def run(quick=False, large=False, langevin=True, out=print):
         except ImportError:
             bench_langevin = None
         if bench_langevin is not None:
-            for r in bench_langevin.workloads(quick=quick):
+            if rounds is None:
+                rounds = 1 if quick else 3
+            for r in bench_langevin.workloads(quick=quick, rounds=rounds):
                 results.append(r)
                 out(
                     f"{r['name']:<28} N={r['n']:>8}  {r['particle_steps_per_second'] / 1e6:8.1f} M "
-                    f"particle-steps/s  (NumPy: {r['numpy_particle_steps_per_second'] / 1e6:.1f} "
-                    f"M/s; peak {r['peak_memory_mb']:.1f} MB)"
+                    f"particle-steps/s on {r['threads']} thread(s), median of {r['rounds']} "
+                    f"({r['particle_steps_per_second_range'][0] / 1e6:.1f}-"
+                    f"{r['particle_steps_per_second_range'][1] / 1e6:.1f}; "
+                    f"{r['particle_steps_per_cpu_second'] / 1e6:.1f} M per CPU-s)  (NumPy: "
+                    f"{r['numpy_particle_steps_per_second'] / 1e6:.1f} M/s; peak "
+                    f"{r['peak_memory_mb']:.1f} MB; load {r['load_average']:.1f})"
                 )
     return results
 
 
-def main(json_path=None, quick=False, large=False):
-    results = run(quick=quick, large=large)
+def main(json_path=None, quick=False, large=False, rounds=None):
+    results = run(quick=quick, large=large, rounds=rounds)
     if json_path:
         meta = dict(
             python=platform.python_version(),

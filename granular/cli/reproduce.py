@@ -467,6 +467,7 @@ def _fig_4_17_to_4_23(cfg, out):
             speed=math.sqrt(2.0),
             sample_times=samples,
             tamsd_lags=lags,
+            threads=1,  # the ensemble's workers already use every core
         )
         return _checked(ensemble(task, cfg.runs_few, seed=11, backend=cfg.backend))
 

@@ -146,6 +146,17 @@ def run(v0, key, *, model, scheme, gamma0, D0, tau0, dt, n_steps, first=0, expon
     return xs, vs
 
 
+def stride(lag, estimator="strided"):
+    """The spacing of window starts, from csrc/tamsd.h's definition: every step for "all";
+    for "strided" the largest power of two <= max(1, lag // 4)."""
+    if estimator == "all":
+        return 1
+    s = 1
+    while 2 * s <= lag // 4:
+        s *= 2
+    return s
+
+
 def tamsd_per_particle(xs, lag, stride):
     """(N,) time-averaged MSD at a lag (in steps) over the windows the engine averages:
     starting at steps 0, stride, 2 stride, ... while they end by the last step."""
@@ -169,6 +180,8 @@ def engine(
     first=0,
     n=None,
     sample_steps=None,
+    estimator="strided",
+    threads=1,
     exponent=1.0,
 ):
     """The C engine's raw entry point (``_core.sde_run``) over a whole run, with fresh
@@ -190,7 +203,8 @@ def engine(
     x2, v2 = np.zeros((len(steps), d)), np.zeros((len(steps), d))
     positions = np.zeros((len(steps), n, d))
     tamsd = np.zeros((n, len(lags)))
-    ring = np.zeros(_core.sde_ring_size(d, lags))
+    code = ("strided", "all").index(estimator)
+    ring = np.zeros(_core.sde_ring_size(d, lags, code))
     _core.sde_run(
         d,
         ("langevin", "udsbm").index(model),
@@ -214,6 +228,9 @@ def engine(
         lags,
         tamsd,
         ring,
+        None,
+        threads,
+        code,
         exponent=exponent,
     )
     return positions[:, first : first + count], v, x2, tamsd[first : first + count]
