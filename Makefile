@@ -58,7 +58,7 @@ ASAN_CFLAGS := -fsanitize=undefined -fno-sanitize-recover=undefined
 ASAN_TESTS ?= $(filter-out test_notebooks.py test_packaging.py,$(notdir $(wildcard tests/test_*.py)))
 # CI's share (.ci/run): the tests that drive the C core hardest
 ASAN_CI_TESTS := test_scene.py test_simulation.py test_neighbour_lists.py test_physics_edmd.py \
-                 test_langevin.py test_fuzz.py
+                 test_langevin.py test_fuzz.py test_checkpoint.py test_restitution.py
 ASAN_ENV   := LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
               ASAN_OPTIONS=detect_leaks=0:allocator_may_return_null=1 \
               UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 GRANULAR_FUZZ_TIMEOUT=30
