@@ -41,7 +41,7 @@ size_t gr_edmd_bytes_per_particle(int dim, int lists)
                    + 2 * sizeof(int32_t)                  /* cell links */
                    + sizeof(int32_t) + sizeof(uint8_t)    /* id_of, is_big */
                    + scratch_per_particle(dim)
-                   + gr_cq_bytes_per_id()                 /* the queue */
+                   + sizeof(gr_cq_item) + sizeof(int32_t) /* queue entry, a bucket's share */
                    + 8 * sizeof(int32_t) + 1;             /* cell heads and bits: at most 8 cells each */
     if (lists)
         bytes += (size_t)(dim + 1) * sizeof(double)       /* centre */

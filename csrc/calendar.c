@@ -9,23 +9,22 @@
 #include "common.h"
 #include "hugemem.h"
 
+enum { GR_CQ_LIST = -1, GR_CQ_OVER = -2, GR_CQ_NONE = -3 };
+
 /* Keys per bucket the width aims at: the near heap then stays a few entries deep, and
  * few buckets are stepped over empty.  Measured best among 1, 2, 4, 8 (edmd_perf.py). */
 #define GR_CQ_PER_BUCKET 2.0
 /* Bucket slots per id.  The calendar covers nb buckets ahead of the start of the
  * current "year" (over_from - nb), so on average half of that ahead of now; keys
  * further ahead take the slower way through the overflow list.  That fraction is about
- * (mean time to a key) / (nb w) ~ n / (GR_CQ_PER_BUCKET nb). */
-#define GR_CQ_SLOTS_PER_ID 1
+ * (mean time to a key) / (nb w) ~ n / (GR_CQ_PER_BUCKET nb): 4 slots per id keep it
+ * near 1/8 for 16 bytes per id. */
+#define GR_CQ_SLOTS_PER_ID 4
 /* Keys sampled to estimate their spread when choosing the width. */
 #define GR_CQ_SAMPLE 1024
 /* Beyond this, bucket numbers saturate (a key that far ahead only needs to be in the
  * overflow; saturation keeps bucket() monotonic and avoids an overflowing conversion). */
 #define GR_CQ_FAR 4611686018427387904.0 /* 2^62 */
-/* A near heap up to this size is searched for an id (a few cache lines at hand); a
- * larger one (many equal keys, or a width far too wide) keeps every id's place in pos,
- * at one more write per move. */
-#define GR_CQ_NEAR_SEARCH 32
 
 /* Monotonic non-decreasing in t, which is all the ordering needs; truncation rather
  * than floor (keys before t0 share bucket 0, harmlessly). */
@@ -37,12 +36,12 @@ static inline int64_t bucket_of(const gr_cq *q, double t)
     return (int64_t)x;
 }
 
-/* ---- the near heap: a binary min-heap of (key, id) ---- */
+/* ---- the near heap: a binary min-heap of (key, id), item[id].where = its slot ---- */
 
 static inline void near_place(gr_cq *q, int32_t k, gr_cq_near e)
 {
     q->near[k] = e;
-    if (q->track) q->pos[e.id] = k;
+    q->item[e.id].where = k;
 }
 
 static void near_sift_up(gr_cq *q, int32_t k, gr_cq_near e)
@@ -70,39 +69,20 @@ static void near_sift_down(gr_cq *q, int32_t k, gr_cq_near e)
     near_place(q, k, e);
 }
 
-static inline void near_push(gr_cq *q, double t, int32_t id)
-{
-    gr_cq_near e = {t, id};
-    near_sift_up(q, q->n_near++, e);
-    if (!q->track && q->n_near > GR_CQ_NEAR_SEARCH) {
-        q->track = 1;
-        for (int32_t k = 0; k < q->n_near; k++) q->pos[q->near[k].id] = k;
-    }
-}
-
 static void near_remove(gr_cq *q, int32_t k)
 {
     gr_cq_near last = q->near[--q->n_near];
-    if (q->n_near == 0) q->track = 0;
     if (k == q->n_near) return;
     if (k > 0 && last.t < q->near[(k - 1) >> 1].t) near_sift_up(q, k, last);
     else near_sift_down(q, k, last);
 }
 
-/* id's place in the near heap, which holds it */
-static inline int32_t near_find(const gr_cq *q, int32_t id)
-{
-    if (q->track) return q->pos[id];
-    int32_t k = 0;
-    while (q->near[k].id != id) k++;
-    return k;
-}
+/* ---- lists ---- */
 
-/* ---- lists: the slots' extra lists and the overflow ---- */
-
-static inline void list_push(gr_cq *q, int32_t *head, int32_t id)
+static inline void list_push(gr_cq *q, int32_t *head, int32_t id, int32_t where)
 {
     gr_cq_item *it = &q->item[id];
+    it->where = where;
     it->prev = -1;
     it->next = *head;
     if (*head >= 0) q->item[*head].prev = id;
@@ -117,68 +97,38 @@ static inline void list_unlink(gr_cq *q, int32_t *head, int32_t id)
     if (it->next >= 0) q->item[it->next].prev = it->prev;
 }
 
-/* ---- slots ---- */
-
-static inline void slot_push(gr_cq *q, int64_t b, int32_t id)
-{
-    const int64_t k = b & (q->nb - 1);
-    gr_cq_slot *sl = &q->slot[k];
-    if (sl->n < GR_CQ_WAYS && q->head[k] < 0) {
-        sl->id[sl->n++] = id;
-    } else {
-        list_push(q, &q->head[k], id);
-    }
-    q->n_list++;
-}
-
-static inline void slot_remove(gr_cq *q, int64_t b, int32_t id)
-{
-    const int64_t k = b & (q->nb - 1);
-    gr_cq_slot *sl = &q->slot[k];
-    int32_t w = 0;
-    while (w < sl->n && sl->id[w] != id) w++;
-    if (w < sl->n) { /* keep the ways in the order they were placed */
-        for (; w + 1 < sl->n; w++) sl->id[w] = sl->id[w + 1];
-        sl->n--;
-    } else {
-        list_unlink(q, &q->head[k], id);
-    }
-    q->n_list--;
-}
-
 /* Put id (finite key, in no structure) where the invariant wants it. */
 static inline void place(gr_cq *q, int32_t id)
 {
     double t = q->item[id].t;
     int64_t b = bucket_of(q, t);
     if (b <= q->cur) {
-        near_push(q, t, id);
+        gr_cq_near e = {t, id};
+        near_sift_up(q, q->n_near++, e);
     } else if (b < q->over_from) {
-        slot_push(q, b, id);
+        list_push(q, &q->head[b & (q->nb - 1)], id, GR_CQ_LIST);
+        q->n_list++;
     } else {
-        list_push(q, &q->over, id);
+        list_push(q, &q->over, id, GR_CQ_OVER);
         q->n_over++;
     }
 }
 
-/* Take id out of wherever its key (finite or not) put it. */
 static inline void take_out(gr_cq *q, int32_t id)
 {
-    const double t = q->item[id].t;
-    if (t != t) {
-        if (q->nan_id == id) q->nan_id = -1;
-        return;
-    }
-    if (t == INFINITY) return;
-    const int64_t b = bucket_of(q, t);
-    if (b <= q->cur) {
-        near_remove(q, near_find(q, id));
-    } else if (b < q->over_from) {
-        slot_remove(q, b, id);
-    } else {
+    gr_cq_item *it = &q->item[id];
+    if (it->where >= 0) {
+        near_remove(q, it->where);
+    } else if (it->where == GR_CQ_LIST) {
+        list_unlink(q, &q->head[bucket_of(q, it->t) & (q->nb - 1)], id);
+        q->n_list--;
+    } else if (it->where == GR_CQ_OVER) {
         list_unlink(q, &q->over, id);
         q->n_over--;
+    } else if (q->nan_id == id) {
+        q->nan_id = -1;
     }
+    it->where = GR_CQ_NONE;
 }
 
 /* Move the overflow keys that now fall before over_from into the calendar. */
@@ -251,16 +201,15 @@ static void rebuild(gr_cq *q)
     q->inv_w = 1.0 / w;
     if (!(w > 0.0) || !isfinite(q->inv_w)) q->inv_w = 1.0; /* all keys equal: any width */
     memset(q->head, 0xff, (size_t)q->nb * sizeof *q->head); /* every byte 0xff: -1 */
-    for (int32_t k = 0; k < q->nb; k++) q->slot[k].n = 0;
     q->over = -1;
     q->n_list = q->n_over = 0;
     q->n_near = 0;
-    q->track = 0;
     q->nan_id = -1;
     q->cur = 0;
     q->over_from = q->nb;
     for (int32_t id = 0; id < n; id++) {
         double t = q->item[id].t;
+        q->item[id].where = GR_CQ_NONE;
         if (t != t) q->nan_id = id;
         else if (t != INFINITY) place(q, id);
     }
@@ -275,11 +224,9 @@ int gr_cq_init(gr_cq *q, int32_t n)
     q->nb = 16;
     while (q->nb < GR_CQ_SLOTS_PER_ID * (int64_t)n && q->nb < (1 << 30)) q->nb <<= 1;
     q->item = gr_big_alloc((size_t)n * sizeof *q->item);
-    q->slot = gr_big_alloc((size_t)q->nb * sizeof *q->slot);
     q->head = gr_big_alloc((size_t)q->nb * sizeof *q->head);
     q->near = malloc((size_t)(n > 0 ? n : 1) * sizeof *q->near);
-    q->pos = malloc((size_t)(n > 0 ? n : 1) * sizeof *q->pos);
-    if (!q->item || !q->slot || !q->head || !q->near || !q->pos) {
+    if (!q->item || !q->head || !q->near) {
         gr_cq_free(q);
         return GR_ERR_NOMEM;
     }
@@ -291,15 +238,11 @@ int gr_cq_init(gr_cq *q, int32_t n)
 void gr_cq_free(gr_cq *q)
 {
     free(q->item);
-    free(q->slot);
     free(q->head);
     free(q->near);
-    free(q->pos);
     q->item = NULL;
-    q->slot = NULL;
     q->head = NULL;
     q->near = NULL;
-    q->pos = NULL;
 }
 
 void gr_cq_update(gr_cq *q, int32_t id, double t)
@@ -340,19 +283,14 @@ int32_t gr_cq_top_slow(gr_cq *q, double *t)
             q->over_from += q->nb;
             spill(q);
         }
-        /* newest first, as in the invariant: the extra list, then the ways backwards */
-        const int64_t k = q->cur & (q->nb - 1);
-        int32_t *head = &q->head[k];
+        int32_t *head = &q->head[q->cur & (q->nb - 1)];
         while (*head >= 0) {
             int32_t id = *head;
             *head = q->item[id].next;
             q->n_list--;
-            near_push(q, q->item[id].t, id);
+            gr_cq_near e = {q->item[id].t, id};
+            near_sift_up(q, q->n_near++, e);
         }
-        gr_cq_slot *sl = &q->slot[k];
-        for (int32_t w = sl->n - 1; w >= 0; w--) near_push(q, q->item[sl->id[w]].t, sl->id[w]);
-        q->n_list -= sl->n;
-        sl->n = 0;
     }
     *t = q->near[0].t;
     return q->near[0].id;
@@ -360,28 +298,22 @@ int32_t gr_cq_top_slow(gr_cq *q, double *t)
 
 void gr_cq_renumber(gr_cq *q, const int32_t *newpos)
 {
-    /* permute the keys in place, cycle by cycle, with `next` marking the ids done
-     * (rebuild() places every id afresh); no allocation, so nothing can fail */
+    /* permute the keys in place, cycle by cycle, with `where` marking the ids done
+     * (rebuild() sets every `where` afresh); no allocation, so nothing can fail */
     gr_cq_item *it = q->item;
-    for (int32_t id = 0; id < q->n; id++) it[id].next = 0;
+    for (int32_t id = 0; id < q->n; id++) it[id].where = 0;
     for (int32_t start = 0; start < q->n; start++) {
-        if (it[start].next) continue;
+        if (it[start].where) continue;
         double carry = it[start].t;
         int32_t j = start;
         do {
             int32_t k = newpos[j];
             double t = it[k].t;
             it[k].t = carry;
-            it[k].next = 1;
+            it[k].where = 1;
             carry = t;
             j = k;
         } while (j != start);
     }
     rebuild(q);
-}
-
-size_t gr_cq_bytes_per_id(void)
-{
-    return sizeof(gr_cq_item) + sizeof(int32_t) /* pos */ + sizeof(gr_cq_near) +
-           GR_CQ_SLOTS_PER_ID * 2 * (sizeof(gr_cq_slot) + sizeof(int32_t)); /* nb <= 2 n */
 }
