@@ -3,6 +3,10 @@
 #   benchmarks/edmd_cachegrind.sh PYTHON DIR WORKLOAD E1 E2 [LL bytes, default 8 MiB]
 # prints Ir, D1 misses (reads + writes) and LL misses (reads + writes) per event.
 set -e
+# a fixed hash seed: Python's start-up then does the same work in both runs
+export PYTHONHASHSEED=0
+# and no BLAS threads: theirs spin a varying number of instructions
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
 py=$1 dir=$2 w=$3 e1=$4 e2=$5 ll=${6:-8388608}
 here=$(dirname "$0")
 for e in "$e1" "$e2"; do
