@@ -290,6 +290,14 @@ def test_ergodicity_breaking_matches_the_per_pair_reference(tau0, a):
         got = theory.udsbm_ergodicity_breaking(lag, starts, 1.3, 2.0, tau0, a, 2, v0_sq=0.7)
         want = eb_reference.ergodicity_breaking(lag, starts, 1.3, 2.0, tau0, a, 2, v0_sq=0.7)
         assert got == pytest.approx(want, rel=1e-9), (lag, len(starts))
+    # the covariance is built in blocks of rows and mirrored block by block: blocks of 7
+    # (many, unequal) give the very same numbers as one block (per-row arithmetic is the same)
+    times = np.unique(np.concatenate([cases[1][1], cases[1][1] + cases[1][0]]))
+    sol = theory._powerlaw_ode(2.0, tau0, a, 0.7 / 2.6, 2.0 * times[-1])
+    one = theory._covariance_on_grid(times, sol, 1.3, 2.0, tau0, a, block=times.size)
+    many = theory._covariance_on_grid(times, sol, 1.3, 2.0, tau0, a, block=7)
+    np.testing.assert_array_equal(many, one)
+    np.testing.assert_array_equal(one, one.T)
 
 
 def test_ergodicity_breaking_does_not_vanish_for_udsbm():
