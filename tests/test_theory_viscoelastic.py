@@ -11,6 +11,8 @@ from scipy.integrate import quad, solve_ivp
 
 from granular import theory
 
+from helpers import eb_reference
+
 # the thesis' gas (N = 1000, r = 0.025, unit box) at T0 = 1, m = 1
 N, R, T0 = 1000.0, 0.025, 1.0
 DELTA = 0.05  # delta(T0) = a_kappa (4 T0 / m)^(1/10): 1 - eps ~ C1 delta ~ 6%
@@ -264,6 +266,38 @@ def test_ergodicity_breaking_of_brownian_motion():
     want = 2 * np.sum(overlap**2) / (2 * (len(starts) * lag) ** 2)
     assert eb == pytest.approx(want, rel=1e-3)
     assert eb == pytest.approx(4 * lag / (3 * 2 * t_stop), rel=0.05)
+
+
+@pytest.mark.parametrize(
+    "tau0,a", [(math.inf, 1.0), (TAU0, 1.0), (TAU0, VISCO), (TAU0, 1.5), (0.5, 0.3), (20.0, VISCO)]
+)
+def test_ergodicity_breaking_matches_the_per_pair_reference(tau0, a):
+    """The fast EB (the covariance once on the grid of window ends, the propagator integral
+    summed over the grid's segments) against the slow per-pair reference
+    (tests/helpers/eb_reference.py: the propagator integral by Gauss-Legendre for each pair
+    of times) on overlapping windows on a grid, windows at random starts (no shared ends)
+    and one window.  Both are exact up to rounding: they agree to ~1e-14; allowed 1e-9
+    relative, the brief's 1e-8 with margin, for the cancellation of the four covariances
+    in C_jk at short lags (up to <x^2> / increment ~ 1e3 here)."""
+    rng = np.random.default_rng(7)
+    cases = [
+        (1.0, np.arange(0.0, 20.0, 0.25)),
+        (0.35, np.sort(rng.uniform(0.0, 15.0, 60))),
+        (2.0, np.array([0.0])),
+        (0.05, np.arange(0.0, 5.0, 0.05)),
+    ]
+    for lag, starts in cases:
+        got = theory.udsbm_ergodicity_breaking(lag, starts, 1.3, 2.0, tau0, a, 2, v0_sq=0.7)
+        want = eb_reference.ergodicity_breaking(lag, starts, 1.3, 2.0, tau0, a, 2, v0_sq=0.7)
+        assert got == pytest.approx(want, rel=1e-9), (lag, len(starts))
+    # the covariance is built in blocks of rows and mirrored block by block: blocks of 7
+    # (many, unequal) give the very same numbers as one block (per-row arithmetic is the same)
+    times = np.unique(np.concatenate([cases[1][1], cases[1][1] + cases[1][0]]))
+    sol = theory._powerlaw_ode(2.0, tau0, a, 0.7 / 2.6, 2.0 * times[-1])
+    one = theory._covariance_on_grid(times, sol, 1.3, 2.0, tau0, a, block=times.size)
+    many = theory._covariance_on_grid(times, sol, 1.3, 2.0, tau0, a, block=7)
+    np.testing.assert_array_equal(many, one)
+    np.testing.assert_array_equal(one, one.T)
 
 
 def test_ergodicity_breaking_does_not_vanish_for_udsbm():

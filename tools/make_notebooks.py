@@ -221,8 +221,8 @@ visco = [
         "instead of Haff's t^(-2), diffuse as MSD ~ t^(1/6), and do not collapse; a constant-xi "
         "gas in a box wider than the critical size of the shear instability leaves Haff's law "
         "as vortices and clusters grow.\n\n"
-        "Full size this notebook takes about one minute (42-53 s measured on a loaded 2-core "
-        "machine; `GRANULAR_QUICK=1`: about 8 s)."
+        "Full size this notebook takes about 15 s (11-15 s measured on a loaded 2-core "
+        "machine; `GRANULAR_QUICK=1`: about 4 s)."
     ),
     setup + "\nimport math\nimport warnings\nfrom granular import langevin",
     (
@@ -314,8 +314,8 @@ print(f"EDMD {slope:.3f}, UDSBM {slope_u:.3f}, theory {slope_th:.3f}", "(1/6 onl
         "covariance, for Gaussian initial velocities)."
     ),
     """c8 = theory.langevin_coefficients(1000, 0.025, 1.0, 0.8, 2 / 3)  # the thesis' gas, xi = 0.8
-t_sde = 40.0 if not QUICK else 10.0
-lags = np.logspace(-1, np.log10(t_sde / 4), 5 if not QUICK else 3)
+t_sde = 100.0 if not QUICK else 10.0  # 2000 steps of dt = 0.05
+lags = np.logspace(-1, np.log10(t_sde / 4), 8 if not QUICK else 3)
 fig, axes = plt.subplots(1, 2, figsize=(11, 4), layout="constrained")
 for a in (1.0, 5 / 6):
     res = langevin.run(
