@@ -394,7 +394,17 @@ _ONSET_SHARE = 0.05
 
 
 def unstable_box_message(scene) -> str | None:
-    """Why a scene's homogeneous cooling will end, or None when theory expects it to last.
+    """Why a scene's homogeneous cooling will end, or None when theory expects it to last:
+    the text of ``unstable_box(scene)``."""
+    found = unstable_box(scene)
+    return None if found is None else found[0]
+
+
+def unstable_box(scene) -> tuple[str, float, float] | None:
+    """Why a scene's homogeneous cooling will end, and when: ``(message, t_star,
+    collisions_per_particle)`` with t* and its collisions per particle from the scene's
+    state (inf where linear theory gives no finite onset), or None when theory expects the
+    homogeneous cooling to last.
 
     None unless the box is periodic, the restitution a plain number xi < 1 (a restitution
     law object is left alone) and the longest side above ``theory.critical_box_size``.
@@ -411,8 +421,8 @@ def unstable_box_message(scene) -> str | None:
 
     Returns
     -------
-    str or None
-        The warning's text, or None.
+    tuple of (str, float, float) or None
+        The warning's text, t* and the collisions per particle until t*; or None.
 
     References
     ----------
@@ -446,6 +456,7 @@ def unstable_box_message(scene) -> str | None:
     )
     temperature = float(scene.temperature)
     mass = float(np.mean(scene.masses))
+    t_star = cpp = math.inf
     if xi > 0 and temperature > 0:
         tau0 = float(theory.haff_tau0(density, radius, float(xi), temperature, mass, d, eta))
         omega0 = float(theory.collision_frequency(density, radius, temperature, mass, d, eta))
@@ -459,7 +470,8 @@ def unstable_box_message(scene) -> str | None:
                 f"{cpp:.3g} collisions per particle; linear theory: the slowest shear modes "
                 f"reach {_ONSET_SHARE:.0%} of the kinetic energy)"
             )
-    return (
-        text + ".  Use a box below L_c (fewer particles at the same density) for homogeneous "
+    text += (
+        ".  Use a box below L_c (fewer particles at the same density) for homogeneous "
         "cooling, or measure the flow with granular.clustering.flow_energy."
     )
+    return text, t_star, cpp

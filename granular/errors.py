@@ -77,7 +77,8 @@ class NoProgressError(GranularError, RuntimeError):
 class ClusteringWarning(UserWarning):
     """A granular gas in a periodic box beyond the critical size of the shear instability
     (``granular.theory.critical_box_size``): its homogeneous cooling will end (vortices,
-    then clusters) and Haff's law will fail.  Issued once per Simulation, by ``run``."""
+    then clusters) and Haff's law will fail.  Issued once per Simulation, by the first
+    ``run`` that can reach the onset t* (``granular.clustering.unstable_box``)."""
 
 
 class CheckpointError(GranularError, ValueError):

@@ -261,17 +261,12 @@ class Simulation:
         -----
         ClusteringWarning
             On the first run of a granular gas (constant xi < 1) in a periodic box beyond
-            the critical size of the shear instability (``granular.clustering``).
+            the critical size of the shear instability (``granular.clustering``) that can
+            reach the instability's onset t* (by ``t_stop`` or the collisions per particle
+            asked for; a run to an energy or an event count may).
         """
         if not getattr(self, "_clustering_checked", False):  # also for restored Simulations
-            self._clustering_checked = True
-            from .clustering import unstable_box_message
-
-            message = unstable_box_message(self._initial)
-            if message:
-                import warnings
-
-                warnings.warn(message, ClusteringWarning, stacklevel=2)
+            self._warn_clustering(t_stop, stop_when)
         if not self._running.acquire(blocking=False):
             raise RuntimeError(
                 "another thread is running this Simulation; a Simulation runs one run at a "
@@ -398,6 +393,28 @@ class Simulation:
     # a collapse cools the gas; an energy this far above the start can only come from
     # heated walls, and it puts the event times beyond float64's resolution
     _BLOWUP_RATIO = 1e6
+
+    def _warn_clustering(self, t_stop, stop_when):
+        """ClusteringWarning, once per Simulation, for the first run that can reach the
+        shear instability's onset: a run that must stop before t* (a box barely beyond L_c
+        can put it past anything float64 can time) has nothing to be warned of."""
+        from .clustering import unstable_box
+
+        found = unstable_box(self._initial)  # t* counts from the initial state, as time does
+        if found is None:
+            self._clustering_checked = True
+            return
+        message, t_star, cpp = found
+        criteria = stop_when or {}
+        if t_stop is not None and t_stop < t_star:
+            return
+        if t_stop is None and set(criteria) == {"collisions_per_particle"}:
+            if criteria["collisions_per_particle"] < cpp:
+                return
+        self._clustering_checked = True
+        import warnings
+
+        warnings.warn(message, ClusteringWarning, stacklevel=3)
 
     def _heated_walls_error(self, exc, energy0):
         """The error to raise instead of ``exc`` when heated walls blew the gas up, else

@@ -276,15 +276,21 @@ def _gas(n, restitution, boundary="periodic", seed=3):
 
 
 def test_clustering_warning_for_a_big_granular_box_once():
-    """N = 3000 at the thesis' density: L = 1.44 > L_c = 1.087 at xi = 0.3."""
+    """N = 3000 at the thesis' density: L = 1.44 > L_c = 1.087 at xi = 0.3.  A run that
+    stops before the onset t* is not warned; the first run that can reach it is, once."""
     scene = _gas(3000, 0.3)
+    message, t_star, cpp = clustering.unstable_box(scene)
+    assert 0 < t_star < math.inf and 0 < cpp < math.inf
     sim = granular.Simulation(scene)
-    with pytest.warns(granular.ClusteringWarning) as record:
-        sim.run(t_stop=1e-3)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        sim.run(t_stop=2e-3)  # once per Simulation
-    message = str(record[0].message)
+        sim.run(t_stop=1e-3 * t_star)  # ends long before the onset
+    with pytest.warns(granular.ClusteringWarning) as record:
+        sim.run(t_stop=t_star)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sim.run(t_stop=1.1 * t_star)  # once per Simulation
+    assert str(record[0].message) == message
     lc = theory.critical_box_size(1000, 0.025, 0.3, eta=scene.packing_fraction)
     for number in (
         f"L = {3 ** (1 / 3):.4g}",
@@ -295,6 +301,12 @@ def test_clustering_warning_for_a_big_granular_box_once():
         assert number in message
     assert "Haff's law" in message and "t* =" in message
     assert record[0].filename == __file__  # points at the caller's run
+    # in collisions per particle: short of the onset, no warning; past it, a warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        granular.Simulation(scene).run(stop_when={"collisions_per_particle": 0.5 * cpp})
+    with pytest.warns(granular.ClusteringWarning):
+        granular.Simulation(scene).run(stop_when={"collisions_per_particle": cpp + 1})
 
 
 @pytest.mark.parametrize(

@@ -41,10 +41,11 @@ import functools
 import math
 import os
 import time
+import warnings
 
 import numpy as np
 
-from .. import Scene, Simulation, analysis, ensemble, langevin, plot, theory
+from .. import ClusteringWarning, Scene, Simulation, analysis, ensemble, langevin, plot, theory
 from .output import write_json
 
 QUICK_RUNS = 20  # runs per experiment in quick mode: enough for Student-t error bars
@@ -340,7 +341,10 @@ def _fig_4_9(cfg, out):
         )
         sim = Simulation(s)
         for t_snap in (2.5, 10.0):
-            sim.run(t_stop=t_snap, sample_times=[t_snap], store=())
+            with warnings.catch_warnings():
+                # the figure shows the clusters that ClusteringWarning foretells (L / L_c ~ 3.6)
+                warnings.simplefilter("ignore", ClusteringWarning)
+                sim.run(t_stop=t_snap, sample_times=[t_snap], store=())
             plot.snapshot(sim.scene.positions, s.radii, s.lower, s.upper, ax=axes[k])
             axes[k].set_title(f"{name}, t = {t_snap}")
             axes[k].set_xticks([])
