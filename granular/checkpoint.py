@@ -86,13 +86,18 @@ def dumps(sim: Simulation) -> bytes:
 
 
 def save(sim: Simulation, path: str | os.PathLike) -> None:
-    """Write ``sim``'s checkpoint to ``path`` atomically: into a temporary file in the same
-    directory, then renamed over ``path``, so a crash mid-way never leaves a half file
-    (an older checkpoint at ``path`` survives until the new one is complete)."""
-    data = dumps(sim)
+    """Write ``sim``'s checkpoint to ``path`` atomically (``write_atomic``): an older
+    checkpoint at ``path`` survives until the new one is complete."""
+    write_atomic(path, dumps(sim), suffix=".npz")
+
+
+def write_atomic(path: str | os.PathLike, data: bytes, suffix: str = ".part") -> None:
+    """Write ``data`` to ``path`` so that a crash mid-way never leaves a half file: into a
+    temporary file (``.tmp-*``) in the same directory, flushed to disk, then renamed over
+    ``path`` (a rename within a file system is atomic)."""
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".npz", dir=folder)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=suffix, dir=folder)
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)

@@ -17,12 +17,12 @@ import hashlib
 import json
 import os
 import pickle
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .checkpoint import write_atomic
 from .errors import CheckpointError
 
 FINGERPRINT = "ensemble.json"
@@ -96,17 +96,7 @@ class RunStore:
         return self._file(point, run).exists()
 
     def _write_atomic(self, target: Path, data: bytes) -> None:
-        fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".part", dir=self.path)
-        try:
-            with os.fdopen(fd, "wb") as f:
-                f.write(data)
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, target)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+        write_atomic(target, data)
 
     def write(self, point, run, seed, status, payload) -> None:
         """Store one finished run: its arrays (status "ok") or its failure."""

@@ -182,31 +182,8 @@ def speed_accuracy_points(quick=False):
         fixed = [1e-3, 1e-2, 0.05, 0.1] if not quick else [1e-2]
         near, beyond = ((1.5, 1.9), (3.0, 10.0)) if not quick else ((1.9,), (3.0,))
         em_dts = fixed + [g / c.gamma0 for g in near]
-        for scheme, dts in (("em", em_dts), ("exact", em_dts + [g / c.gamma0 for g in beyond])):
-            for dt in dts:
-                t0 = clock()
-                r = langevin.run(
-                    n_sde,
-                    gamma0=c.gamma0,
-                    D0=c.D0,
-                    tau0=c.tau0,
-                    dt=dt,
-                    t_stop=t_max,
-                    scheme=scheme,
-                    sample_times=times,
-                    seed=5,
-                )
-                sec = clock() - t0
-                add(
-                    scheme,
-                    f"{r.model} {scheme}, dt={dt:.3g}",
-                    r.msd(),
-                    sec,
-                    at=r.times,
-                    dt=dt,
-                    n=n_sde,
-                    gamma_dt=c.gamma0 * dt,
-                )
+        exact_dts = em_dts + [g / c.gamma0 for g in beyond]
+        _sde_points(add, c, n_sde, {"em": em_dts, "exact": exact_dts}, t_max, times)
     return points, refs
 
 
@@ -275,32 +252,7 @@ def viscoelastic_points(quick=False):
         add("edmd", f"N={n}, runs={runs}", msd, sec, n=n, runs=runs)
     n_sde = 4000 if not quick else 500
     dts = ([1e-2, 0.05, 0.1] if not quick else [1e-2]) + [1.9 / c.gamma0]
-    for scheme in ("em", "exact"):
-        for dt in dts:
-            t0 = clock()
-            r = langevin.run(
-                n_sde,
-                gamma0=c.gamma0,
-                D0=c.D0,
-                tau0=c.tau0,
-                exponent=VISCO_A,
-                dt=dt,
-                t_stop=t_max,
-                scheme=scheme,
-                sample_times=times,
-                seed=5,
-            )
-            sec = clock() - t0
-            add(
-                scheme,
-                f"UDSBM a=5/6 {scheme}, dt={dt:.3g}",
-                r.msd(),
-                sec,
-                at=r.times,
-                dt=dt,
-                n=n_sde,
-                gamma_dt=c.gamma0 * dt,
-            )
+    _sde_points(add, c, n_sde, {"em": dts, "exact": dts}, t_max, times, VISCO_A, "UDSBM a=5/6")
     return points, ref_info
 
 
@@ -801,3 +753,34 @@ def main(out="speed-accuracy", quick=False):
     return dict(
         points=points, em_stability=stab, collapse_map=cells, dense_cost=dense, scene_costs=costs
     )
+
+
+def _sde_points(add, c, n_sde, dts_by_scheme, t_max, times, exponent=1.0, label=None):
+    """One Langevin run per (scheme, dt), timed, each handed to ``add`` as a point:
+    its MSD at ``times``, its cost and its step (``gamma0 dt``)."""
+    for scheme, dts in dts_by_scheme.items():
+        for dt in dts:
+            t0 = clock()
+            r = langevin.run(
+                n_sde,
+                gamma0=c.gamma0,
+                D0=c.D0,
+                tau0=c.tau0,
+                exponent=exponent,
+                dt=dt,
+                t_stop=t_max,
+                scheme=scheme,
+                sample_times=times,
+                seed=5,
+            )
+            sec = clock() - t0
+            add(
+                scheme,
+                f"{label or r.model} {scheme}, dt={dt:.3g}",
+                r.msd(),
+                sec,
+                at=r.times,
+                dt=dt,
+                n=n_sde,
+                gamma_dt=c.gamma0 * dt,
+            )
