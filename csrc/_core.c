@@ -616,6 +616,7 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
         PyErr_Format(PyExc_ValueError, "threads must be >= 1, got %d", threads);
         return NULL;
     }
+    if (threads > 256) threads = 256; /* more than any machine's cores: no thread per block */
     cfg.key = key;
     if (cfg.dim < 1 || cfg.dim > 3 || n < 0 || first < 0) {
         PyErr_SetString(PyExc_ValueError, "dim must be 1..3 and n, first non-negative");

@@ -354,7 +354,8 @@ const char *gr_cq_check(const gr_cq *q, uint8_t *seen)
         return "the queue's bucket width or start is not a positive finite number";
     /* bucket numbers are saturated at 2^62, and the calendar spans at most nb of them */
     const int64_t far = (int64_t)GR_CQ_FAR;
-    if (q->cur < -far || q->cur > far || q->over_from <= q->cur || q->over_from - q->cur > q->nb)
+    if (q->cur < -far || q->cur > far || q->over_from <= q->cur || q->nb < 0 ||
+        q->over_from > q->cur + q->nb) /* cur is bounded: the sum cannot overflow */
         return "the queue's current bucket and overflow start are inconsistent";
     for (int32_t k = 0; k < q->n_near; k++) {
         const gr_cq_near e = q->near[k];

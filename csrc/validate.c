@@ -14,9 +14,13 @@ static int validate_law(const gr_law *law, gr_error *err)
     case GR_LAW_CONSTANT:
         return GR_OK;
     case GR_LAW_VISCOELASTIC:
-        if (!(law->scale > 0.0 && isfinite(law->scale) && law->v_max > 0.0)) {
+        /* v_max is where the series stops (delta = GR_VISCO_DELTA_MAX); a larger one would
+         * let eps = 1 - delta (C1 - C2 delta) climb above 1 past delta = C1 / C2 */
+        if (!(law->scale > 0.0 && isfinite(law->scale) && law->v_max > 0.0 &&
+              law->v_max <= pow(GR_VISCO_DELTA_MAX / law->scale, 5) * (1.0 + 1e-12))) {
             gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, law->scale,
-                         "a viscoelastic law needs A kappa^(2/5) > 0 and finite, and v_max > 0");
+                         "a viscoelastic law needs A kappa^(2/5) > 0 and finite, and "
+                         "0 < v_max <= (0.25 / A kappa^(2/5))^5");
             return GR_ERR_VALUE;
         }
         return GR_OK;

@@ -5,10 +5,12 @@
 already there instead of repeating them.  Files are written to a temporary name and
 renamed, so a run killed mid-write leaves no file that passes for finished.  The
 directory's ``ensemble.json`` holds a fingerprint of what made it (models, run options,
-quantities, seed, granular version); a call that differs in any of them is refused, so
-runs of different models are never mixed.  Runs are identified by (point, run index) and
-their seeds, so the runs count may grow between calls: ``runs=k`` then ``runs=n`` computes
-only the n - k new ones.
+quantities, seed, granular version); a call that differs in any of them is refused.  A
+model function is recognised by its pickle (its qualified name and any partial arguments),
+not by its code: edit a function's body and keep its name, and the directory will not
+notice -- start a new directory when the model changes.  Runs are identified by (point,
+run index) and their seeds, so the runs count may grow between calls: ``runs=k`` then
+``runs=n`` computes only the n - k new ones.
 """
 
 from __future__ import annotations

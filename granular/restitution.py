@@ -349,6 +349,12 @@ class TabulatedRestitution(RestitutionLaw):
         return (self.speeds.tobytes(), self.values.tobytes())
 
     def __repr__(self) -> str:
+        if len(self.speeds) > 10:  # a measured curve of many points: a summary, not pages
+            return (
+                f"TabulatedRestitution(<{len(self.speeds)} points, speeds "
+                f"{self.speeds[0]:g}..{self.speeds[-1]:g}, values "
+                f"{self.values.min():g}..{self.values.max():g}>)"
+            )
         return (
             f"TabulatedRestitution(speeds={self.speeds.tolist()!r}, "
             f"values={self.values.tolist()!r})"

@@ -341,7 +341,8 @@ class Scene:
         return (
             f"Scene(n={self.n}, dim={self.dim}, boundary={self.boundary!r}, "
             f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
-            f"temperature={self.temperature:.4g})"
+            + (f"wall_restitution={self.wall_restitution}, " if self.boundary == "walls" else "")
+            + f"temperature={self.temperature:.4g})"
         )
 
     # -- constructors ---------------------------------------------------------------

@@ -352,6 +352,9 @@ def test_scene_refuses_what_is_not_a_restitution():
     [
         ((7, 0.0, 0.0, np.empty(0), np.empty(0)), "unknown kind"),
         ((1, -1.0, 1.0, np.empty(0), np.empty(0)), "viscoelastic"),
+        # v_max past the series' range (0.25 / 0.1)^5 = 97.66 would let eps exceed 1
+        ((1, 0.1, math.inf, np.empty(0), np.empty(0)), "viscoelastic"),
+        ((1, 0.1, 98.0, np.empty(0), np.empty(0)), "viscoelastic"),
         ((2, 0.0, 0.0, np.array([0.0, 2.0, 1.0]), np.array([1.0, 0.9, 0.8])), "increasing"),
         ((2, 0.0, 0.0, np.array([0.0, 1.0]), np.array([1.0, 2.0])), r"\[0, 1\]"),
         ((2, 0.0, 0.0, np.empty(0), np.empty(0)), "points"),

@@ -15,7 +15,7 @@ Three parts, each against ``granular.theory``:
   compare them with the same fit of the **full second-order expressions**
   (``viscoelastic_temperature_second_order``, ``msd_viscoelastic_second_order``): the
   asymptotes -5/3 and 1/6 are approached so slowly (the MSD's within 10% only from
-  ~10^5 tau0') that a late fit against them would measure the approach, not the physics;
+  ~10^6 tau0') that a late fit against them would measure the approach, not the physics;
   the quantity texts state the leading-order expressions' exponents and the asymptotes
   beside them.
 - **Power-law UDSBM** (``langevin.from_scene`` of the same scene: exponent 5/6, tau0' of
@@ -163,8 +163,8 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
             f"d ln MSD / d ln t of the viscoelastic gas (EDMD, as visco.haff.exponent), "
             f"t / tau0' = {t_max / 10:g} ... {t_max:g}; theory: the same fit of "
             f"msd_viscoelastic_second_order; the leading order (msd_viscoelastic) gives "
-            f"{q1:.4f} there, the asymptote 1/6 = 0.1667 (reached within 10% only from "
-            f"~1e5 tau0')",
+            f"{q1:.4f} there, the asymptote 1/6 = 0.1667 (the MSD within 10% of its asymptote only "
+            f"from ~1e6 tau0')",
             m_slopes,
             None,
             q2,
