@@ -103,6 +103,17 @@ def collision_time(
     return 1.0 / collision_frequency(density, radius, temperature, mass, dim, eta)
 
 
+def _constant_xi(xi):
+    """A formula for a constant restitution given a law: say what to use instead."""
+    if isinstance(xi, _restitution.RestitutionLaw):
+        raise TypeError(
+            f"xi must be a number (a constant restitution), got a {type(xi).__name__}; for "
+            "a viscoelastic gas use theory.viscoelastic_* with the law, or "
+            "langevin.coefficients_from_scene(scene)"
+        )
+    return xi
+
+
 def haff_tau0(
     density: FloatOrArray,
     radius: FloatOrArray,
@@ -119,6 +130,7 @@ def haff_tau0(
     ``(1 - xi^2) m (v_n)^2 / 4``, which averages to ``(1 - xi^2) T`` over collisions of a
     Maxwellian gas, so ``dT/dt = -(1 - xi^2) omega T / d``.  Infinite for xi = 1.
     """
+    xi = _constant_xi(xi)
     if not 0.0 <= xi <= 1.0:
         raise ValueError("xi must lie in [0, 1]")
     if xi == 1.0:
@@ -149,6 +161,7 @@ def diffusion_d0(
     counterpart ``1 / (2 n g2 sigma) sqrt(T0 / (pi m))`` (velocity relaxation rate
     gamma_E = (2/d) omega, the same Enskog derivation).  Per dimension:
     ``<dx^2> = 2 D t``."""
+    xi = _constant_xi(xi)
     _check_dim(dim)
     g2 = contact_value(_eta(density, radius, dim, eta), dim)
     sigma = 2.0 * radius
@@ -179,6 +192,7 @@ def langevin_coefficients(
     """gamma0, D0, tau0 of a gas of n particles in a box of the given volume, as the thesis
     derives them for its Langevin and UDSBM models: D0 (2.52), ``gamma0 = T0 / (m D0)``
     (2.55), tau0 (2.45; infinite for xi = 1)."""
+    xi = _constant_xi(xi)
     density = n / volume
     d0 = float(diffusion_d0(density, radius, xi, temperature0, mass, dim))
     gamma0 = temperature0 / (mass * d0)
@@ -401,6 +415,7 @@ def cooling_rate(
     ``zeta = (1 - xi^2) omega / d`` with omega the Enskog collision frequency (2.42); the
     same Maxwellian estimate as ``haff_tau0`` (``zeta(T0) = 2 / tau0``), equal to Garzo &
     Dufty's ``zeta* = (d + 2) / (4 d) chi (1 - xi^2)`` at a2 = 0 in units of ``n T / eta0``."""
+    xi = _constant_xi(xi)
     xi = np.asarray(xi, dtype=np.float64)
     if np.any((xi < 0) | (xi > 1)):
         raise ValueError("xi must lie in [0, 1]")
@@ -430,6 +445,7 @@ def shear_viscosity(
     pi)`` in 2D (sigma = 2 r).  At xi = 1 this is Enskog's first Sonine viscosity: 3D
     ``eta0 [(1 + 8 phi chi / 5)^2 / chi + 768 phi^2 chi / (25 pi)]`` (Chapman & Cowling),
     2D ``eta0 [(1 + phi chi)^2 / chi + 8 phi^2 chi / pi]`` (Gass 1971)."""
+    xi = _constant_xi(xi)
     _check_dim(dim)
     xi = np.asarray(xi, dtype=np.float64)
     phi = _eta(density, radius, dim, eta)
@@ -491,6 +507,7 @@ def critical_box_size(
     Rev. E 59, 5895.  Valid at Navier-Stokes order (L_c many mean free paths) and where the
     Enskog transport coefficients hold (packing fraction up to about 0.25 in 3D).
     """
+    xi = _constant_xi(xi)
     xi = np.asarray(xi, dtype=np.float64)
     zeta = cooling_rate(density, radius, xi, 1.0, 1.0, dim, eta)
     visc = shear_viscosity(density, radius, xi, 1.0, 1.0, dim, eta)

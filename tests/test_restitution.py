@@ -369,3 +369,20 @@ def test_the_engine_checks_a_law_itself(law, match):
             _core.edmd_check(*s._engine_args(), **{key: law})
     with pytest.raises(TypeError, match="law must be None"):
         _core.EDMD(*s._engine_args(), law=(1, 2.0))
+
+
+def test_constant_restitution_formulas_name_what_to_use_for_a_law():
+    """Haff's law and its relatives are for a constant xi: handed a law (as a user with a
+    viscoelastic scene might, scene.restitution), they say what to use instead."""
+    law = Viscoelastic.from_restitution(0.9, 1.0)
+    calls = [
+        lambda: granular.theory.haff_tau0(1000, 0.025, law, 1.0),
+        lambda: granular.theory.diffusion_d0(1000, 0.025, law, 1.0),
+        lambda: granular.theory.langevin_coefficients(1000, 0.025, 1.0, law, 1.0),
+        lambda: granular.theory.cooling_rate(1000, 0.025, law, 1.0),
+        lambda: granular.theory.shear_viscosity(1000, 0.025, law, 1.0),
+        lambda: granular.theory.critical_box_size(1000, 0.025, law),
+    ]
+    for call in calls:
+        with pytest.raises(TypeError, match="viscoelastic_"):
+            call()
