@@ -17,6 +17,7 @@ against.
 
 from __future__ import annotations
 
+import abc
 import math
 from typing import Any
 
@@ -50,24 +51,28 @@ def _positive(value: Any, name: str) -> float:
     return x
 
 
-class RestitutionLaw:
-    """Base of the restitution laws: eps(v_n) for normal impact speeds v_n >= 0."""
+class RestitutionLaw(abc.ABC):
+    """Base of the restitution laws: eps(v_n) for normal impact speeds v_n >= 0.  A law
+    says its value, whether it dissipates, how the engine takes it and what identifies it;
+    equality and hashing follow from the last."""
 
+    @abc.abstractmethod
     def __call__(self, speed: ArrayLike) -> NDArray[np.float64]:
         """eps at the given normal impact speeds (>= 0), as the engine applies it."""
-        raise NotImplementedError
 
     @property
+    @abc.abstractmethod
     def loses_energy(self) -> bool:
         """Whether some collision loses kinetic energy under this law (eps < 1)."""
-        raise NotImplementedError
 
-    def _engine(self) -> tuple:
-        """The law as the engine takes it: (kind, scale, v_max, speeds, values)."""
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _engine(self) -> tuple | None:
+        """The law as the engine takes it: (kind, scale, v_max, speeds, values), or None
+        for a constant (the engine's own loop)."""
 
+    @abc.abstractmethod
     def _key(self) -> tuple:
-        raise NotImplementedError
+        """The numbers that identify the law (equality, hashing)."""
 
     def __eq__(self, other: object) -> bool:
         return type(other) is type(self) and self._key() == other._key()  # type: ignore[attr-defined]
@@ -108,6 +113,10 @@ class ConstantRestitution(RestitutionLaw):
     @property
     def loses_energy(self) -> bool:
         return self.value < 1.0
+
+    def _engine(self) -> None:
+        """None: the engine's constant-restitution loop takes the number itself."""
+        return None
 
     def _key(self) -> tuple:
         return (self.value,)

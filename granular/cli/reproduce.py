@@ -618,11 +618,21 @@ def _fig_4_17_to_4_23(cfg, out):
     return names, rows
 
 
+def _tools():
+    """What the experiments in their own modules (reproduce_clustering, reproduce_visco)
+    take from this one: ensembles in this process (threads: their warnings can be
+    silenced, and results do not depend on the backend), figures and rows."""
+    return dict(
+        ensemble=functools.partial(_checked_ensemble, backend="threads"),
+        save=_save,
+        fig=_fig,
+        row=_row,
+        mean_row=_mean_row,
+    )
+
+
 def _fig_clustering(cfg, out):
     """Where homogeneous cooling ends (issue 15): see ``reproduce_clustering``."""
-    import warnings
-
-    from ..errors import ClusteringWarning
     from . import reproduce_clustering
 
     # its big box lies beyond L_c on purpose: silence the warning, which needs the runs in
@@ -630,30 +640,14 @@ def _fig_clustering(cfg, out):
     # backend)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ClusteringWarning)
-        return reproduce_clustering._fig_clustering(
-            cfg,
-            out,
-            ensemble=functools.partial(_checked_ensemble, backend="threads"),
-            save=_save,
-            fig=_fig,
-            row=_row,
-            mean_row=_mean_row,
-        )
+        return reproduce_clustering._fig_clustering(cfg, out, **_tools())
 
 
 def _fig_visco(cfg, out):
     """Viscoelastic gases (issue 15): see ``reproduce_visco``."""
     from . import reproduce_visco
 
-    return reproduce_visco._fig_visco(
-        cfg,
-        out,
-        ensemble=functools.partial(_checked_ensemble, backend="threads"),
-        save=_save,
-        fig=_fig,
-        row=_row,
-        mean_row=_mean_row,
-    )
+    return reproduce_visco._fig_visco(cfg, out, **_tools())
 
 
 FIGURES = {
