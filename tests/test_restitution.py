@@ -81,7 +81,8 @@ def test_restitution_tends_to_one_at_rest():
     assert np.all(np.diff(eps) < 0)  # falls as the impact speed grows
     # 1 - eps -> C1 A kappa^(2/5) v^(1/5): leading order, relative error ~ C2/C1 delta
     d = law.delta(v)
-    np.testing.assert_allclose((1 - eps) / (C1 * d), 1.0, rtol=0.7 * d.max() + 1e-9)
+    # (per speed: C2/C1 = 0.692 < 0.7, so the bound holds at each delta, tight at small ones)
+    assert np.all(np.abs((1 - eps) / (C1 * d) - 1.0) <= 0.7 * d + 1e-9)
     assert eps[0] > 1 - 1e-6 and float(law(0.0)) == 1.0
 
 
