@@ -5,9 +5,10 @@ The fastest open event-driven code we know is F. Smallenburg's (github.com/FSmal
 `Cell/` keeps cell lists, `Single/` neighbour lists.  Its numbers depend on the machine as
 much as ours, so the only fair comparison is both codes on the same machine at the same
 time.  This script does that: for each workload it runs a prepared copy of the other code,
-and granular on the same number of pair collisions, and repeats, interleaved, the order
-alternating from round to round; every round is printed with the load average, then the
-median and range per workload and code.
+and granular with the same N (read from the other code's init.sph) on the same number of
+pair collisions, and repeats, interleaved, the order alternating from round to round; every
+round is printed with both sides' wall and CPU seconds and the load average, then the median
+and range per workload and code, and of the ratio granular / other round by round.
 
 The other code is not shipped here; prepare one directory per workload:
   1. clone the repository; copy `Cell/` (dilute workloads) or `Single/` (packing 0.45),
@@ -27,13 +28,15 @@ Then, for example:
     python benchmarks/compare_open_edmd.py --other 3d-1e5-0.065=/tmp/sm/cell_1e5 \\
         --other 3d-1e4-0.45=/tmp/sm/single_1e4 --repeats 2
 
-(`--tiny` runs only granular's side and the lattice writer at a tiny size: what CI checks.)
+(`--tiny` runs granular's side, the lattice writer and the report reader, on a stand-in for
+the other code, at a tiny size: what CI checks.)
 
 The other code's throughput is the pair collisions between its first and last reports
 ("Simtime: t, Collisions: c"; its output is made line-buffered) over the wall time between
-them: its setup (8 s at N = 1e6) and final snapshot are not timed.  granular then runs the
-same number of pair collisions in one window after building and equilibrating the gas,
-which is not timed either (bench.edmd_workload with one window).
+them, its CPU time over the same span read from /proc: its setup (8 s at N = 1e6) and final
+snapshot are not timed.  granular then runs the same number of pair collisions in one
+window after building and equilibrating the gas, which is not timed either
+(bench.edmd_workload with one window; wall and CPU time of that window).
 """
 
 import argparse
@@ -74,10 +77,25 @@ def write_init(path, m, eta):
                 f.writelines(f"a {x:.12f} {y:.12f} {(k + 0.5) * a:.12f} 0.5\n" for k in range(m))
 
 
+def other_n(directory):
+    """The other code's N: the first line of its init.sph, so that granular runs the same
+    number of spheres (a lattice of M**3 is not always the workload's round N)."""
+    with open(os.path.join(directory, "init.sph")) as f:
+        return int(f.readline())
+
+
+def _cpu_seconds(pid):
+    """User + system CPU seconds of a running process so far (/proc, clock ticks)."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def run_other(directory, eta):
-    """Run ./md in directory, line-buffered; (pair collisions, seconds) between its first
-    and its last report ("Simtime: t, Collisions: c, ..."), so that neither its setup (8 s
-    at N = 1e6) nor its final snapshot is timed, as granular's setup is not."""
+    """Run ./md in directory, line-buffered; (pair collisions, wall seconds, CPU seconds)
+    between its first and its last report ("Simtime: t, Collisions: c, ..."), so that
+    neither its setup (8 s at N = 1e6) nor its final snapshot is timed, as granular's setup
+    is not."""
     proc = subprocess.Popen(
         ["stdbuf", "-oL", "./md"], cwd=directory, stdout=subprocess.PIPE, text=True
     )
@@ -87,25 +105,35 @@ def run_other(directory, eta):
         if m := re.match(r"Packing fraction\s*:\s*([0-9.]+)", line):
             packing = float(m.group(1))
         elif m := re.match(r"Simtime:\s*[0-9.e+-]+,\s*Collisions:\s*(\d+)", line):
-            reports.append((now, int(m.group(1))))
+            reports.append((now, _cpu_seconds(proc.pid), int(m.group(1))))
     if proc.wait() != 0:
         raise RuntimeError(f"{directory}: ./md exited with status {proc.returncode}")
     if packing is None or abs(packing - eta) > 1e-3:
         raise RuntimeError(f"{directory}: packing fraction {packing}, not the workload's {eta}")
     if len(reports) < 2:
         raise RuntimeError(f"{directory}: fewer than two 'Simtime: ..., Collisions: ...' lines")
-    (t0, c0), (t1, c1) = reports[0], reports[-1]
-    return c1 - c0, t1 - t0
+    (t0, cpu0, c0), (t1, cpu1, c1) = reports[0], reports[-1]
+    return c1 - c0, t1 - t0, cpu1 - cpu0
+
+
+# What the other code prints, for --tiny: its packing fraction, then a report a step.
+STAND_IN = """#!/bin/sh
+echo "Packing fraction : 0.0650"
+for c in 1000 2000 3000 4000; do
+    i=0; while [ $i -lt 20000 ]; do i=$((i + 1)); done
+    echo "Simtime: $c.0, Collisions: $c, Press: 1.0"
+done
+"""
 
 
 # pair collisions the other code ran per workload, for granular's next run of it
 PAIRS = {}
 
 
-def run_granular(name, pairs):
-    n, eta, _ = WORKLOADS[name]
+def run_granular(name, n, pairs):
+    _, eta, _ = WORKLOADS[name]
     r = edmd_workload(name, 3, n, eta, 2.0 * pairs / n, windows=1)
-    return r["pair_collisions"], r["seconds"]
+    return r["pair_collisions"], r["seconds"], r["cpu_seconds"]
 
 
 def main():
@@ -140,6 +168,15 @@ def main():
             with open(path) as f:
                 if len(f.readlines()) != 2 + 4**3:
                     raise RuntimeError(f"{path}: not the N + 2 lines of an init.sph")
+            # the other code's report format, from a stand-in that burns a little CPU
+            md = os.path.join(folder, "md")
+            with open(md, "w") as f:
+                f.write(STAND_IN)
+            os.chmod(md, 0o755)
+            pairs, seconds, cpu = run_other(folder, 0.065)
+            if pairs != 3000 or not 0.0 <= cpu <= 2.0 * seconds + 0.05 or other_n(folder) != 64:
+                raise RuntimeError(f"stand-in read as {pairs} pairs, {seconds} s, {cpu} CPU s")
+            print(f"{'stand-in':14s} {'other':12s} {pairs:16d} {seconds:8.2f} {cpu:8.2f}")
         r = edmd_workload("3d-tiny-0.065", 3, 500, 0.065, 2.0, windows=1)
         print(f"{r['name']:14s} {'granular':12s} {r['pair_collisions']:16d} {r['seconds']:8.2f}")
         return
@@ -161,42 +198,60 @@ def main():
     if unknown:
         p.error(f"unknown workloads {sorted(unknown)}; known: {', '.join(WORKLOADS)}")
     names = [name for name in WORKLOADS if name in others]
+    sizes = {name: other_n(others[name]) for name in names}
     rows = []  # (workload, code, pair collisions per second)
+    ratios = {name: [] for name in names}  # granular / other per round: (wall, CPU)
 
-    def report(round_, name, code, pairs, seconds):
+    def report(round_, name, code, pairs, seconds, cpu):
         rows.append((name, code, pairs / seconds))
         print(
-            f"{round_:5d} {name:14s} {code:12s} {pairs:16d} {seconds:8.2f} "
-            f"{pairs / seconds / 1e6:7.3f} {os.getloadavg()[0]:6.2f}",
+            f"{round_:5d} {name:14s} {sizes[name]:8d} {code:12s} {pairs:16d} {seconds:8.2f} "
+            f"{cpu:8.2f} {pairs / seconds / 1e6:7.3f} {os.getloadavg()[0]:6.2f}",
             flush=True,
         )
 
     print(
-        f"{'round':>5s} {'workload':14s} {'code':12s} {'pair collisions':>16s} {'seconds':>8s} "
-        f"{'M/s':>7s} {'load':>6s}"
+        f"{'round':>5s} {'workload':14s} {'N':>8s} {'code':12s} {'pair collisions':>16s} "
+        f"{'wall s':>8s} {'CPU s':>8s} {'M/s':>7s} {'load':>6s}"
     )
     for round_ in range(args.repeats):
         for name in names:
             # the order alternates from round to round, so a machine whose load drifts
-            # during a round favours neither code; granular runs the other's pair count
+            # during a round favours neither code; granular runs the other's N and pair
+            # count (in odd rounds the count of its previous run: granular goes first)
+            eta = WORKLOADS[name][1]
             if round_ % 2 == 0:
-                pairs, seconds = run_other(others[name], WORKLOADS[name][1])
-                report(round_, name, "Smallenburg", pairs, seconds)
-                report(round_, name, "granular", *run_granular(name, pairs))
+                other = run_other(others[name], eta)
+                mine = run_granular(name, sizes[name], other[0])
+                order = (("Smallenburg", other), ("granular", mine))
             else:
-                pairs = PAIRS.get(name) or 2_000_000
-                mine = run_granular(name, pairs)
-                other = run_other(others[name], WORKLOADS[name][1])
-                report(round_, name, "granular", *mine)
-                report(round_, name, "Smallenburg", *other)
-            PAIRS[name] = pairs
-    print("\nmedian (smallest-largest) over the rounds, M pair collisions/s:")
+                mine = run_granular(name, sizes[name], PAIRS.get(name) or 2_000_000)
+                other = run_other(others[name], eta)
+                order = (("granular", mine), ("Smallenburg", other))
+            for code, (pairs, seconds, cpu) in order:
+                report(round_, name, code, pairs, seconds, cpu)
+            PAIRS[name] = other[0]
+            # rates per wall second and per CPU second, granular's over the other's
+            ratios[name].append(
+                (
+                    (mine[0] / mine[1]) / (other[0] / other[1]),
+                    (mine[0] / mine[2]) / (other[0] / other[2]),
+                )
+            )
+    print("\nmedian (smallest-largest) over the rounds, M pair collisions/s (wall):")
     for name in names:
         line = []
         for code in ("granular", "Smallenburg"):
             r = sorted(rate for w, c, rate in rows if w == name and c == code)
             line.append(f"{code} {np.median(r) / 1e6:.3f} ({r[0] / 1e6:.3f}-{r[-1] / 1e6:.3f})")
         print(f"{name:14s} " + ", ".join(line))
+    print("\ngranular / Smallenburg, round by round: median (smallest-largest)")
+    for name in names:
+        wall, cpu = np.array(ratios[name]).T
+        print(
+            f"{name:14s} wall {np.median(wall):.2f} ({wall.min():.2f}-{wall.max():.2f}), "
+            f"CPU {np.median(cpu):.2f} ({cpu.min():.2f}-{cpu.max():.2f})"
+        )
     if args.plot:
         plot(rows, args.plot)
 
