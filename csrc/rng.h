@@ -66,4 +66,31 @@ static inline double gr_normal(gr_stream *s)
     return gr_normal_tail(s, hz, iz);
 }
 
+/* Normals for a batch of consecutive streams, the same bits as gr_normal.
+ *
+ * The steps of one particle are a chain only through its state; their random numbers are
+ * independent functions of the step.  So the engine (sde.c) draws them ahead,
+ * GR_NORMAL_BATCH steps at a time: gr_normal_batch(key, step0, particle, m, z) sets
+ * z[k * GR_NORMAL_BATCH + j] to the k-th of m normals that gr_normal draws in turn from
+ * gr_stream_at(key, step0 + j, particle), for j < GR_NORMAL_BATCH and k < m <=
+ * GR_NORMAL_BATCH_MAX_M.
+ *
+ * How, and why the bits are the same: every draw of the batch is first taken as if it
+ * passed the ziggurat's fast path -- a pure function of (stream seed, k), since the k-th
+ * draw of a stream is gr_mix64(seed + (k + 1) golden) when no draw before it left the fast
+ * path -- in loops with no branch and a fixed trip count, which the compiler vectorises
+ * (64-bit integer arithmetic, two table look-ups, one int-to-double conversion and one
+ * multiplication, each exact or correctly rounded the same way in any instruction set).
+ * A stream any of whose m draws misses the fast path (about 1.2% of draws: the wedges and
+ * the tail, which draw more from the stream and so shift its later draws) is then drawn
+ * again from its seed by gr_normal itself.  On x86-64 with GCC or Clang the batch loop is
+ * compiled three times -- plain, AVX2, AVX-512 -- and gr_rng_init picks the widest the CPU
+ * runs (rng.c); it does integer work and a lone multiply, so no instruction set can fuse
+ * or reorder anything. */
+#define GR_NORMAL_BATCH 16
+#define GR_NORMAL_BATCH_MAX_M 6
+void gr_normal_batch(uint64_t key, uint64_t step0, uint64_t particle, int m, double *z);
+/* The batch loop in use: "plain", "avx2" or "avx512" (set by gr_rng_init). */
+const char *gr_normal_batch_kernel(void);
+
 #endif

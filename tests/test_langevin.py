@@ -776,3 +776,31 @@ def test_the_same_bits_as_the_step_by_step_engine(monkeypatch, name):
     want = json.loads((Path(__file__).with_name("sde_bits.json")).read_text())
     got = sde_bits.digest(sde_bits.run_case(sde_bits.cases()[name], monkeypatch))
     assert got == want[name]
+
+
+@pytest.mark.parametrize("kernel", ["plain", "avx2", "avx512"])
+def test_every_compilation_of_the_batched_normals_gives_the_same_bits(kernel):
+    """rng.c compiles the batch of normals plain, for AVX2 and for AVX-512, and picks the
+    widest the CPU runs; GRANULAR_RNG_KERNEL asks for a narrower one.  Each one this CPU
+    runs gives every digest of tests/sde_bits.json (main's bits), in its own process (the
+    choice is made at import)."""
+    env = dict(os.environ, GRANULAR_RNG_KERNEL=kernel)
+    tests = Path(__file__).resolve().parent
+    script = textwrap.dedent(
+        f"""
+        import json, sys
+        sys.path.insert(0, {str(tests)!r})
+        import granular._core
+        from helpers import sde_bits
+        print(granular._core.RNG_KERNEL)
+        print(json.dumps({{k: sde_bits.digest(sde_bits.run_case(c))
+                          for k, c in sde_bits.cases().items()}}))
+        """
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True
+    ).stdout.splitlines()
+    if out[0] != kernel:
+        pytest.skip(f"this CPU does not run the {kernel} compilation (got {out[0]})")
+    want = json.loads((tests / "sde_bits.json").read_text())
+    assert json.loads(out[1]) == want
