@@ -76,17 +76,18 @@ static inline double gr_normal(gr_stream *s)
  * GR_NORMAL_BATCH_MAX_M.
  *
  * How, and why the bits are the same: every draw of the batch is first taken as if it
- * passed the ziggurat's fast path -- a pure function of (stream seed, k), since the k-th
- * draw of a stream is gr_mix64(seed + (k + 1) golden) when no draw before it left the fast
- * path -- in loops with no branch and a fixed trip count, which the compiler vectorises
- * (64-bit integer arithmetic, two table look-ups, one int-to-double conversion and one
- * multiplication, each exact or correctly rounded the same way in any instruction set).
- * A stream any of whose m draws misses the fast path (about 1.2% of draws: the wedges and
- * the tail, which draw more from the stream and so shift its later draws) is then drawn
- * again from its seed by gr_normal itself.  On x86-64 with GCC or Clang the batch loop is
- * compiled three times -- plain, AVX2, AVX-512 -- and gr_rng_init picks the widest the CPU
- * runs (rng.c); it does integer work and a lone multiply, so no instruction set can fuse
- * or reorder anything. */
+ * and the draws before it passed the ziggurat's fast path -- then the k-th draw of a
+ * stream is gr_mix64(seed + (k + 1) golden), a pure function of (stream seed, k) -- in
+ * loops with no branch and fixed trip counts that vectorise (64-bit integer arithmetic,
+ * two table look-ups, one int-to-double conversion and one multiplication, each exact or
+ * correctly rounded the same way in any instruction set).  A draw that misses the fast
+ * path (2.8% of draws: the wedges, the tail, and layer 1, whose k is 0) is redone by
+ * gr_normal's own slow path from the stream state gr_normal would have there, and the
+ * stream's later draws by gr_normal (the slow path draws more, shifting them).  On x86-64
+ * with GCC or Clang the batch exists plain, compiled for AVX2, and written for AVX-512
+ * with intrinsics (8 streams a vector, the tables gathered); gr_rng_init picks the widest
+ * the CPU runs (rng.c).  Only integer work and that lone multiply happen there, and the
+ * particle update stays in portable code: nothing can be fused or reordered. */
 #define GR_NORMAL_BATCH 16
 #define GR_NORMAL_BATCH_MAX_M 6
 void gr_normal_batch(uint64_t key, uint64_t step0, uint64_t particle, int m, double *z);

@@ -7,7 +7,10 @@
  * only the rings of one particle's past positions at a time (tamsd.h: O(levels) memory,
  * not O(N x steps)).  The particles are split over threads by blocks (sde.h).
  * Invariant: a particle's random numbers depend only on (key, step, particle), never on
- * the order of work. */
+ * the order of work -- nor on how many steps' worth are drawn at once: a particle's
+ * normals are drawn GR_NORMAL_BATCH steps ahead (rng.h's gr_normal_batch, vectorised),
+ * each the very number gr_normal would draw in its step's stream, and the update reads
+ * them in the same order, so the bits are those of drawing step by step. */
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
