@@ -826,5 +826,10 @@ PyMODINIT_FUNC PyInit__core(void)
         return NULL;
     }
     gr_rng_init();
+    /* which compilation of the batched normals runs here (rng.c): for tests and reports */
+    if (PyModule_AddStringConstant(m, "RNG_KERNEL", gr_normal_batch_kernel()) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
     return m;
 }

@@ -66,4 +66,32 @@ static inline double gr_normal(gr_stream *s)
     return gr_normal_tail(s, hz, iz);
 }
 
+/* Normals for a batch of consecutive streams, the same bits as gr_normal.
+ *
+ * The steps of one particle are a chain only through its state; their random numbers are
+ * independent functions of the step.  So the engine (sde.c) draws them ahead,
+ * GR_NORMAL_BATCH steps at a time: gr_normal_batch(key, step0, particle, m, z) sets
+ * z[k * GR_NORMAL_BATCH + j] to the k-th of m normals that gr_normal draws in turn from
+ * gr_stream_at(key, step0 + j, particle), for j < GR_NORMAL_BATCH and k < m <=
+ * GR_NORMAL_BATCH_MAX_M.
+ *
+ * How, and why the bits are the same: every draw of the batch is first taken as if it
+ * and the draws before it passed the ziggurat's fast path -- then the k-th draw of a
+ * stream is gr_mix64(seed + (k + 1) golden), a pure function of (stream seed, k) -- in
+ * loops with no branch and fixed trip counts that vectorise (64-bit integer arithmetic,
+ * two table look-ups, one int-to-double conversion and one multiplication, each exact or
+ * correctly rounded the same way in any instruction set).  A draw that misses the fast
+ * path (2.8% of draws: the wedges, the tail, and layer 1, whose k is 0) is redone by
+ * gr_normal's own slow path from the stream state gr_normal would have there, and the
+ * stream's later draws by gr_normal (the slow path draws more, shifting them).  On x86-64
+ * with GCC or Clang the batch exists plain, compiled for AVX2, and written for AVX-512
+ * with intrinsics (8 streams a vector, the tables gathered); gr_rng_init picks the widest
+ * the CPU runs (rng.c).  Only integer work and that lone multiply happen there, and the
+ * particle update stays in portable code: nothing can be fused or reordered. */
+#define GR_NORMAL_BATCH 16
+#define GR_NORMAL_BATCH_MAX_M 6
+void gr_normal_batch(uint64_t key, uint64_t step0, uint64_t particle, int m, double *z);
+/* The batch loop in use: "plain", "avx2" or "avx512" (set by gr_rng_init). */
+const char *gr_normal_batch_kernel(void);
+
 #endif

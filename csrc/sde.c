@@ -7,7 +7,10 @@
  * only the rings of one particle's past positions at a time (tamsd.h: O(levels) memory,
  * not O(N x steps)).  The particles are split over threads by blocks (sde.h).
  * Invariant: a particle's random numbers depend only on (key, step, particle), never on
- * the order of work. */
+ * the order of work -- nor on how many steps' worth are drawn at once: a particle's
+ * normals are drawn GR_NORMAL_BATCH steps ahead (rng.h's gr_normal_batch, vectorised),
+ * each the very number gr_normal would draw in its step's stream, and the update reads
+ * them in the same order, so the bits are those of drawing step by step. */
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -67,21 +70,38 @@ typedef struct {
                                 for an exponent != 1 (a pow a step saved per particle), or NULL */
 } step_params;
 
+/* A particle's normals drawn ahead (rng.h's gr_normal_batch): z[k * GR_NORMAL_BATCH + j]
+ * is the k-th normal of step first + j (the stream (key, first + j - 1, i)). */
+typedef struct {
+    int64_t first;
+    double z[GR_NORMAL_BATCH_MAX_M * GR_NORMAL_BATCH];
+} normals_ahead;
+
 /* Steps from+1 .. to of particle i (the step numbered k goes from t = (k-1) dt to k dt and
- * draws the randoms of (key, k-1, i)).  Always inlined with a constant d, so that each
- * dimension gets its own unrolled loop. */
+ * draws the randoms of (key, k-1, i)), its normals from `ahead`, refilled for the next
+ * GR_NORMAL_BATCH steps whenever a step is past them (steps only go forward, and the
+ * buffer lives as long as the particle's run, across bookkeeping stops).  Each normal is
+ * the very number gr_normal would draw at that point of the step's stream, so the
+ * update, unchanged, gives the same bits as drawing step by step.  Always inlined with a
+ * constant d, so that each dimension gets its own unrolled loop. */
 #if defined(__GNUC__) || defined(__clang__)
 #define GR_ALWAYS_INLINE inline __attribute__((always_inline))
 #else
 #define GR_ALWAYS_INLINE inline
 #endif
 
-static GR_ALWAYS_INLINE void run_steps(
-    const int d, const step_params *p, int64_t i, int64_t from, int64_t to, double *xi, double *vi)
+static GR_ALWAYS_INLINE void run_steps(const int d, const step_params *p, int64_t i,
+                                       int64_t from, int64_t to, double *xi, double *vi,
+                                       normals_ahead *ahead)
 {
     const double dt = p->dt;
+    const int m = p->em ? d : 2 * d; /* normals a step */
     for (int64_t step = from + 1; step <= to; step++) {
-        gr_stream rs = gr_stream_at(p->key, (uint64_t)(step - 1), (uint64_t)i);
+        if (step - ahead->first >= GR_NORMAL_BATCH) {
+            ahead->first = step;
+            gr_normal_batch(p->key, (uint64_t)(step - 1), (uint64_t)i, m, ahead->z);
+        }
+        const double *z = ahead->z + (step - ahead->first); /* z[k B]: the k-th normal */
         if (p->em) {
             double a_coef = 1.0 - p->g0 * dt, b = p->b0;
             if (p->em_table) {
@@ -94,9 +114,9 @@ static GR_ALWAYS_INLINE void run_steps(
                 b = p->b0 * s * sqrt(s);
             }
             for (int a = 0; a < d; a++) {
-                double z = gr_normal(&rs);
+                const double za = z[a * GR_NORMAL_BATCH];
                 xi[a] += vi[a] * dt;
-                vi[a] = a_coef * vi[a] + b * z;
+                vi[a] = a_coef * vi[a] + b * za;
             }
         } else {
             exact_coef e = p->ex0;
@@ -108,8 +128,8 @@ static GR_ALWAYS_INLINE void run_steps(
                 double s = udsbm_decay(w, p->expo);
                 e = exact_for(p->g0 * s, p->D0 * s, dt);
             }
-            for (int a = 0; a < d; a++) {
-                double z1 = gr_normal(&rs), z2 = gr_normal(&rs);
+            for (int a = 0; a < d; a++) { /* per axis: z1 drives v, z2 the rest of x */
+                const double z1 = z[2 * a * GR_NORMAL_BATCH], z2 = z[(2 * a + 1) * GR_NORMAL_BATCH];
                 xi[a] += vi[a] * e.drift + e.kx * z1 + e.sx * z2;
                 vi[a] = e.c * vi[a] + e.sv * z1;
             }
@@ -203,6 +223,8 @@ static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, d
         vi[a] = v[a];
     }
     int64_t ks = rs->ks0;
+    normals_ahead ahead;
+    ahead.first = -GR_NORMAL_BATCH; /* none yet: the first step fills it */
     const gr_tamsd_plan *tp = rs->plan;
     double *acc = out->tamsd + i * tp->n_lags; /* the particle's window sums, in time order */
     /* the slow lags' next window ends after step_from: k + j s >= step_from */
@@ -241,9 +263,9 @@ static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, d
         /* steps step+1 .. next, each with its own dimension so that the axis loops
          * unroll */
         switch (d) {
-        case 1: run_steps(1, rs->sp, i, step, next, xi, vi); break;
-        case 2: run_steps(2, rs->sp, i, step, next, xi, vi); break;
-        default: run_steps(3, rs->sp, i, step, next, xi, vi); break;
+        case 1: run_steps(1, rs->sp, i, step, next, xi, vi, &ahead); break;
+        case 2: run_steps(2, rs->sp, i, step, next, xi, vi, &ahead); break;
+        default: run_steps(3, rs->sp, i, step, next, xi, vi, &ahead); break;
         }
         step = next;
     }

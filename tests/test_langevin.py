@@ -4,6 +4,7 @@ probability of 5.7e-7 per comparison (two-sided Gaussian tail at 5 sigma), so by
 bound even a test comparing at all its ~60 sample times fails by chance less than once in
 10^4 runs."""
 
+import json
 import math
 import os
 import re
@@ -12,6 +13,7 @@ import subprocess
 import sys
 import textwrap
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,7 +21,7 @@ import pytest
 import granular
 from granular import langevin, theory
 
-from helpers import sde_reference
+from helpers import sde_bits, sde_reference
 
 G0, D0 = 9.26, 0.072  # the thesis' standard gas, xi = 0.8 (theory.langevin_coefficients)
 TAU0 = 0.972
@@ -760,3 +762,45 @@ def test_run_draws_from_its_seed_as_documented():
         n=5,
     )
     np.testing.assert_array_equal(part, r.positions[:, 2:4])
+
+
+# -- the same bits as before the inner loop was batched -------------------------------------
+#
+# tests/sde_bits.json: SHA-256 digests of every array of the runs in helpers/sde_bits.py,
+# computed with the engine BEFORE its random numbers were drawn in batches (main at commit
+# 402792d, unchanged build).  The batched engine must give the very same bits.
+
+
+@pytest.mark.parametrize("name", sorted(sde_bits.cases()))
+def test_the_same_bits_as_the_step_by_step_engine(monkeypatch, name):
+    want = json.loads((Path(__file__).with_name("sde_bits.json")).read_text())
+    got = sde_bits.digest(sde_bits.run_case(sde_bits.cases()[name], monkeypatch))
+    assert got == want[name]
+
+
+@pytest.mark.parametrize("kernel", ["plain", "avx2", "avx512"])
+def test_every_compilation_of_the_batched_normals_gives_the_same_bits(kernel):
+    """rng.c compiles the batch of normals plain, for AVX2 and for AVX-512, and picks the
+    widest the CPU runs; GRANULAR_RNG_KERNEL asks for a narrower one.  Each one this CPU
+    runs gives every digest of tests/sde_bits.json (main's bits), in its own process (the
+    choice is made at import)."""
+    env = dict(os.environ, GRANULAR_RNG_KERNEL=kernel)
+    tests = Path(__file__).resolve().parent
+    script = textwrap.dedent(
+        f"""
+        import json, sys
+        sys.path.insert(0, {str(tests)!r})
+        import granular._core
+        from helpers import sde_bits
+        print(granular._core.RNG_KERNEL)
+        print(json.dumps({{k: sde_bits.digest(sde_bits.run_case(c))
+                          for k, c in sde_bits.cases().items()}}))
+        """
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True
+    ).stdout.splitlines()
+    if out[0] != kernel:
+        pytest.skip(f"this CPU does not run the {kernel} compilation (got {out[0]})")
+    want = json.loads((tests / "sde_bits.json").read_text())
+    assert json.loads(out[1]) == want
