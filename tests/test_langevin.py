@@ -7,6 +7,7 @@ bound even a test comparing at all its ~60 sample times fails by chance less tha
 import json
 import math
 import os
+import platform
 import re
 import signal
 import subprocess
@@ -771,6 +772,15 @@ def test_run_draws_from_its_seed_as_documented():
 # 402792d, unchanged build).  The batched engine must give the very same bits.
 
 
+# the digests were recorded on x86-64 Linux: the ziggurat's tail calls the C library's exp,
+# whose last bit another platform's library may round differently
+RECORDED_HERE = pytest.mark.skipif(
+    platform.machine() not in ("x86_64", "AMD64") or not sys.platform.startswith("linux"),
+    reason="sde_bits.json was recorded on x86-64 Linux (glibc's exp in the ziggurat tail)",
+)
+
+
+@RECORDED_HERE
 @pytest.mark.parametrize("name", sorted(sde_bits.cases()))
 def test_the_same_bits_as_the_step_by_step_engine(monkeypatch, name):
     want = json.loads((Path(__file__).with_name("sde_bits.json")).read_text())
@@ -778,6 +788,7 @@ def test_the_same_bits_as_the_step_by_step_engine(monkeypatch, name):
     assert got == want[name]
 
 
+@RECORDED_HERE
 @pytest.mark.parametrize("kernel", ["plain", "avx2", "avx512"])
 def test_every_compilation_of_the_batched_normals_gives_the_same_bits(kernel):
     """rng.c compiles the batch of normals plain, for AVX2 and for AVX-512, and picks the
