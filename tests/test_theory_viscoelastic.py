@@ -397,3 +397,34 @@ def test_ergodicity_breaking_does_not_vanish_for_udsbm():
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+# Each function with the positional arguments of its earlier (unreleased) order, or of
+# haff_tau0's: a swapped a_kappa and density, or radius and volume, must not give a number.
+POSITIONAL_CALLS = [
+    ("viscoelastic_delta", (A_KAPPA, T0)),
+    ("viscoelastic_cooling_rate", (T0, A_KAPPA, N, R)),
+    ("viscoelastic_tau0", (A_KAPPA, N, R, T0)),
+    ("viscoelastic_tau0", (N, R, A_KAPPA, T0)),  # haff_tau0's order with a_kappa for xi
+    ("viscoelastic_temperature", (1.0, T0, TAU0)),
+    ("viscoelastic_cooling_time", (0.5, T0, A_KAPPA, N, R)),
+    ("viscoelastic_temperature_second_order", (1.0, T0, A_KAPPA, N, R)),
+    ("viscoelastic_diffusion", (1.0, D0, TAU0)),
+    ("msd_viscoelastic", (1.0, D0, TAU0)),
+    ("msd_viscoelastic_asymptote", (1.0, D0, TAU0)),
+    ("msd_viscoelastic_second_order", (1.0, T0, A_KAPPA, N, R)),
+    ("viscoelastic_langevin_coefficients", (N, R, 1.0, A_KAPPA, T0)),
+    ("powerlaw_udsbm_moments", (1.0, D0, G0, TAU0, VISCO)),
+    ("msd_powerlaw_udsbm", (1.0, D0, G0, TAU0, VISCO)),
+    ("msd_powerlaw_udsbm_asymptote", (1.0, D0, TAU0, VISCO)),
+    ("powerlaw_udsbm_increment_msd", (1.0, 0.0, D0, G0, TAU0, VISCO)),
+    ("udsbm_ergodicity_breaking", (1.0, [0.0], D0, G0)),
+]
+
+
+@pytest.mark.parametrize("name,args", POSITIONAL_CALLS, ids=[c[0] for c in POSITIONAL_CALLS])
+def test_parameters_are_keyword_only(name, args):
+    """The material and model parameters are keyword-only (at most t, T or the lag is
+    positional), so a swap cannot pass silently: the positional call is a TypeError."""
+    with pytest.raises(TypeError, match="positional argument"):
+        getattr(theory, name)(*args)
