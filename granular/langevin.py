@@ -348,7 +348,13 @@ class LangevinResult:
             return theory.msd_langevin(t, self.D0, self.gamma0, self.dim, v0_sq=self.v0_sq)
         if self.exponent != 1.0:
             return theory.msd_powerlaw_udsbm(
-                t, self.D0, self.gamma0, self.tau0, self.exponent, self.dim, v0_sq=self.v0_sq
+                t,
+                D0=self.D0,
+                gamma0=self.gamma0,
+                tau0=self.tau0,
+                exponent=self.exponent,
+                dim=self.dim,
+                v0_sq=self.v0_sq,
             )
         return theory.msd_udsbm(t, self.D0, self.gamma0, self.tau0, self.dim, v0_sq=self.v0_sq)
 
@@ -401,12 +407,12 @@ class LangevinResult:
             out.append(
                 theory.udsbm_ergodicity_breaking(
                     k * self.dt,
-                    starts,
-                    self.D0,
-                    self.gamma0,
-                    self.tau0,
-                    self.exponent,
-                    self.dim,
+                    starts=starts,
+                    D0=self.D0,
+                    gamma0=self.gamma0,
+                    tau0=self.tau0,
+                    exponent=self.exponent,
+                    dim=self.dim,
                     v0_sq=self.v0_sq,
                 )
             )
@@ -463,7 +469,14 @@ def theory_tamsd(
             if v0_sq is None:
                 raise ValueError("the power-law UDSBM (exponent != 1) needs v0_sq")
             incr = theory.powerlaw_udsbm_increment_msd(
-                lag, starts, D0, gamma0, tau0, exponent, dim, v0_sq=v0_sq
+                lag,
+                start=starts,
+                D0=D0,
+                gamma0=gamma0,
+                tau0=tau0,
+                exponent=exponent,
+                dim=dim,
+                v0_sq=v0_sq,
             )
         else:
             incr = theory.udsbm_increment_msd(lag, starts, D0, gamma0, tau0, dim, v0_sq=v0_sq)
@@ -831,7 +844,13 @@ def _scene_model(scene: Scene) -> tuple[LangevinCoefficients, float]:
     law = scene.restitution
     if isinstance(law, Viscoelastic):
         c = theory.viscoelastic_langevin_coefficients(
-            scene.n, radius, scene.volume, law, scene.temperature, mass, scene.dim
+            n=scene.n,
+            radius=radius,
+            volume=scene.volume,
+            a_kappa=law,
+            temperature0=scene.temperature,
+            mass=mass,
+            dim=scene.dim,
         )
         return c, VISCOELASTIC_EXPONENT
     if isinstance(law, RestitutionLaw):

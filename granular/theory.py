@@ -566,6 +566,11 @@ def shear_mode_level(box: FloatOrArray, critical: FloatOrArray) -> FloatOrArray:
 # (2015); Bodrova et al., Sci. Rep. 6, 30520 (2016)).  Its second moments are computed here
 # from their exact linear ODEs (no closed form for a != 1), its TAMSD and
 # ergodicity-breaking parameter from the exact position covariance.
+#
+# Every function of both parts takes its parameters by keyword (only t, T or the lag is
+# positional): they are floats of similar size in orders that differ from haff_tau0's and
+# msd_udsbm's, so a swapped a_kappa and density, or a dim landing on exponent, would
+# otherwise give a plausible wrong number without an error.
 
 # the engine's constants (granular/restitution.py, csrc/restitution.h), so theory and the
 # law applied at every collision are one: C1 = 1.15345, C2 = (3/5) C1^2 = 0.79827
@@ -606,7 +611,7 @@ def _check_a_kappa(a_kappa: AKappa) -> float:
 
 
 def viscoelastic_delta(
-    a_kappa: AKappa, temperature: FloatOrArray, mass: float = 1.0
+    temperature: FloatOrArray, *, a_kappa: AKappa, mass: float = 1.0
 ) -> FloatOrArray:
     """The small parameter of the viscoelastic restitution series at a temperature,
     ``delta = a_kappa (4 T / m)^(1/10)``: 1 - eps at the mean squared impact speed is about
@@ -627,6 +632,7 @@ def viscoelastic_delta(
 
 def viscoelastic_cooling_rate(
     temperature: FloatOrArray,
+    *,
     a_kappa: AKappa,
     density: float,
     radius: float,
@@ -686,6 +692,7 @@ def viscoelastic_cooling_rate(
 
 
 def viscoelastic_tau0(
+    *,
     a_kappa: AKappa,
     density: float,
     radius: float,
@@ -717,11 +724,21 @@ def viscoelastic_tau0(
     Brilliantov & Poeschel, Kinetic Theory of Granular Gases (OUP 2004), ch. 8; Schwager
     & Poeschel, PRE 57, 650 (1998).
     """
-    zeta = float(viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta))
+    zeta = float(
+        viscoelastic_cooling_rate(
+            temperature0,
+            a_kappa=a_kappa,
+            density=density,
+            radius=radius,
+            mass=mass,
+            dim=dim,
+            eta=eta,
+        )
+    )
     return math.inf if zeta == 0.0 else 5.0 / (3.0 * zeta)
 
 
-def viscoelastic_temperature(t: FloatOrArray, temperature0: float, tau0: float) -> FloatOrArray:
+def viscoelastic_temperature(t: FloatOrArray, *, temperature0: float, tau0: float) -> FloatOrArray:
     """Leading-order cooling of viscoelastic particles, ``T0 (1 + t/tau0')^(-5/3)``
     (tau0' from ``viscoelastic_tau0``): Haff's law T0 (1 + t/tau0)^-2 with the exponent
     of eps(g)'s g^(1/5).  Valid for delta(T0) << 1, in the homogeneous cooling state (no
@@ -738,6 +755,7 @@ def viscoelastic_temperature(t: FloatOrArray, temperature0: float, tau0: float) 
 
 def viscoelastic_cooling_time(
     temperature: FloatOrArray,
+    *,
     temperature0: float,
     a_kappa: AKappa,
     density: float,
@@ -762,16 +780,14 @@ def viscoelastic_cooling_time(
     ValueError
         If zeta_2 is not smaller than zeta_1 at T0 (delta too large for the series).
     """
-    alpha = float(viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta))
-    beta = alpha - float(
-        viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta, order=2)
-    )
+    material = dict(a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta)
+    alpha = float(viscoelastic_cooling_rate(temperature0, **material))
+    beta = alpha - float(viscoelastic_cooling_rate(temperature0, **material, order=2))
     if 0.0 < alpha <= beta:
+        delta0 = float(viscoelastic_delta(temperature0, a_kappa=a_kappa, mass=mass))
         raise ValueError(
             f"the second-order term of the restitution series ({beta:.3g}) is not smaller than "
-            f"the first ({alpha:.3g}): delta = "
-            f"{float(viscoelastic_delta(a_kappa, temperature0, mass)):.3g} is too large for the "
-            "series"
+            f"the first ({alpha:.3g}): delta = {delta0:.3g} is too large for the series"
         )
     y = (np.asarray(temperature, dtype=np.float64) / temperature0) ** 0.1
     if np.any((y <= 0) | (y > 1)):
@@ -789,6 +805,7 @@ def viscoelastic_cooling_time(
 
 def viscoelastic_temperature_second_order(
     t: FloatOrArray,
+    *,
     temperature0: float,
     a_kappa: AKappa,
     density: float,
@@ -802,10 +819,9 @@ def viscoelastic_temperature_second_order(
     with rates zeta_1 and zeta_1 + zeta_2 at T0, which bracket it).  Its difference from
     ``viscoelastic_temperature`` is relative O(delta(T0)) early and decays like delta(T(t))
     ~ t^(-1/6).  Maxwellian approximation (see ``viscoelastic_cooling_rate``)."""
-    alpha = float(viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta))
-    beta = alpha - float(
-        viscoelastic_cooling_rate(temperature0, a_kappa, density, radius, mass, dim, eta, order=2)
-    )
+    material = dict(a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta)
+    alpha = float(viscoelastic_cooling_rate(temperature0, **material))
+    beta = alpha - float(viscoelastic_cooling_rate(temperature0, **material, order=2))
     t = np.asarray(t, dtype=np.float64)
     if np.any(t < 0):
         raise ValueError("t must be >= 0")
@@ -819,13 +835,8 @@ def viscoelastic_temperature_second_order(
         late = (
             viscoelastic_cooling_time(
                 temperature0 * np.maximum(mid, 1e-300) ** 10,
-                temperature0,
-                a_kappa,
-                density,
-                radius,
-                mass,
-                dim,
-                eta,
+                temperature0=temperature0,
+                **material,
             )
             > t
         )  # cooled to mid only after t: at t it is still warmer
@@ -835,7 +846,7 @@ def viscoelastic_temperature_second_order(
     return out[()] if out.ndim == 0 else out
 
 
-def viscoelastic_diffusion(t: FloatOrArray, D0: float, tau0: float) -> FloatOrArray:
+def viscoelastic_diffusion(t: FloatOrArray, *, D0: float, tau0: float) -> FloatOrArray:
     """Self-diffusion coefficient of the viscoelastic gas, ``D(t) = D0 (1 + t/tau0')^(-5/6)``.
 
     Enskog's D ~ sqrt(T) / (n g2 sigma^2) (``diffusion_d0``) with T(t) of
@@ -853,7 +864,7 @@ def viscoelastic_diffusion(t: FloatOrArray, D0: float, tau0: float) -> FloatOrAr
     return D0 * (1.0 + np.asarray(t, dtype=np.float64) / tau0) ** (-5.0 / 6.0)
 
 
-def msd_viscoelastic(t: FloatOrArray, D0: float, tau0: float, dim: int = 3) -> FloatOrArray:
+def msd_viscoelastic(t: FloatOrArray, *, D0: float, tau0: float, dim: int = 3) -> FloatOrArray:
     """MSD of the viscoelastic gas, total over ``dim``, from D(t) of
     ``viscoelastic_diffusion``: ``2 d int_0^t D = 12 d D0 tau0' ((1 + t/tau0')^(1/6) - 1)``,
     for t much longer than the mean collision time (it misses the ballistic start, as the
@@ -870,7 +881,7 @@ def msd_viscoelastic(t: FloatOrArray, D0: float, tau0: float, dim: int = 3) -> F
 
 
 def msd_viscoelastic_asymptote(
-    t: FloatOrArray, D0: float, tau0: float, dim: int = 3
+    t: FloatOrArray, *, D0: float, tau0: float, dim: int = 3
 ) -> FloatOrArray:
     """Late-time power law of ``msd_viscoelastic``: ``12 d D0 tau0'^(5/6) t^(1/6)``; the
     full expression falls short of it by the factor (1 + tau0'/t)^(1/6) - (tau0'/t)^(1/6)
@@ -881,6 +892,7 @@ def msd_viscoelastic_asymptote(
 
 def msd_viscoelastic_second_order(
     t: FloatOrArray,
+    *,
     temperature0: float,
     a_kappa: AKappa,
     density: float,
@@ -929,13 +941,14 @@ def msd_viscoelastic_second_order(
     t_max = float(np.max(t)) if t.size else 0.0
     if t_max == 0.0:
         return np.zeros_like(t)[()]
-    tau = viscoelastic_tau0(a_kappa, density, radius, temperature0, mass, dim, eta)
+    material = dict(a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta)
+    tau = viscoelastic_tau0(temperature0=temperature0, **material)
     start = min(1e-6 * (tau if math.isfinite(tau) else t_max), 1e-3 * t_max)
     grid = np.concatenate([[0.0], np.geomspace(start, t_max, points)])
-    T = viscoelastic_temperature_second_order(
-        grid, temperature0, a_kappa, density, radius, mass, dim, eta
+    T = viscoelastic_temperature_second_order(grid, temperature0=temperature0, **material)
+    half_loss = (
+        0.5 * VISCOELASTIC_C1 * math.gamma(2.1) * viscoelastic_delta(T, a_kappa=a_kappa, mass=mass)
     )
-    half_loss = 0.5 * VISCOELASTIC_C1 * math.gamma(2.1) * viscoelastic_delta(a_kappa, T, mass)
     D = diffusion_d0(density, radius, 1.0, T, mass, dim, eta) / (1.0 - half_loss) ** 2
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (D[1:] + D[:-1]) * np.diff(grid))])
     out = 2.0 * dim * np.interp(t, grid, integral)
@@ -943,6 +956,7 @@ def msd_viscoelastic_second_order(
 
 
 def viscoelastic_langevin_coefficients(
+    *,
     n: float,
     radius: float,
     volume: float,
@@ -958,7 +972,14 @@ def viscoelastic_langevin_coefficients(
     ``viscoelastic_diffusion`` (Bodrova et al., PCCP 17, 21791 (2015))."""
     density = n / volume
     d0 = float(diffusion_d0(density, radius, 1.0, temperature0, mass, dim))
-    tau0 = viscoelastic_tau0(a_kappa, density, radius, temperature0, mass, dim)
+    tau0 = viscoelastic_tau0(
+        a_kappa=a_kappa,
+        density=density,
+        radius=radius,
+        temperature0=temperature0,
+        mass=mass,
+        dim=dim,
+    )
     return LangevinCoefficients(temperature0 / (mass * d0), d0, tau0)
 
 
@@ -1016,6 +1037,7 @@ def _powerlaw_ode(gamma0, tau0, exponent, v0_sq_reduced, t_max_reduced):
 
 def powerlaw_udsbm_moments(
     t: FloatOrArray,
+    *,
     D0: float,
     gamma0: float,
     tau0: float,
@@ -1055,6 +1077,7 @@ def powerlaw_udsbm_moments(
 
 def msd_powerlaw_udsbm(
     t: FloatOrArray,
+    *,
     D0: float,
     gamma0: float,
     tau0: float,
@@ -1065,12 +1088,14 @@ def msd_powerlaw_udsbm(
     """Ensemble MSD of UDSBM with power-law coefficients, total over ``dim``:
     ``dim <x^2>`` of ``powerlaw_udsbm_moments`` (see there).  Late times, for a < 1:
     ``msd_powerlaw_udsbm_asymptote``."""
-    xx, _, _ = powerlaw_udsbm_moments(t, D0, gamma0, tau0, exponent, v0_sq)
+    xx, _, _ = powerlaw_udsbm_moments(
+        t, D0=D0, gamma0=gamma0, tau0=tau0, exponent=exponent, v0_sq=v0_sq
+    )
     return dim * np.asarray(xx) if np.ndim(xx) else dim * xx
 
 
 def msd_powerlaw_udsbm_asymptote(
-    t: FloatOrArray, D0: float, tau0: float, exponent: float, dim: int = 3
+    t: FloatOrArray, *, D0: float, tau0: float, exponent: float, dim: int = 3
 ) -> FloatOrArray:
     """Overdamped limit of the power-law UDSBM MSD for a < 1, total over ``dim``:
     ``2 d int_0^t D = 2 d D0 tau0 ((1 + t/tau0)^(1-a) - 1) / (1 - a)``, ~ t^(1-a) (t^(1/6)
@@ -1211,6 +1236,7 @@ def _covariance_on_grid(times, sol, D0, gamma0, tau0, exponent, block=512):
 
 def powerlaw_udsbm_increment_msd(
     lag: FloatOrArray,
+    *,
     start: FloatOrArray,
     D0: float,
     gamma0: float,
@@ -1245,6 +1271,7 @@ def powerlaw_udsbm_increment_msd(
 
 def udsbm_ergodicity_breaking(
     lag: float,
+    *,
     starts: ArrayLike,
     D0: float,
     gamma0: float,

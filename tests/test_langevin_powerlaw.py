@@ -137,7 +137,9 @@ def test_exact_scheme_msd_matches_theory(exponent):
     ok = r.times > 0
     np.testing.assert_array_less(np.abs(r.msd()[ok] / th[ok] - 1), 5 * rel_se_msd(n) + 1e-5)
     # the temperature: <v^2>(t) of the same moments, same tolerance
-    _, _, vv = theory.powerlaw_udsbm_moments(r.times, D0, G0, TAU0, exponent, v0_sq=r.v0_sq)
+    _, _, vv = theory.powerlaw_udsbm_moments(
+        r.times, D0=D0, gamma0=G0, tau0=TAU0, exponent=exponent, v0_sq=r.v0_sq
+    )
     np.testing.assert_array_less(np.abs(r.v2 / (3 * vv) - 1), 5 * rel_se_msd(n) + 1e-5)
 
 
@@ -173,7 +175,7 @@ def test_scheme_errors_without_noise():
     10-fold (8 to 12).  At dt = 0.01 the exact scheme is within 1e-5 relative (measured
     9e-7; docs/powerlaw_udsbm.md)."""
     t = 5.0
-    th_xx, _, _ = theory.powerlaw_udsbm_moments(t, D0, G0, TAU0, VISCO)
+    th_xx, _, _ = theory.powerlaw_udsbm_moments(t, D0=D0, gamma0=G0, tau0=TAU0, exponent=VISCO)
     err = {}
     for scheme in ("em", "exact"):
         for dt in (0.05, 0.005):
@@ -235,7 +237,9 @@ def test_tamsd_and_ergodicity_breaking_match_theory(exponent):
     se = np.sqrt((m4 - sd**4) / (n * mean**4) + 4 * eb**2 * sd**2 / (n * mean**2))
     eb_th = r.theory_ergodicity_breaking(eb_lags)
     np.testing.assert_array_less(np.abs(eb - eb_th), 5 * se)
-    msd_at_lag = theory.msd_powerlaw_udsbm(r.tamsd_lags[1:], D0, G0, TAU0, exponent, v0_sq=r.v0_sq)
+    msd_at_lag = theory.msd_powerlaw_udsbm(
+        r.tamsd_lags[1:], D0=D0, gamma0=G0, tau0=TAU0, exponent=exponent, v0_sq=r.v0_sq
+    )
     assert np.all(msd_at_lag - mean > 10 * sd / math.sqrt(n))
 
 
@@ -270,14 +274,16 @@ def test_core_refuses_a_bad_exponent():
 
 def test_theory_refuses_bad_input():
     with pytest.raises(ValueError, match="exponent must be positive"):
-        theory.msd_powerlaw_udsbm(1.0, D0, G0, TAU0, 0.0)
+        theory.msd_powerlaw_udsbm(1.0, D0=D0, gamma0=G0, tau0=TAU0, exponent=0.0)
     with pytest.raises(ValueError, match="exponent must be positive"):
-        theory.powerlaw_udsbm_increment_msd(1.0, 0.0, D0, G0, TAU0, -1.0)
+        theory.powerlaw_udsbm_increment_msd(
+            1.0, start=0.0, D0=D0, gamma0=G0, tau0=TAU0, exponent=-1.0
+        )
     with pytest.raises(ValueError, match="gamma0 must be positive"):
-        theory.msd_powerlaw_udsbm(1.0, D0, -G0, TAU0, VISCO)
+        theory.msd_powerlaw_udsbm(1.0, D0=D0, gamma0=-G0, tau0=TAU0, exponent=VISCO)
     with pytest.raises(ValueError, match="t must be finite"):
-        theory.msd_powerlaw_udsbm(-1.0, D0, G0, TAU0, VISCO)
+        theory.msd_powerlaw_udsbm(-1.0, D0=D0, gamma0=G0, tau0=TAU0, exponent=VISCO)
     with pytest.raises(ValueError, match="0 < exponent < 1"):
-        theory.msd_powerlaw_udsbm_asymptote(1.0, D0, TAU0, 1.0)
+        theory.msd_powerlaw_udsbm_asymptote(1.0, D0=D0, tau0=TAU0, exponent=1.0)
     with pytest.raises(ValueError, match="lag > 0"):
-        theory.udsbm_ergodicity_breaking(0.0, [0.0], D0, G0)
+        theory.udsbm_ergodicity_breaking(0.0, starts=[0.0], D0=D0, gamma0=G0)

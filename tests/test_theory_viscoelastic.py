@@ -27,7 +27,11 @@ def _ode_temperature(t, a_kappa, order, dim=3, radius=R):
 
     def rhs(_, y):
         T = math.exp(y[0])
-        return [-theory.viscoelastic_cooling_rate(T, a_kappa, N, radius, dim=dim, order=order)]
+        return [
+            -theory.viscoelastic_cooling_rate(
+                T, a_kappa=a_kappa, density=N, radius=radius, dim=dim, order=order
+            )
+        ]
 
     sol = solve_ivp(
         rhs, (0, t[-1]), [math.log(T0)], t_eval=t, method="LSODA", rtol=1e-12, atol=1e-13
@@ -41,10 +45,12 @@ def test_cooling_law_solves_its_ode(dim, radius):
     """T0 (1 + t/tau0')^(-5/3) with tau0' = 5/(3 zeta_1(T0)) against the ODE with the
     first-order rate, from t = 0 to 10^4 tau0' (T down by 6.7 decades): relative 1e-8 (the
     solver's rtol 1e-12 on ln T accumulated over ~10^3 steps)."""
-    tau = theory.viscoelastic_tau0(A_KAPPA, N, radius, T0, dim=dim)
+    tau = theory.viscoelastic_tau0(
+        a_kappa=A_KAPPA, density=N, radius=radius, temperature0=T0, dim=dim
+    )
     t = tau * np.logspace(-3, 4, 30)
     np.testing.assert_allclose(
-        theory.viscoelastic_temperature(t, T0, tau),
+        theory.viscoelastic_temperature(t, temperature0=T0, tau0=tau),
         _ode_temperature(t, A_KAPPA, 1, dim, radius),
         rtol=1e-8,
     )
@@ -57,22 +63,28 @@ def test_second_order_cooling_solves_its_ode():
     second term makes collisions more elastic), but not more slowly than the leading order
     with the smaller rate zeta_1 + zeta_2 at T0 (zeta >= that times (T/T0)^(3/5)): T / T_lead
     <= (zeta_1 / (zeta_1 + zeta_2))^(5/3) at T0 (12% at delta = 0.05)."""
-    tau = theory.viscoelastic_tau0(A_KAPPA, N, R, T0)
+    tau = theory.viscoelastic_tau0(a_kappa=A_KAPPA, density=N, radius=R, temperature0=T0)
     t = tau * np.logspace(-3, 4, 30)
-    second = theory.viscoelastic_temperature_second_order(t, T0, A_KAPPA, N, R)
+    second = theory.viscoelastic_temperature_second_order(
+        t, temperature0=T0, a_kappa=A_KAPPA, density=N, radius=R
+    )
     np.testing.assert_allclose(second, _ode_temperature(t, A_KAPPA, 2), rtol=1e-8)
-    lead = theory.viscoelastic_temperature(t, T0, tau)
+    lead = theory.viscoelastic_temperature(t, temperature0=T0, tau0=tau)
     assert np.all(second > lead)
-    z1 = theory.viscoelastic_cooling_rate(T0, A_KAPPA, N, R)
-    z12 = theory.viscoelastic_cooling_rate(T0, A_KAPPA, N, R, order=2)
+    z1 = theory.viscoelastic_cooling_rate(T0, a_kappa=A_KAPPA, density=N, radius=R)
+    z12 = theory.viscoelastic_cooling_rate(T0, a_kappa=A_KAPPA, density=N, radius=R, order=2)
     assert np.max(second / lead) < (z1 / z12) ** (5 / 3)
 
 
 def test_cooling_time_is_the_inverse():
-    tau = theory.viscoelastic_tau0(A_KAPPA, N, R, T0)
+    tau = theory.viscoelastic_tau0(a_kappa=A_KAPPA, density=N, radius=R, temperature0=T0)
     t = tau * np.array([0.0, 0.1, 3.0, 500.0])
-    T = theory.viscoelastic_temperature_second_order(t, T0, A_KAPPA, N, R)
-    back = theory.viscoelastic_cooling_time(T, T0, A_KAPPA, N, R)
+    T = theory.viscoelastic_temperature_second_order(
+        t, temperature0=T0, a_kappa=A_KAPPA, density=N, radius=R
+    )
+    back = theory.viscoelastic_cooling_time(
+        T, temperature0=T0, a_kappa=A_KAPPA, density=N, radius=R
+    )
     np.testing.assert_allclose(back, t, rtol=1e-9, atol=1e-12 * tau)
 
 
@@ -82,20 +94,34 @@ def test_limits_of_small_dissipation():
     delta/100 is 10 within 2%: the next order adds (c2/c1) delta, measured 6.7% at
     delta = 0.05, so 0.6% at delta/10); a_kappa = 0 is elastic (no
     cooling, tau0' = inf); the rate is zeta_1 ~ T^(3/5)."""
-    t1 = theory.viscoelastic_tau0(A_KAPPA, N, R, T0)
-    t2 = theory.viscoelastic_tau0(A_KAPPA / 10, N, R, T0)
+    t1 = theory.viscoelastic_tau0(a_kappa=A_KAPPA, density=N, radius=R, temperature0=T0)
+    t2 = theory.viscoelastic_tau0(a_kappa=A_KAPPA / 10, density=N, radius=R, temperature0=T0)
     assert t2 / t1 == pytest.approx(10, rel=1e-12)
 
     def correction(a_kappa):
-        tau = theory.viscoelastic_tau0(a_kappa, N, R, T0)
+        tau = theory.viscoelastic_tau0(a_kappa=a_kappa, density=N, radius=R, temperature0=T0)
         t = 3.0 * tau
-        lead = theory.viscoelastic_temperature(t, T0, tau)
-        return theory.viscoelastic_temperature_second_order(t, T0, a_kappa, N, R) / lead - 1
+        lead = theory.viscoelastic_temperature(t, temperature0=T0, tau0=tau)
+        return (
+            theory.viscoelastic_temperature_second_order(
+                t, temperature0=T0, a_kappa=a_kappa, density=N, radius=R
+            )
+            / lead
+            - 1
+        )
 
     assert correction(A_KAPPA / 10) / correction(A_KAPPA / 100) == pytest.approx(10, rel=0.02)
-    assert theory.viscoelastic_tau0(0.0, N, R, T0) == math.inf
-    assert theory.viscoelastic_temperature_second_order(5.0, T0, 0.0, N, R) == T0
-    z = [theory.viscoelastic_cooling_rate(T, A_KAPPA, N, R) for T in (1.0, 0.01)]
+    assert theory.viscoelastic_tau0(a_kappa=0.0, density=N, radius=R, temperature0=T0) == math.inf
+    assert (
+        theory.viscoelastic_temperature_second_order(
+            5.0, temperature0=T0, a_kappa=0.0, density=N, radius=R
+        )
+        == T0
+    )
+    z = [
+        theory.viscoelastic_cooling_rate(T, a_kappa=A_KAPPA, density=N, radius=R)
+        for T in (1.0, 0.01)
+    ]
     assert z[0] / z[1] == pytest.approx(100 ** (3 / 5), rel=1e-12)
 
 
@@ -113,7 +139,7 @@ def test_first_order_rate_is_the_constant_xi_rate_at_the_effective_restitution()
     one_minus_xi2 = 2 * theory.VISCOELASTIC_C1 * A_KAPPA * moment(2.2) / moment(2)
     xi = math.sqrt(1 - one_minus_xi2)
     haff = theory.haff_tau0(N, R, xi, T0)
-    zeta = theory.viscoelastic_cooling_rate(T0, A_KAPPA, N, R)
+    zeta = theory.viscoelastic_cooling_rate(T0, a_kappa=A_KAPPA, density=N, radius=R)
     assert zeta == pytest.approx(2 / haff, rel=1e-9)
 
 
@@ -125,16 +151,18 @@ def test_diffusion_and_msd():
     1.1% once x = 100, t = 10^12 tau0' (numerical derivative: 1e-6)."""
     D, tau = 0.3, 2.0
     for t in (0.5, 10.0, 1e4):
-        want = 2 * 3 * quad(lambda s: theory.viscoelastic_diffusion(s, D, tau), 0, t)[0]
-        assert theory.msd_viscoelastic(t, D, tau) == pytest.approx(want, rel=1e-10)
+        want = 2 * 3 * quad(lambda s: theory.viscoelastic_diffusion(s, D0=D, tau0=tau), 0, t)[0]
+        assert theory.msd_viscoelastic(t, D0=D, tau0=tau) == pytest.approx(want, rel=1e-10)
     t = np.array([1e2, 1e6, 1e12]) * tau
-    ratio = theory.msd_viscoelastic(t, D, tau) / theory.msd_viscoelastic_asymptote(t, D, tau)
+    ratio = theory.msd_viscoelastic(t, D0=D, tau0=tau) / theory.msd_viscoelastic_asymptote(
+        t, D0=D, tau0=tau
+    )
     np.testing.assert_allclose(ratio, (1 + tau / t) ** (1 / 6) - (tau / t) ** (1 / 6), rtol=1e-9)
     h = 1e-4
     lt = math.log(1e12 * tau)
     slope = (
-        math.log(theory.msd_viscoelastic(math.exp(lt + h), D, tau))
-        - math.log(theory.msd_viscoelastic(math.exp(lt - h), D, tau))
+        math.log(theory.msd_viscoelastic(math.exp(lt + h), D0=D, tau0=tau))
+        - math.log(theory.msd_viscoelastic(math.exp(lt - h), D0=D, tau0=tau))
     ) / (2 * h)
     x = (1 + 1e12) ** (1 / 6)
     assert slope == pytest.approx(x / (x - 1) / 6, rel=1e-6)
@@ -144,15 +172,17 @@ def test_diffusion_and_msd():
 def test_langevin_coefficients_of_the_viscoelastic_gas():
     """The power-law UDSBM with these coefficients and a = 5/6 has D gamma = T(t)/m of the
     cooling law and D(t) of viscoelastic_diffusion (identities of the parametrisation)."""
-    c = theory.viscoelastic_langevin_coefficients(N, R, 1.0, A_KAPPA, T0)
+    c = theory.viscoelastic_langevin_coefficients(
+        n=N, radius=R, volume=1.0, a_kappa=A_KAPPA, temperature0=T0
+    )
     assert c.gamma0 * c.D0 == pytest.approx(T0, rel=1e-14)
-    assert c.tau0 == theory.viscoelastic_tau0(A_KAPPA, N, R, T0)
+    assert c.tau0 == theory.viscoelastic_tau0(a_kappa=A_KAPPA, density=N, radius=R, temperature0=T0)
     assert c.D0 == theory.diffusion_d0(N, R, 1.0, T0)
     t = np.array([0.3, 30.0]) * c.tau0
     w = 1 + t / c.tau0
     np.testing.assert_allclose(
         c.gamma0 * w**-VISCO * c.D0 * w**-VISCO,
-        theory.viscoelastic_temperature(t, T0, c.tau0),
+        theory.viscoelastic_temperature(t, temperature0=T0, tau0=c.tau0),
         rtol=1e-14,
     )
 
@@ -168,16 +198,18 @@ def test_moments_at_exponent_one_are_the_thesis_closed_forms(v0_sq):
     v0 = theory.udsbm_v0_sq(D0, G0, TAU0) if v0_sq == "udsbm" else v0_sq
     v = D0 * G0 if v0 is None else v0
     t = np.array([1e-3, 0.1, 1.0, 10.0, 100.0])
-    got = theory.msd_powerlaw_udsbm(t, D0, G0, TAU0, 1.0, v0_sq=v)
+    got = theory.msd_powerlaw_udsbm(t, D0=D0, gamma0=G0, tau0=TAU0, exponent=1.0, v0_sq=v)
     np.testing.assert_allclose(got, theory.msd_udsbm(t, D0, G0, TAU0, v0_sq=v), rtol=1e-10)
     lag, start = np.array([0.01, 0.5, 3.0, 0.2]), np.array([0.0, 2.0, 20.0, 50.0])
     np.testing.assert_allclose(
-        theory.powerlaw_udsbm_increment_msd(lag, start, D0, G0, TAU0, 1.0, v0_sq=v),
+        theory.powerlaw_udsbm_increment_msd(
+            lag, start=start, D0=D0, gamma0=G0, tau0=TAU0, exponent=1.0, v0_sq=v
+        ),
         theory.udsbm_increment_msd(lag, start, D0, G0, TAU0, v0_sq=v),
         rtol=1e-8,  # the increment at lag 0.01 from t = 0 is a difference: 1e-10 / it
     )
     np.testing.assert_allclose(
-        theory.msd_powerlaw_udsbm(t, D0, G0, math.inf, 1.0, v0_sq=v),
+        theory.msd_powerlaw_udsbm(t, D0=D0, gamma0=G0, tau0=math.inf, exponent=1.0, v0_sq=v),
         theory.msd_langevin(t, D0, G0, v0_sq=v),
         rtol=1e-10,
     )
@@ -225,12 +257,14 @@ def test_msd_is_the_double_integral_of_the_velocity_autocorrelation():
     for t in (0.3, 4.0):
 
         def outer(t1, t=t):
-            _, _, vv = theory.powerlaw_udsbm_moments(t1, D0, G0, TAU0, a)
+            _, _, vv = theory.powerlaw_udsbm_moments(t1, D0=D0, gamma0=G0, tau0=TAU0, exponent=a)
             k = quad(lambda u: math.exp(-gamma_integral(t1, u)), t1, t, epsabs=0, epsrel=1e-12)[0]
             return vv * k
 
         want = 3 * 2 * quad(outer, 0, t, epsabs=0, epsrel=1e-11, limit=200)[0]
-        assert theory.msd_powerlaw_udsbm(t, D0, G0, TAU0, a) == pytest.approx(want, rel=1e-8)
+        assert theory.msd_powerlaw_udsbm(
+            t, D0=D0, gamma0=G0, tau0=TAU0, exponent=a
+        ) == pytest.approx(want, rel=1e-8)
 
 
 def test_late_msd_approaches_the_overdamped_power_law():
@@ -240,16 +274,16 @@ def test_late_msd_approaches_the_overdamped_power_law():
     from t = 10^4 to 10^6); the local exponent of dMSD/dt is -5/6 within that excess / 6
     + 1e-3; and MSD / the overdamped asymptote falls towards 1."""
     t = np.array([1e4, 1e5, 1e6])
-    _, xv, _ = theory.powerlaw_udsbm_moments(t, D0, G0, TAU0, VISCO)
+    _, xv, _ = theory.powerlaw_udsbm_moments(t, D0=D0, gamma0=G0, tau0=TAU0, exponent=VISCO)
     w = 1 + t / TAU0
     excess = xv / (D0 * w**-VISCO) - 1
     settled = excess * G0 * TAU0 * w ** (1 / 6)
     assert abs(settled[-1] / settled[0] - 1) < 0.05
     slope = np.log(xv[2] / xv[1]) / np.log(10)
     assert abs(slope + 5 / 6) < excess[1] / 6 + 1e-3
-    ratio = theory.msd_powerlaw_udsbm(t, D0, G0, TAU0, VISCO) / theory.msd_powerlaw_udsbm_asymptote(
-        t, D0, TAU0, VISCO
-    )
+    ratio = theory.msd_powerlaw_udsbm(
+        t, D0=D0, gamma0=G0, tau0=TAU0, exponent=VISCO
+    ) / theory.msd_powerlaw_udsbm_asymptote(t, D0=D0, tau0=TAU0, exponent=VISCO)
     assert np.all(np.diff(ratio) < 0) and np.all(ratio > 1)
 
 
@@ -261,7 +295,7 @@ def test_ergodicity_breaking_of_brownian_motion():
     continuous-time 4 lag / (3 d t_stop) (within 5%: windows every lag/10, lag/t = 1/50)."""
     lag, t_stop = 1.0, 50.0
     starts = np.arange(0, t_stop - lag + 1e-9, lag / 10)
-    eb = theory.udsbm_ergodicity_breaking(lag, starts, 1.0, 1e4, dim=2)
+    eb = theory.udsbm_ergodicity_breaking(lag, starts=starts, D0=1.0, gamma0=1e4, dim=2)
     overlap = np.maximum(lag - np.abs(starts[:, None] - starts[None, :]), 0)
     want = 2 * np.sum(overlap**2) / (2 * (len(starts) * lag) ** 2)
     assert eb == pytest.approx(want, rel=1e-3)
@@ -287,7 +321,9 @@ def test_ergodicity_breaking_matches_the_per_pair_reference(tau0, a):
         (0.05, np.arange(0.0, 5.0, 0.05)),
     ]
     for lag, starts in cases:
-        got = theory.udsbm_ergodicity_breaking(lag, starts, 1.3, 2.0, tau0, a, 2, v0_sq=0.7)
+        got = theory.udsbm_ergodicity_breaking(
+            lag, starts=starts, D0=1.3, gamma0=2.0, tau0=tau0, exponent=a, dim=2, v0_sq=0.7
+        )
         want = eb_reference.ergodicity_breaking(lag, starts, 1.3, 2.0, tau0, a, 2, v0_sq=0.7)
         assert got == pytest.approx(want, rel=1e-9), (lag, len(starts))
     # the covariance is built in blocks of rows and mirrored block by block: blocks of 7
@@ -308,7 +344,9 @@ def test_ergodicity_breaking_does_not_vanish_for_udsbm():
 
     def eb(tau0, a, t_stop):
         starts = np.arange(0, t_stop - lag + 1e-9, 0.25)
-        return theory.udsbm_ergodicity_breaking(lag, starts, D0, G0, tau0, a)
+        return theory.udsbm_ergodicity_breaking(
+            lag, starts=starts, D0=D0, gamma0=G0, tau0=tau0, exponent=a
+        )
 
     lang = eb(math.inf, 1.0, 40.0) / eb(math.inf, 1.0, 10.0)
     assert lang == pytest.approx(0.25, rel=0.15)
@@ -319,15 +357,74 @@ def test_ergodicity_breaking_does_not_vanish_for_udsbm():
 @pytest.mark.parametrize(
     "call,match",
     [
-        (lambda: theory.viscoelastic_tau0(-1.0, N, R, T0), "a_kappa"),
-        (lambda: theory.viscoelastic_tau0(math.nan, N, R, T0), "a_kappa"),
-        (lambda: theory.viscoelastic_delta(-0.1, T0), "a_kappa"),
-        (lambda: theory.viscoelastic_cooling_rate(T0, A_KAPPA, N, R, order=3), "order"),
-        (lambda: theory.viscoelastic_cooling_time(2 * T0, T0, A_KAPPA, N, R), r"\(0, T0\]"),
-        (lambda: theory.viscoelastic_cooling_time(0.5, T0, 5.0, N, R), "too large"),
-        (lambda: theory.viscoelastic_temperature_second_order(-1.0, T0, A_KAPPA, N, R), "t must"),
+        (
+            lambda: theory.viscoelastic_tau0(a_kappa=-1.0, density=N, radius=R, temperature0=T0),
+            "a_kappa",
+        ),
+        (
+            lambda: theory.viscoelastic_tau0(
+                a_kappa=math.nan, density=N, radius=R, temperature0=T0
+            ),
+            "a_kappa",
+        ),
+        (lambda: theory.viscoelastic_delta(T0, a_kappa=-0.1), "a_kappa"),
+        (
+            lambda: theory.viscoelastic_cooling_rate(
+                T0, a_kappa=A_KAPPA, density=N, radius=R, order=3
+            ),
+            "order",
+        ),
+        (
+            lambda: theory.viscoelastic_cooling_time(
+                2 * T0, temperature0=T0, a_kappa=A_KAPPA, density=N, radius=R
+            ),
+            r"\(0, T0\]",
+        ),
+        (
+            lambda: theory.viscoelastic_cooling_time(
+                0.5, temperature0=T0, a_kappa=5.0, density=N, radius=R
+            ),
+            "too large",
+        ),
+        (
+            lambda: theory.viscoelastic_temperature_second_order(
+                -1.0, temperature0=T0, a_kappa=A_KAPPA, density=N, radius=R
+            ),
+            "t must",
+        ),
     ],
 )
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+# Each function with the positional arguments of its earlier (unreleased) order, or of
+# haff_tau0's: a swapped a_kappa and density, or radius and volume, must not give a number.
+POSITIONAL_CALLS = [
+    ("viscoelastic_delta", (A_KAPPA, T0)),
+    ("viscoelastic_cooling_rate", (T0, A_KAPPA, N, R)),
+    ("viscoelastic_tau0", (A_KAPPA, N, R, T0)),
+    ("viscoelastic_tau0", (N, R, A_KAPPA, T0)),  # haff_tau0's order with a_kappa for xi
+    ("viscoelastic_temperature", (1.0, T0, TAU0)),
+    ("viscoelastic_cooling_time", (0.5, T0, A_KAPPA, N, R)),
+    ("viscoelastic_temperature_second_order", (1.0, T0, A_KAPPA, N, R)),
+    ("viscoelastic_diffusion", (1.0, D0, TAU0)),
+    ("msd_viscoelastic", (1.0, D0, TAU0)),
+    ("msd_viscoelastic_asymptote", (1.0, D0, TAU0)),
+    ("msd_viscoelastic_second_order", (1.0, T0, A_KAPPA, N, R)),
+    ("viscoelastic_langevin_coefficients", (N, R, 1.0, A_KAPPA, T0)),
+    ("powerlaw_udsbm_moments", (1.0, D0, G0, TAU0, VISCO)),
+    ("msd_powerlaw_udsbm", (1.0, D0, G0, TAU0, VISCO)),
+    ("msd_powerlaw_udsbm_asymptote", (1.0, D0, TAU0, VISCO)),
+    ("powerlaw_udsbm_increment_msd", (1.0, 0.0, D0, G0, TAU0, VISCO)),
+    ("udsbm_ergodicity_breaking", (1.0, [0.0], D0, G0)),
+]
+
+
+@pytest.mark.parametrize("name,args", POSITIONAL_CALLS, ids=[c[0] for c in POSITIONAL_CALLS])
+def test_parameters_are_keyword_only(name, args):
+    """The material and model parameters are keyword-only (at most t, T or the lag is
+    positional), so a swap cannot pass silently: the positional call is a TypeError."""
+    with pytest.raises(TypeError, match="positional argument"):
+        getattr(theory, name)(*args)

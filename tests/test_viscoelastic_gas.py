@@ -42,16 +42,25 @@ def test_law_and_theory_share_a_kappa():
         1 - theory.VISCOELASTIC_C1 * d + theory.VISCOELASTIC_C2 * d * d, rel=1e-15
     )
     T = 0.5
-    assert theory.viscoelastic_delta(law, T) == theory.viscoelastic_delta(law.a_kappa, T)
-    assert theory.viscoelastic_delta(law, T) == pytest.approx(law.a_kappa * (4 * T) ** 0.1)
-    for f in (theory.viscoelastic_tau0, theory.viscoelastic_langevin_coefficients):
-        args = (N, R, N / DENSITY) if f is theory.viscoelastic_langevin_coefficients else ()
-        if args:
-            assert f(*args, law, T) == f(*args, law.a_kappa, T)
-        else:
-            assert f(law, DENSITY, R, T) == f(law.a_kappa, DENSITY, R, T)
+    assert theory.viscoelastic_delta(T, a_kappa=law) == theory.viscoelastic_delta(
+        T, a_kappa=law.a_kappa
+    )
+    assert theory.viscoelastic_delta(T, a_kappa=law) == pytest.approx(law.a_kappa * (4 * T) ** 0.1)
+    box = dict(n=N, radius=R, volume=N / DENSITY, temperature0=T)
+    assert theory.viscoelastic_langevin_coefficients(
+        a_kappa=law, **box
+    ) == theory.viscoelastic_langevin_coefficients(a_kappa=law.a_kappa, **box)
+    gas = dict(density=DENSITY, radius=R, temperature0=T)
+    assert theory.viscoelastic_tau0(a_kappa=law, **gas) == theory.viscoelastic_tau0(
+        a_kappa=law.a_kappa, **gas
+    )
     with pytest.raises(TypeError, match="Viscoelastic"):
-        theory.viscoelastic_tau0(TabulatedRestitution([0, 1], [1, 0.9]), DENSITY, R, T)
+        theory.viscoelastic_tau0(
+            a_kappa=TabulatedRestitution([0, 1], [1, 0.9]),
+            density=DENSITY,
+            radius=R,
+            temperature0=T,
+        )
 
 
 def test_from_scene_gives_the_powerlaw_udsbm_of_a_viscoelastic_scene():
@@ -61,9 +70,11 @@ def test_from_scene_gives_the_powerlaw_udsbm_of_a_viscoelastic_scene():
     scene = Scene.random(N, R, box=(np.zeros(3), np.full(3, 0.63)), restitution=law, seed=1)
     c = langevin.coefficients_from_scene(scene)
     assert c == theory.viscoelastic_langevin_coefficients(
-        N, R, scene.volume, law.a_kappa, scene.temperature
+        n=N, radius=R, volume=scene.volume, a_kappa=law.a_kappa, temperature0=scene.temperature
     )
-    assert c.tau0 == theory.viscoelastic_tau0(law, N / scene.volume, R, scene.temperature)
+    assert c.tau0 == theory.viscoelastic_tau0(
+        a_kappa=law, density=N / scene.volume, radius=R, temperature0=scene.temperature
+    )
     res = langevin.from_scene(scene, dt=0.01, t_stop=1.0, n=50, seed=1)
     assert res.exponent == pytest.approx(5 / 6) and res.tau0 == c.tau0
     assert res.model == "udsbm"
@@ -89,7 +100,9 @@ def cooling_runs():
     sim.run(stop_when={"collisions_per_particle": 20}, store=())
     eq = sim.scene
     law = Viscoelastic(DELTA0 / (4 * eq.temperature) ** 0.1, 1.0)
-    tau = theory.viscoelastic_tau0(law, DENSITY, R, eq.temperature, eta=eq.packing_fraction)
+    tau = theory.viscoelastic_tau0(
+        a_kappa=law, density=DENSITY, radius=R, temperature0=eq.temperature, eta=eq.packing_fraction
+    )
     times = np.concatenate([[0.0], np.geomspace(0.1 * tau, 1000 * tau, 25)])
     rng = np.random.default_rng(15)
     temps, msds, clamped, collisions = [], [], 0, 0
@@ -133,7 +146,12 @@ def test_viscoelastic_gas_cools_as_the_second_order_theory(cooling_runs):
     mean = r["T"].mean(axis=0)
     err = r["T"].std(axis=0, ddof=1) / math.sqrt(len(r["T"]))
     second = theory.viscoelastic_temperature_second_order(
-        times, eq.temperature, r["law"], DENSITY, R, eta=eq.packing_fraction
+        times,
+        temperature0=eq.temperature,
+        a_kappa=r["law"],
+        density=DENSITY,
+        radius=R,
+        eta=eq.packing_fraction,
     )
     tol = _student(len(r["T"])) * err + 0.02 * second
     bad = np.flatnonzero(np.abs(mean - second) > tol)
@@ -158,10 +176,15 @@ def test_viscoelastic_gas_cooling_exponent_approaches_minus_five_thirds(cooling_
 
     per_run = [slope(T) for T in r["T"]]
     mean, err = np.mean(per_run), np.std(per_run, ddof=1) / math.sqrt(len(per_run))
-    lead = slope(theory.viscoelastic_temperature(times, eq.temperature, tau))
+    lead = slope(theory.viscoelastic_temperature(times, temperature0=eq.temperature, tau0=tau))
     second = slope(
         theory.viscoelastic_temperature_second_order(
-            times, eq.temperature, r["law"], DENSITY, R, eta=eq.packing_fraction
+            times,
+            temperature0=eq.temperature,
+            a_kappa=r["law"],
+            density=DENSITY,
+            radius=R,
+            eta=eq.packing_fraction,
         )
     )
     assert lead == pytest.approx(-5 / 3, rel=3e-3)
@@ -186,7 +209,12 @@ def test_viscoelastic_gas_msd_follows_the_second_order_theory(cooling_runs):
     mean = r["msd"].mean(axis=0)[w]
     err = r["msd"].std(axis=0, ddof=1)[w] / math.sqrt(len(r["msd"]))
     theory_msd = theory.msd_viscoelastic_second_order(
-        times[w], eq.temperature, r["law"], DENSITY, R, eta=eq.packing_fraction
+        times[w],
+        temperature0=eq.temperature,
+        a_kappa=r["law"],
+        density=DENSITY,
+        radius=R,
+        eta=eq.packing_fraction,
     )
     eps_eff = 1 - theory.VISCOELASTIC_C1 * math.gamma(2.1) * DELTA0
     tol = _student(len(r["msd"])) * err + diffusion_margin(eps_eff) * theory_msd
@@ -199,14 +227,16 @@ def test_msd_second_order_limits():
     within O(delta) of the leading order msd_viscoelastic."""
     t = np.geomspace(0.01, 100.0, 9)
     d_e = theory.diffusion_d0(DENSITY, R, 1.0, 0.5)
-    elastic = theory.msd_viscoelastic_second_order(t, 0.5, 0.0, DENSITY, R)
+    elastic = theory.msd_viscoelastic_second_order(
+        t, temperature0=0.5, a_kappa=0.0, density=DENSITY, radius=R
+    )
     assert elastic == pytest.approx(6 * d_e * t, rel=1e-12)
     law = Viscoelastic(1e-3, 1.0)  # delta(T0) = 1.1e-3
-    tau = theory.viscoelastic_tau0(law, DENSITY, R, 0.5)
+    tau = theory.viscoelastic_tau0(a_kappa=law, density=DENSITY, radius=R, temperature0=0.5)
     ts = np.geomspace(0.1, 100.0, 5) * tau
-    ratio = theory.msd_viscoelastic_second_order(ts, 0.5, law, DENSITY, R) / (
-        theory.msd_viscoelastic(ts, d_e, tau)
-    )
+    ratio = theory.msd_viscoelastic_second_order(
+        ts, temperature0=0.5, a_kappa=law, density=DENSITY, radius=R
+    ) / (theory.msd_viscoelastic(ts, D0=d_e, tau0=tau))
     # first-order corrections: some delta(T0) (x 1.34 in the rate, 0.6 C1 in D) and the
     # quadrature's 1e-4
     assert np.all(np.abs(ratio - 1) < 5 * 1.1e-3 + 1e-4), ratio

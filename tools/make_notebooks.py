@@ -241,8 +241,10 @@ eq = sim.scene
 T0 = eq.temperature
 law = granular.Viscoelastic.from_restitution(0.9, speed=math.sqrt(4 * T0))
 a_kappa = law.a_kappa  # A kappa^(2/5), the number theory takes
-c = theory.viscoelastic_langevin_coefficients(n, r, eq.volume, a_kappa, T0)
-print(f"delta(T0) = {theory.viscoelastic_delta(a_kappa, T0):.3f}, tau0' = {c.tau0:.3f}")
+c = theory.viscoelastic_langevin_coefficients(
+    n=n, radius=r, volume=eq.volume, a_kappa=a_kappa, temperature0=T0
+)
+print(f"delta(T0) = {theory.viscoelastic_delta(T0, a_kappa=a_kappa):.3f}, tau0' = {c.tau0:.3f}")
 t_stop = (1000 if not QUICK else 100) * c.tau0
 times = np.concatenate([[0], np.logspace(-2, np.log10(t_stop), 40)])
 visco_sim = granular.Simulation(eq.replace(restitution=law))
@@ -259,8 +261,11 @@ print("collisions past the series' range:", visco_sim.stats["law_clamped_collisi
 t = traj.times[1:]
 T = traj.temperature[1:]
 axes[0].loglog(t, T, "o", ms=3, label="EDMD")
-axes[0].loglog(t, theory.viscoelastic_temperature(t, T0, c.tau0), label="leading order")
-second = theory.viscoelastic_temperature_second_order(t, T0, a_kappa, eq.density, r)
+T1 = theory.viscoelastic_temperature(t, temperature0=T0, tau0=c.tau0)
+axes[0].loglog(t, T1, label="leading order")
+second = theory.viscoelastic_temperature_second_order(
+    t, temperature0=T0, a_kappa=a_kappa, density=eq.density, radius=r
+)
 axes[0].loglog(t, second, "--", label="with the next term")
 axes[0].set(xlabel="t", ylabel="T", title="viscoelastic cooling")
 axes[0].legend()
@@ -292,14 +297,15 @@ axes[1].legend();""",
 )
 ax = plot.msd(traj.times, traj.msd(), label="EDMD")
 ax.plot(u.times[1:], u.msd()[1:], label="UDSBM, a = 5/6")
-ax.plot(t, theory.msd_viscoelastic(t, c.D0, c.tau0), "--", label="theory, 2 d int D")
-ax.plot(t, theory.msd_viscoelastic_asymptote(t, c.D0, c.tau0), ":", label="t^(1/6) asymptote")
+ax.plot(t, theory.msd_viscoelastic(t, D0=c.D0, tau0=c.tau0), "--", label="theory, 2 d int D")
+asymptote = theory.msd_viscoelastic_asymptote(t, D0=c.D0, tau0=c.tau0)
+ax.plot(t, asymptote, ":", label="t^(1/6) asymptote")
 ax.legend()
 late = traj.times > 10 * c.tau0
 tl = traj.times[late]
 slope = np.polyfit(np.log(tl), np.log(traj.msd()[late]), 1)[0]
 slope_u = np.polyfit(np.log(tl), np.log(np.interp(tl, u.times, u.msd())), 1)[0]
-slope_th = np.polyfit(np.log(tl), np.log(theory.msd_viscoelastic(tl, c.D0, c.tau0)), 1)[0]
+slope_th = np.polyfit(np.log(tl), np.log(theory.msd_viscoelastic(tl, D0=c.D0, tau0=c.tau0)), 1)[0]
 print(f"d ln MSD / d ln t over t in [{tl[0]:.3g}, {tl[-1]:.3g}]:")
 print(f"EDMD {slope:.3f}, UDSBM {slope_u:.3f}, theory {slope_th:.3f}", "(1/6 only as t -> inf)")""",
     (

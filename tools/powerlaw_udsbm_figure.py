@@ -49,19 +49,21 @@ def main():
     t = np.geomspace(1, 1e6, 50)
     ax_msd.loglog(
         t,
-        theory.msd_powerlaw_udsbm_asymptote(t, D0, TAU0, 5 / 6),
+        theory.msd_powerlaw_udsbm_asymptote(t, D0=D0, tau0=TAU0, exponent=5 / 6),
         "k--",
         lw=1,
         label="a = 5/6 overdamped: ~ t^(1/6)",
     )
-    ax_msd.loglog(t, theory.msd_powerlaw_udsbm(t, D0, G0, TAU0, 5 / 6), "C3-", lw=0.8)
+    ax_msd.loglog(
+        t, theory.msd_powerlaw_udsbm(t, D0=D0, gamma0=G0, tau0=TAU0, exponent=5 / 6), "C3-", lw=0.8
+    )
     ax_msd.set(xlabel="t", ylabel="MSD (3D)", title="ensemble MSD, N = 2000, dt = 0.01")
     ax_msd.legend(fontsize=8)
     ax_tamsd.set(xlabel="lag", ylabel="TAMSD (3D)", title=f"time-averaged MSD over t = {t_stop:g}")
     ax_tamsd.legend(fontsize=7, ncol=2)
 
     t_end = 5.0
-    xx, _, _ = theory.powerlaw_udsbm_moments(t_end, D0, G0, TAU0, 5 / 6)
+    xx, _, _ = theory.powerlaw_udsbm_moments(t_end, D0=D0, gamma0=G0, tau0=TAU0, exponent=5 / 6)
     dts = np.array([0.1, 0.05, 0.02, 0.01, 0.005, 0.002])
     for scheme, marker in (("exact", "o-"), ("em", "s-")):
         err = [

@@ -127,11 +127,11 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
         scene, runs, seed=15, t_stop=times[-1], sample_times=times,
         quantities=("temperature", "msd"),
     )  # fmt: skip
-    args = (T0, law, DENSITY, RADIUS)
-    T2 = theory.viscoelastic_temperature_second_order(times, *args, eta=eta)
-    T1 = theory.viscoelastic_temperature(times, T0, tau)
-    m2 = theory.msd_viscoelastic_second_order(times, *args, eta=eta)
-    m1 = theory.msd_viscoelastic(times, c.D0, tau)
+    gas = dict(temperature0=T0, a_kappa=law, density=DENSITY, radius=RADIUS, eta=eta)
+    T2 = theory.viscoelastic_temperature_second_order(times, **gas)
+    T1 = theory.viscoelastic_temperature(times, temperature0=T0, tau0=tau)
+    m2 = theory.msd_viscoelastic_second_order(times, **gas)
+    m1 = theory.msd_viscoelastic(times, D0=c.D0, tau0=tau)
     names, rows = [], []
 
     # the box against the critical size at the gas' most inelastic moment, its start
@@ -185,7 +185,9 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
     ut = ures.times
     n_u = ures.runs[0]["final_positions"].shape[0]
     u_slopes = [_slope(ut, r["msd"], u_window) for r in ures.runs]
-    u_th = theory.msd_powerlaw_udsbm(ut, c.D0, c.gamma0, tau, langevin.VISCOELASTIC_EXPONENT)
+    u_th = theory.msd_powerlaw_udsbm(
+        ut, D0=c.D0, gamma0=c.gamma0, tau0=tau, exponent=langevin.VISCOELASTIC_EXPONENT
+    )
     rows.append(
         mean_row(
             "visco.udsbm.msd.exponent",
@@ -245,7 +247,7 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax.plot(s, m2[1:], "-", color="C1", label="msd_viscoelastic_second_order")
     ax.plot(s, m1[1:], "--", color="C2", label="msd_viscoelastic (leading order)")
     ax.plot(
-        s, theory.msd_viscoelastic_asymptote(times[1:], c.D0, tau), ":", color="0.4",
+        s, theory.msd_viscoelastic_asymptote(times[1:], D0=c.D0, tau0=tau), ":", color="0.4",
         label=r"asymptote $\propto t^{1/6}$",
     )  # fmt: skip
     um = ures.mean["msd"]

@@ -209,10 +209,12 @@ def viscoelastic_points(quick=False):
     t_fit = t_max / 10
     times = _times(t_max)
     law = Viscoelastic.from_restitution(VISCO_EPS, math.sqrt(4 * T0))
-    c = theory.viscoelastic_langevin_coefficients(1000, R, 1.0, law.a_kappa, T0)
+    c = theory.viscoelastic_langevin_coefficients(
+        n=1000, radius=R, volume=1.0, a_kappa=law.a_kappa, temperature0=T0
+    )
     ref_runs = 64 if not quick else 4
     ref, ref_cost = _edmd_msd(1000, law, ref_runs, times, seed=99)
-    th = theory.msd_viscoelastic(times, c.D0, c.tau0)
+    th = theory.msd_viscoelastic(times, D0=c.D0, tau0=c.tau0)
     slope_ref, slope_th = _loglog_slope(times, ref, t_fit), _loglog_slope(times, th, t_fit)
     ref_info = dict(
         times=times.tolist(),
@@ -230,7 +232,7 @@ def viscoelastic_points(quick=False):
     def add(method, label, msd, seconds, at=times, **extra):
         ok = at > 0
         e_ref = float(np.max(np.abs(msd[ok] / _loglog_interp(at[ok], times, ref) - 1)))
-        th_at = theory.msd_viscoelastic(at[ok], c.D0, c.tau0)
+        th_at = theory.msd_viscoelastic(at[ok], D0=c.D0, tau0=c.tau0)
         slope = _loglog_slope(at, msd, t_fit)
         points.append(
             dict(
