@@ -103,10 +103,16 @@ REPRODUCE_MARGINS = {
     "sde.": _euler_maruyama_margin(),
     "ergodicity.": _euler_maruyama_margin(),
     # viscoelastic exponents against the same late-window fit of the second-order expressions
-    # (reproduce_visco): what they neglect (O(delta^2), the Sonine a2, velocity correlations
-    # beyond Enskog's) is bounded by the size of the first-order correction itself in the
-    # quick window, second-order against leading-order fit: 1.0% for T, 4-5% for the MSD
-    "visco.haff.exponent": 0.01,
+    # (reproduce_visco).  Cooling: what the second order neglects (O(delta^2), the Sonine
+    # a2, velocity correlations beyond Enskog's) measured 0.10 +- 0.11% in the full
+    # reproduction (40 runs to 1e4 tau0') and 0.18 +- 0.13% in the quick one: margin 0.3%,
+    # a third of the 1.05% between the second and the leading order there, so that with the
+    # quick run's ~0.13% standard error (60 runs) the tolerance, ~0.8%, excludes the leading
+    # order.  MSD: the two orders are 4% apart in the quick window, the second order's own
+    # miss 1.3 +- 1.3% there and 4.2 +- 1.9% in the full reproduction (velocity correlations
+    # beyond Enskog's D); margin 5%, so this row checks the second order to what it leaves
+    # out but cannot tell it from the leading one: the full reproduction's row can (2 SE)
+    "visco.haff.exponent": 0.003,
     "visco.msd.exponent": 0.05,
     # the exact scheme freezes gamma and D at each step's midpoint, an error second order in
     # dt: 2.2e-5 relative in <x^2> at dt = 0.05 for a = 5/6 (docs/powerlaw_udsbm.md), ours is
