@@ -235,6 +235,21 @@ int gr_edmd_save(const gr_edmd *s, unsigned char *buf, size_t size)
 
 /* ---- restoring ---- */
 
+/* Whether an engine with n particles in list mode could have grown its rows to cap
+ * entries (nlist.c): from GR_NL_CAP_START by doublings, up to GR_NL_CAP_MAX, each one
+ * made when a row of cap / 2 entries needed one more -- and a row lists each other
+ * particle at most once (the box is more than twice the lists' reach wide, build.c), so
+ * cap / 2 < n - 1.  The rows are n * cap int32 allocated before anything else is read:
+ * no more than the engine itself could have allocated. */
+static int cap_reachable(int32_t cap, int dim, int64_t n)
+{
+    const int32_t start = GR_NL_CAP_START(dim);
+    if (cap < start || cap > GR_NL_CAP_MAX || cap % start != 0) return 0;
+    const int32_t doublings = cap / start;
+    if ((doublings & (doublings - 1)) != 0) return 0;
+    return cap == start || cap / 2 < n - 1;
+}
+
 /* The arrays a restore replaces (the rest of the engine stays). */
 static void free_state(gr_edmd *t)
 {
@@ -433,10 +448,11 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
              h.nb != want.nb || h.ncells != want.ncells || memcmp(h.nc, want.nc, sizeof h.nc) != 0 ||
              h.big_n != want.big_n)
         what = "made for another scene or other engine knobs (sizes differ)";
-    else if (h.lists && !(h.cap >= want.cap && h.cap <= GR_NL_CAP_MAX))
-        what = "its neighbour-list capacity is out of range";
+    else if (h.lists && !(h.cap >= want.cap && cap_reachable(h.cap, h.dim, h.n)))
+        what = "its neighbour-list capacity (header field cap) is out of range: not a "
+               "doubling of the start, or more than twice the particles the lists can hold";
     else if (!h.lists && h.cap != want.cap)
-        what = "its neighbour-list capacity is out of range";
+        what = "its neighbour-list capacity (header field cap) is out of range";
     if (what) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, what);
         return GR_ERR_VALUE;

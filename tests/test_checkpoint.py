@@ -357,6 +357,58 @@ def test_an_engine_state_for_another_scene_is_refused(saved):
             Simulation(scene, **knobs)._engine.restore_state(state)
 
 
+def _rewrite_state(data, edit):
+    """The checkpoint bytes with the engine state passed through edit(bytearray) and its
+    checksum made to match, as a file crafted past the checksum would be."""
+    with np.load(__import__("io").BytesIO(data)) as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    state = bytearray(arrays["engine_state"].tobytes())
+    edit(state)
+    arrays["engine_state"] = np.frombuffer(bytes(state), dtype=np.uint8)
+    meta = json.loads(str(arrays["meta"][()]))
+    meta["engine_state_sha256"] = __import__("hashlib").sha256(bytes(state)).hexdigest()
+    arrays["meta"] = np.array(json.dumps(meta))
+    buf = __import__("io").BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+# the neighbour-list capacity in the engine state's header (csrc/checkpoint.c, `header`):
+# magic 8, version 4, byte order 4, layout 8, total 8, n 8, dim, stride, lists, nb,
+# ncells 4 each, nc 3 x 4, then cap (int32)
+CAP_AT = 72
+
+
+def test_a_neighbour_list_capacity_the_engine_could_not_reach_is_refused(tmp_path):
+    """The rows (n x cap int32) are allocated from the header's cap before the rest is
+    read: only a capacity the engine itself could have grown to is accepted -- 32 (3D)
+    doubled while a row of cap / 2 could overflow, which with n = 60 particles (59 others
+    to list) is 32 or 64 -- not 128, not the largest list the engine allows (16384), not
+    one that is no doubling (48)."""
+    sim = Simulation(Scene.random(60, 0.1, dim=3, seed=3), shell=0.25)
+    sim.run(stop_when={"events": 300})
+    assert sim.stats["shell"] > 0
+    data = ck.dumps(sim)
+    _, arrays = ck._read_npz(data, "x")
+    assert int(np.frombuffer(arrays["engine_state"], np.int32, 1, CAP_AT)[0]) == 32
+
+    def with_cap(cap):
+        def edit(state):
+            state[CAP_AT : CAP_AT + 4] = np.int32(cap).tobytes()
+
+        return _rewrite_state(data, edit)
+
+    path = tmp_path / "cap.npz"
+    path.write_bytes(with_cap(64))  # reachable: loads, and runs on as the original
+    loaded = Simulation.load(path)
+    more = {"events": 600}
+    _assert_same_trajectory(sim.run(stop_when=more), loaded.run(stop_when=more))
+    for cap in (128, 16384, 48, 2**31 - 1):
+        path.write_bytes(with_cap(cap))
+        with pytest.raises(CheckpointError, match=r"neighbour-list capacity \(header field cap\)"):
+            Simulation.load(path)
+
+
 def test_corrupted_engine_states_never_crash_the_core():
     """Thousands of corrupted engine states (truncated, bytes flipped, words overwritten
     with indices just out of range, NaN and inf), fed straight to the C restore past the
