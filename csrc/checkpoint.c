@@ -327,6 +327,28 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         return "its box, restitution, contact duration or engine knobs differ from the scene's";
     if (t->nl.broken != 0 && t->nl.broken != 1) return "its neighbour-list flag is corrupt";
 
+    /* counters: each starts at 0 and grows by one at a time (order.next: events plus a
+     * multiple of n), so a negative one is corrupt, and one past INT64_MAX / 2 (2^62
+     * events: centuries at 1e9 a second) is one the next increments could overflow */
+#define GR_COUNTER(x) {"its counter " #x " is negative or past INT64_MAX / 2", t->x}
+    const struct {
+        const char *why;
+        int64_t value;
+    } counters[] = {
+        GR_COUNTER(events),      GR_COUNTER(pair),       GR_COUNTER(wall),
+        GR_COUNTER(invalid),     GR_COUNTER(elastic_tc), GR_COUNTER(law_clamped),
+        GR_COUNTER(crossings),   GR_COUNTER(shell_exits), GR_COUNTER(same_instant),
+        GR_COUNTER(order.next),
+    };
+#undef GR_COUNTER
+    for (size_t k = 0; k < sizeof counters / sizeof counters[0]; k++)
+        if (counters[k].value < 0 || counters[k].value > INT64_MAX / 2) return counters[k].why;
+    for (int32_t i = 0; i < n; i++)
+        if (t->sched[i].count < 0 || t->sched[i].count > INT64_MAX / 2 || t->sched[i].pcount < 0 ||
+            t->sched[i].pcount > INT64_MAX / 2)
+            return "a particle's collision counter (count or pcount) is negative or past "
+                   "INT64_MAX / 2";
+
     /* the renumbering is a permutation; through it each particle has the radius, mass
      * and bigness the scene gives it (skel: the scene's index -> s's internal index) */
     for (int32_t i = 0; i < n; i++) {

@@ -409,6 +409,65 @@ def test_a_neighbour_list_capacity_the_engine_could_not_reach_is_refused(tmp_pat
             Simulation.load(path)
 
 
+# the counters the engine state holds, in order, from `events` on (csrc/checkpoint.c)
+COUNTERS = ("events", "pair", "wall", "invalid", "elastic_tc", "law_clamped")
+
+
+@pytest.mark.parametrize("name", COUNTERS)
+def test_negative_or_overflowing_counters_are_refused(saved, name, tmp_path):
+    """Counters start at 0 and grow by one: a file with one negative, or past
+    INT64_MAX / 2 where the next increments could overflow, is corrupt; INT64_MAX / 2
+    itself loads.  The counters are found by their values (events, pair and wall
+    collisions side by side as int64)."""
+    stats = ck.loads(saved).stats
+    _, arrays = ck._read_npz(saved, "x")
+    known = np.array(
+        [stats["events"], stats["pair_collisions"], stats["wall_collisions"]], np.int64
+    ).tobytes()
+    at = bytes(arrays["engine_state"]).find(known)
+    assert at > 0 and bytes(arrays["engine_state"]).count(known) == 1
+    at += 8 * COUNTERS.index(name)
+    path = tmp_path / "count.npz"
+
+    def with_value(v):
+        def edit(state):
+            state[at : at + 8] = np.int64(v).tobytes()
+
+        return _rewrite_state(saved, edit)
+
+    path.write_bytes(with_value(2**62 - 1))  # INT64_MAX // 2
+    Simulation.load(path)
+    for v in (-1, -(2**63), 2**62, 2**63 - 1):
+        path.write_bytes(with_value(v))
+        with pytest.raises(CheckpointError, match=f"counter {name} is negative or past"):
+            Simulation.load(path)
+
+
+@pytest.mark.parametrize("field", ["count", "pcount"])
+def test_negative_or_overflowing_particle_counters_are_refused(field, tmp_path):
+    """Each particle's collision counter (and the copy of its partner's its prediction
+    keeps) likewise.  Two disks stopped right after their one collision: each scheduling
+    state holds t_last = that time then count = 1, pcount (csrc/schedstate.h)."""
+    s = Scene([[0.3, 0.5], [0.7, 0.5]], [[1.0, 0.0], [-1.0, 0.0]], 0.05, boundary="walls")
+    sim = Simulation(s)
+    sim.run(stop_when={"collisions_per_particle": 1e-9})
+    assert sim.stats["pair_collisions"] == 1
+    data = ck.dumps(sim)
+    state = bytes(ck._read_npz(data, "x")[1]["engine_state"])
+    known = np.float64(sim.time).tobytes() + np.int64(1).tobytes()
+    assert state.count(known) == 2
+    at = state.find(known) + 8 + (8 if field == "pcount" else 0)
+    path = tmp_path / "count.npz"
+    for v in (-1, 2**62):
+
+        def edit(state, v=v):
+            state[at : at + 8] = np.int64(v).tobytes()
+
+        path.write_bytes(_rewrite_state(data, edit))
+        with pytest.raises(CheckpointError, match=r"collision counter .*negative or past"):
+            Simulation.load(path)
+
+
 def test_corrupted_engine_states_never_crash_the_core():
     """Thousands of corrupted engine states (truncated, bytes flipped, words overwritten
     with indices just out of range, NaN and inf), fed straight to the C restore past the
