@@ -53,7 +53,8 @@ typedef struct {
     unsigned char *out;
     const unsigned char *in;
     size_t size, at;
-    int bad; /* a read past the end */
+    int bad;          /* a read past the end */
+    int law_differs;  /* a restitution law read differs from the engine's */
 } cursor;
 
 static void io(cursor *c, void *p, size_t bytes)
@@ -71,6 +72,38 @@ static void io(cursor *c, void *p, size_t bytes)
 }
 
 #define IO(c, x) io((c), &(x), sizeof(x))
+
+static int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* A restitution law, in full (kind, numbers, table).  The engine's own law comes from
+ * the scene it was built from; reading compares the file's with it number by number
+ * (c->law_differs) and keeps the engine's, so a file cannot bring in another law, nor
+ * size anything: a table is read only as long as the engine's. */
+static void io_law(cursor *c, const gr_law *mine)
+{
+    gr_law l = *mine;
+    IO(c, l.kind);
+    IO(c, l.scale);
+    IO(c, l.v_max);
+    IO(c, l.count);
+    if (c->in && !c->bad &&
+        (l.kind != mine->kind || !same_double(l.scale, mine->scale) ||
+         !same_double(l.v_max, mine->v_max) || l.count != mine->count))
+        c->law_differs = 1;
+    if (c->bad || c->law_differs || mine->kind != GR_LAW_TABLE) return;
+    for (int side = 0; side < 2; side++) {
+        const double *x = side ? mine->values : mine->speeds;
+        for (int64_t k = 0; k < mine->count; k++) {
+            double v = x[k];
+            IO(c, v);
+            if (c->bad) return;
+            if (c->in && !same_double(v, x[k])) {
+                c->law_differs = 1;
+                return;
+            }
+        }
+    }
+}
 
 /* The header: what the sizes of the arrays that follow depend on. */
 typedef struct {
@@ -140,6 +173,9 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, cfg->cell_factor);
     IO(c, cfg->big_ratio);
     IO(c, cfg->shell);
+    io_law(c, &cfg->law);
+    io_law(c, &cfg->wall_law);
+    if (c->law_differs) return; /* read: the rest is not this scene's */
 
     IO(c, s->t);
     IO(c, s->eps_t);
@@ -215,7 +251,7 @@ static void transfer(cursor *c, gr_edmd *s)
 
 size_t gr_edmd_save_size(const gr_edmd *s)
 {
-    cursor c = {NULL, NULL, 0, 0, 0};
+    cursor c = {NULL, NULL, 0, 0, 0, 0};
     header h = header_of(s, 0);
     io_header(&c, &h);
     transfer(&c, (gr_edmd *)s); /* counting only: s is not written */
@@ -226,7 +262,7 @@ int gr_edmd_save(const gr_edmd *s, unsigned char *buf, size_t size)
 {
     const size_t total = gr_edmd_save_size(s);
     if (size < total) return GR_ERR_VALUE;
-    cursor c = {buf, NULL, size, 0, 0};
+    cursor c = {buf, NULL, size, 0, 0, 0};
     header h = header_of(s, total);
     io_header(&c, &h);
     transfer(&c, (gr_edmd *)s); /* writing: s is only read */
@@ -303,8 +339,6 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     }
     return GR_OK;
 }
-
-static int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
 
 /* The queue key schedule() gives a particle with this scheduling state. */
 static double key_of(const gr_sched *e) { return e->t_coll < e->t_cross ? e->t_coll : e->t_cross; }
@@ -457,7 +491,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
 
 int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error *err)
 {
-    cursor c = {NULL, buf, size, 0, 0};
+    cursor c = {NULL, buf, size, 0, 0, 0};
     header h, want = header_of(s, size);
     io_header(&c, &h);
     const char *what = NULL;
@@ -489,7 +523,10 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
         status = GR_ERR_NOMEM;
     } else {
         transfer(&c, &t);
-        if (c.bad || c.at != size) what = "truncated or corrupt";
+        if (c.law_differs)
+            what = "its restitution law (pair or wall: kind, parameters or table) differs from "
+                   "the scene's";
+        else if (c.bad || c.at != size) what = "truncated or corrupt";
         else what = check_state(&t, s, seen, skel);
         if (what) status = GR_ERR_VALUE;
     }

@@ -409,6 +409,44 @@ def test_a_neighbour_list_capacity_the_engine_could_not_reach_is_refused(tmp_pat
             Simulation.load(path)
 
 
+def test_a_restitution_law_other_than_the_saved_one_is_refused(tmp_path):
+    """The engine state holds the laws (kind, parameters, table); a file whose scene
+    description names another law (the JSON edited, the engine state untouched), or an
+    engine built with another law, is refused, as a different scalar restitution is."""
+    law = TabulatedRestitution([0.0, 0.5, 2.0], [1.0, 0.9, 0.7])
+    wall = Viscoelastic.from_restitution(0.9, 1.0)
+    base = Scene.random(
+        100, 0.02, dim=2, boundary="walls", restitution=law, wall_restitution=wall, seed=16
+    )
+    sim = Simulation(base)
+    sim.run(0.3)
+    data = ck.dumps(sim)
+    assert ck.loads(data).stats == sim.stats  # the unaltered bytes load
+    meta, _ = ck._read_npz(data, "x")
+    others = {
+        "restitution": (
+            TabulatedRestitution([0.0, 0.5, 2.0], [1.0, 0.9, 0.69]),  # one value
+            TabulatedRestitution([0.0, 0.5, 2.0, 3.0], [1.0, 0.9, 0.7, 0.7]),  # one more point
+            Viscoelastic.from_restitution(0.9, 1.0),  # another kind
+            0.9,  # a number
+        ),
+        "wall_restitution": (
+            Viscoelastic.from_restitution(0.91, 1.0),  # another damping
+            TabulatedRestitution([0.0], [0.9]),
+        ),
+    }
+    path = tmp_path / "law.npz"
+    state = bytes(ck._read_npz(data, "x")[1]["engine_state"])
+    for name, laws in others.items():
+        for other in laws:
+            scene = dict(meta["scene"], **{name: granular.restitution.describe(other)})
+            path.write_bytes(_rewrite_meta(data, scene=scene))
+            with pytest.raises(CheckpointError, match="restitution law"):
+                Simulation.load(path)
+            with pytest.raises(ValueError, match="restitution law"):
+                Simulation(base.replace(**{name: other}))._engine.restore_state(state)
+
+
 # the counters the engine state holds, in order, from `events` on (csrc/checkpoint.c)
 COUNTERS = ("events", "pair", "wall", "invalid", "elastic_tc", "law_clamped")
 
