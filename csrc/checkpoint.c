@@ -53,7 +53,8 @@ typedef struct {
     unsigned char *out;
     const unsigned char *in;
     size_t size, at;
-    int bad; /* a read past the end */
+    int bad;          /* a read past the end */
+    int law_differs;  /* a restitution law read differs from the engine's */
 } cursor;
 
 static void io(cursor *c, void *p, size_t bytes)
@@ -71,6 +72,38 @@ static void io(cursor *c, void *p, size_t bytes)
 }
 
 #define IO(c, x) io((c), &(x), sizeof(x))
+
+static int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
+
+/* A restitution law, in full (kind, numbers, table).  The engine's own law comes from
+ * the scene it was built from; reading compares the file's with it number by number
+ * (c->law_differs) and keeps the engine's, so a file cannot bring in another law, nor
+ * size anything: a table is read only as long as the engine's. */
+static void io_law(cursor *c, const gr_law *mine)
+{
+    gr_law l = *mine;
+    IO(c, l.kind);
+    IO(c, l.scale);
+    IO(c, l.v_max);
+    IO(c, l.count);
+    if (c->in && !c->bad &&
+        (l.kind != mine->kind || !same_double(l.scale, mine->scale) ||
+         !same_double(l.v_max, mine->v_max) || l.count != mine->count))
+        c->law_differs = 1;
+    if (c->bad || c->law_differs || mine->kind != GR_LAW_TABLE) return;
+    for (int side = 0; side < 2; side++) {
+        const double *x = side ? mine->values : mine->speeds;
+        for (int64_t k = 0; k < mine->count; k++) {
+            double v = x[k];
+            IO(c, v);
+            if (c->bad) return;
+            if (c->in && !same_double(v, x[k])) {
+                c->law_differs = 1;
+                return;
+            }
+        }
+    }
+}
 
 /* The header: what the sizes of the arrays that follow depend on. */
 typedef struct {
@@ -140,6 +173,9 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, cfg->cell_factor);
     IO(c, cfg->big_ratio);
     IO(c, cfg->shell);
+    io_law(c, &cfg->law);
+    io_law(c, &cfg->wall_law);
+    if (c->law_differs) return; /* read: the rest is not this scene's */
 
     IO(c, s->t);
     IO(c, s->eps_t);
@@ -215,7 +251,7 @@ static void transfer(cursor *c, gr_edmd *s)
 
 size_t gr_edmd_save_size(const gr_edmd *s)
 {
-    cursor c = {NULL, NULL, 0, 0, 0};
+    cursor c = {NULL, NULL, 0, 0, 0, 0};
     header h = header_of(s, 0);
     io_header(&c, &h);
     transfer(&c, (gr_edmd *)s); /* counting only: s is not written */
@@ -226,7 +262,7 @@ int gr_edmd_save(const gr_edmd *s, unsigned char *buf, size_t size)
 {
     const size_t total = gr_edmd_save_size(s);
     if (size < total) return GR_ERR_VALUE;
-    cursor c = {buf, NULL, size, 0, 0};
+    cursor c = {buf, NULL, size, 0, 0, 0};
     header h = header_of(s, total);
     io_header(&c, &h);
     transfer(&c, (gr_edmd *)s); /* writing: s is only read */
@@ -234,6 +270,21 @@ int gr_edmd_save(const gr_edmd *s, unsigned char *buf, size_t size)
 }
 
 /* ---- restoring ---- */
+
+/* Whether an engine with n particles in list mode could have grown its rows to cap
+ * entries (nlist.c): from GR_NL_CAP_START by doublings, up to GR_NL_CAP_MAX, each one
+ * made when a row of cap / 2 entries needed one more -- and a row lists each other
+ * particle at most once (the box is more than twice the lists' reach wide, build.c), so
+ * cap / 2 < n - 1.  The rows are n * cap int32 allocated before anything else is read:
+ * no more than the engine itself could have allocated. */
+static int cap_reachable(int32_t cap, int dim, int64_t n)
+{
+    const int32_t start = GR_NL_CAP_START(dim);
+    if (cap < start || cap > GR_NL_CAP_MAX || cap % start != 0) return 0;
+    const int32_t doublings = cap / start;
+    if ((doublings & (doublings - 1)) != 0) return 0;
+    return cap == start || cap / 2 < n - 1;
+}
 
 /* The arrays a restore replaces (the rest of the engine stays). */
 static void free_state(gr_edmd *t)
@@ -289,8 +340,6 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     return GR_OK;
 }
 
-static int same_double(double a, double b) { return memcmp(&a, &b, sizeof a) == 0; }
-
 /* The queue key schedule() gives a particle with this scheduling state. */
 static double key_of(const gr_sched *e) { return e->t_coll < e->t_cross ? e->t_coll : e->t_cross; }
 
@@ -311,6 +360,28 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         !same_double(a->shell, b->shell))
         return "its box, restitution, contact duration or engine knobs differ from the scene's";
     if (t->nl.broken != 0 && t->nl.broken != 1) return "its neighbour-list flag is corrupt";
+
+    /* counters: each starts at 0 and grows by one at a time (order.next: events plus a
+     * multiple of n), so a negative one is corrupt, and one past INT64_MAX / 2 (2^62
+     * events: centuries at 1e9 a second) is one the next increments could overflow */
+#define GR_COUNTER(x) {"its counter " #x " is negative or past INT64_MAX / 2", t->x}
+    const struct {
+        const char *why;
+        int64_t value;
+    } counters[] = {
+        GR_COUNTER(events),      GR_COUNTER(pair),       GR_COUNTER(wall),
+        GR_COUNTER(invalid),     GR_COUNTER(elastic_tc), GR_COUNTER(law_clamped),
+        GR_COUNTER(crossings),   GR_COUNTER(shell_exits), GR_COUNTER(same_instant),
+        GR_COUNTER(order.next),
+    };
+#undef GR_COUNTER
+    for (size_t k = 0; k < sizeof counters / sizeof counters[0]; k++)
+        if (counters[k].value < 0 || counters[k].value > INT64_MAX / 2) return counters[k].why;
+    for (int32_t i = 0; i < n; i++)
+        if (t->sched[i].count < 0 || t->sched[i].count > INT64_MAX / 2 || t->sched[i].pcount < 0 ||
+            t->sched[i].pcount > INT64_MAX / 2)
+            return "a particle's collision counter (count or pcount) is negative or past "
+                   "INT64_MAX / 2";
 
     /* the renumbering is a permutation; through it each particle has the radius, mass
      * and bigness the scene gives it (skel: the scene's index -> s's internal index) */
@@ -420,7 +491,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
 
 int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error *err)
 {
-    cursor c = {NULL, buf, size, 0, 0};
+    cursor c = {NULL, buf, size, 0, 0, 0};
     header h, want = header_of(s, size);
     io_header(&c, &h);
     const char *what = NULL;
@@ -433,10 +504,11 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
              h.nb != want.nb || h.ncells != want.ncells || memcmp(h.nc, want.nc, sizeof h.nc) != 0 ||
              h.big_n != want.big_n)
         what = "made for another scene or other engine knobs (sizes differ)";
-    else if (h.lists && !(h.cap >= want.cap && h.cap <= GR_NL_CAP_MAX))
-        what = "its neighbour-list capacity is out of range";
+    else if (h.lists && !(h.cap >= want.cap && cap_reachable(h.cap, h.dim, h.n)))
+        what = "its neighbour-list capacity (header field cap) is out of range: not a "
+               "doubling of the start, or more than twice the particles the lists can hold";
     else if (!h.lists && h.cap != want.cap)
-        what = "its neighbour-list capacity is out of range";
+        what = "its neighbour-list capacity (header field cap) is out of range";
     if (what) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, what);
         return GR_ERR_VALUE;
@@ -451,7 +523,10 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
         status = GR_ERR_NOMEM;
     } else {
         transfer(&c, &t);
-        if (c.bad || c.at != size) what = "truncated or corrupt";
+        if (c.law_differs)
+            what = "its restitution law (pair or wall: kind, parameters or table) differs from "
+                   "the scene's";
+        else if (c.bad || c.at != size) what = "truncated or corrupt";
         else what = check_state(&t, s, seen, skel);
         if (what) status = GR_ERR_VALUE;
     }

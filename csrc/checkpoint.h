@@ -19,8 +19,9 @@
  *
  * Binary layout (native byte order; a buffer from a machine of the other order, or
  * from a build whose structs differ, is refused by the header): a header (magic,
- * GR_CHECKPOINT_VERSION, byte-order mark, gr_checkpoint_layout(), sizes), the config,
- * the counters, then the arrays. */
+ * GR_CHECKPOINT_VERSION, byte-order mark, gr_checkpoint_layout(), sizes), the config
+ * with its restitution laws (tables in full, compared on restore with the engine's), the
+ * counters, then the arrays. */
 #ifndef GR_CHECKPOINT_H
 #define GR_CHECKPOINT_H
 
@@ -31,7 +32,7 @@
 #include "edmd.h"
 
 /* Bump when the order or meaning of what a checkpoint holds changes. */
-#define GR_CHECKPOINT_VERSION 1
+#define GR_CHECKPOINT_VERSION 2 /* 2: the restitution laws */
 
 /* A fingerprint of this build's state layout: GR_CHECKPOINT_VERSION and the sizes and
  * field offsets of the structs a checkpoint copies.  A struct that changes changes it,

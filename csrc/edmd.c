@@ -218,8 +218,11 @@ static inline int streak(gr_edmd *s, int32_t i, double t)
 }
 
 /* The restitution law's eps for a pair at contact: its normal approach speed
- * |dv . dr| / |dr| (0 for a pair that does not approach: gr_pair_collide refuses it). */
-static double pair_law(gr_edmd *s, int dim, const double *dr, const double *vi, const double *vj)
+ * |dv . dr| / |dr| (0 for a pair that does not approach: gr_pair_collide refuses it).
+ * *clamped += 1 if the speed is past the law's range; the caller adds that to
+ * s->law_clamped only if this eps is the one applied (not replaced by the TC model). */
+static double pair_law(const gr_edmd *s, int dim, const double *dr, const double *vi,
+                       const double *vj, int64_t *clamped)
 {
     double b = 0.0, dr2 = 0.0;
     for (int a = 0; a < dim; a++) {
@@ -227,7 +230,7 @@ static double pair_law(gr_edmd *s, int dim, const double *dr, const double *vi, 
         dr2 += dr[a] * dr[a];
     }
     double vn = b < 0.0 && dr2 > 0.0 ? -b / sqrt(dr2) : 0.0;
-    return gr_law_eval(&s->cfg.law, vn, &s->law_clamped);
+    return gr_law_eval(&s->cfg.law, vn, clamped);
 }
 
 static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
@@ -243,12 +246,15 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, in
         if (s->cfg.periodic) dr[a] = nearest_image(dr[a], s->L[a]);
     }
     double xi = s->cfg.restitution;
-    if (laws && s->cfg.law.kind != GR_LAW_CONSTANT) xi = pair_law(s, dim, dr, VEL(p, dim), VEL(q, dim));
+    int64_t clamped = 0; /* 1 if xi is the law's at its range's end */
+    if (laws && s->cfg.law.kind != GR_LAW_CONSTANT)
+        xi = pair_law(s, dim, dr, VEL(p, dim), VEL(q, dim), &clamped);
     if (s->cfg.contact_duration > 0.0 && xi < 1.0 &&
         (t - s->sched[i].t_last < s->cfg.contact_duration ||
          t - s->sched[j].t_last < s->cfg.contact_duration)) {
         xi = 1.0; /* TC model: within t_c of a previous collision, collide elastically */
         s->elastic_tc++;
+        clamped = 0; /* the clamped eps is not the one applied */
     }
     double before = kinetic_of(s, dim, i) + kinetic_of(s, dim, j);
     double vir = gr_pair_collide(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
@@ -261,6 +267,7 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, in
     s->kinetic += kinetic_of(s, dim, i) + kinetic_of(s, dim, j) - before;
     s->virial += vir;
     s->pair++;
+    s->law_clamped += clamped; /* a collision that happened, with the clamped law's eps */
     s->sched[i].count++;
     s->sched[j].count++;
     int collapse_i = streak(s, i, t), collapse_j = streak(s, j, t);
@@ -287,11 +294,15 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, in
     move(dim, p, t);
     double before = kinetic_of(s, dim, i), vn = v[a];
     double ew = s->cfg.wall_restitution;
+    int64_t clamped = 0; /* 1 if e_w is the law's at its range's end */
     /* a law gives e_w of the same rule (2.22) from the normal impact speed |v_a| */
     if (laws && s->cfg.wall_law.kind != GR_LAW_CONSTANT)
-        ew = gr_law_eval(&s->cfg.wall_law, fabs(vn), &s->law_clamped);
-    if (ew < 1.0 && s->cfg.contact_duration > 0.0 && t - s->sched[i].t_last < s->cfg.contact_duration)
+        ew = gr_law_eval(&s->cfg.wall_law, fabs(vn), &clamped);
+    if (ew < 1.0 && s->cfg.contact_duration > 0.0 && t - s->sched[i].t_last < s->cfg.contact_duration) {
         ew = 1.0;
+        clamped = 0; /* TC model: the clamped e_w is not the one applied */
+    }
+    s->law_clamped += clamped;
     v[a] = -v[a];
     if (ew != 1.0)
         for (int k = 0; k < dim; k++) v[k] *= ew; /* law of reflection kept (2.22) */

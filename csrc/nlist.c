@@ -13,7 +13,7 @@ int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *
     /* leave a hair early: two particles each within delta (1 - 1e-9) of centres more
      * than sigma + 2 delta apart stay apart by more than rounding */
     nl->exit2 = shell * (1.0 - 1e-9) * shell * (1.0 - 1e-9);
-    nl->cap = dim == 3 ? 32 : 16;
+    nl->cap = GR_NL_CAP_START(dim);
     nl->centre = gr_big_alloc((size_t)n * (dim + 1) * sizeof *nl->centre);
     nl->rows = gr_big_alloc((size_t)n * nl->cap * sizeof *nl->rows);
     nl->near = malloc((size_t)n * sizeof *nl->near);

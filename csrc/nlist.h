@@ -27,6 +27,7 @@
 #include "schedstate.h"
 
 #define GR_NL_CAP_MAX 16384
+#define GR_NL_CAP_START(dim) ((dim) == 3 ? 32 : 16) /* rows' capacity before any growth */
 #define GR_NL_BITS 5
 #define GR_NL_CODE_MASK ((1 << GR_NL_BITS) - 1)
 /* the image code in the low GR_NL_BITS bits leaves list mode n < 2^26 */

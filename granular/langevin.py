@@ -203,6 +203,8 @@ class LangevinResult:
     exponent : a of UDSBM's (1 + t/tau0)^-a (1 for the Langevin model)
     n, dim : particles and dimensions
     v0_sq : initial mean squared velocity per component
+    initial : the initial velocities, as given to ``run``: "thermal" or "udsbm" (Gaussian)
+        or "fixed" (one speed for every particle)
     """
 
     times: NDArray[np.float64]
@@ -228,6 +230,7 @@ class LangevinResult:
     t_stop: float
     v0_sq: float
     exponent: float = 1.0
+    initial: str = "thermal"
 
     @property
     def msd(self) -> _ArrayAndMethod:
@@ -388,8 +391,25 @@ class LangevinResult:
         ``sde_lag_stride`` steps) at its lags or at ``lags``:
         ``theory.udsbm_ergodicity_breaking`` (cost: squared windows per lag).  It assumes
         Gaussian initial velocities (``initial`` "thermal" or "udsbm"), as Isserlis'
-        theorem there needs."""
+        theorem there needs.
+
+        Raises
+        ------
+        ValueError
+            For a run started with ``initial="fixed"``: every particle at one speed is not
+            a Gaussian velocity, so the TAMSD's variance is not the one Isserlis' theorem
+            gives (its fourth moments differ), and no number is returned rather than a
+            wrong one."""
         from . import theory
+
+        if self.initial not in ("thermal", "udsbm"):
+            raise ValueError(
+                f"theory_ergodicity_breaking assumes Gaussian initial velocities (initial "
+                f"'thermal' or 'udsbm'); this run started with initial={self.initial!r} -- "
+                "one speed for every particle -- whose velocities are not Gaussian, so "
+                "Isserlis' theorem, on which the theory rests, does not hold: measure EB "
+                "(ergodicity_breaking) or run with initial='thermal'"
+            )
 
         lag_t = self.tamsd_lags if lags is None else np.atleast_1d(np.asarray(lags, float))
         n_steps = round(self.t_stop / self.dt)
@@ -804,6 +824,7 @@ def run(
         t_stop=n_steps * dt,
         v0_sq=v0_sq,
         exponent=exponent if model == "udsbm" else 1.0,
+        initial=initial,
     )
 
 

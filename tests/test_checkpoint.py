@@ -357,6 +357,155 @@ def test_an_engine_state_for_another_scene_is_refused(saved):
             Simulation(scene, **knobs)._engine.restore_state(state)
 
 
+def _rewrite_state(data, edit):
+    """The checkpoint bytes with the engine state passed through edit(bytearray) and its
+    checksum made to match, as a file crafted past the checksum would be."""
+    with np.load(__import__("io").BytesIO(data)) as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    state = bytearray(arrays["engine_state"].tobytes())
+    edit(state)
+    arrays["engine_state"] = np.frombuffer(bytes(state), dtype=np.uint8)
+    meta = json.loads(str(arrays["meta"][()]))
+    meta["engine_state_sha256"] = __import__("hashlib").sha256(bytes(state)).hexdigest()
+    arrays["meta"] = np.array(json.dumps(meta))
+    buf = __import__("io").BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+# the neighbour-list capacity in the engine state's header (csrc/checkpoint.c, `header`):
+# magic 8, version 4, byte order 4, layout 8, total 8, n 8, dim, stride, lists, nb,
+# ncells 4 each, nc 3 x 4, then cap (int32)
+CAP_AT = 72
+
+
+def test_a_neighbour_list_capacity_the_engine_could_not_reach_is_refused(tmp_path):
+    """The rows (n x cap int32) are allocated from the header's cap before the rest is
+    read: only a capacity the engine itself could have grown to is accepted -- 32 (3D)
+    doubled while a row of cap / 2 could overflow, which with n = 60 particles (59 others
+    to list) is 32 or 64 -- not 128, not the largest list the engine allows (16384), not
+    one that is no doubling (48)."""
+    sim = Simulation(Scene.random(60, 0.1, dim=3, seed=3), shell=0.25)
+    sim.run(stop_when={"events": 300})
+    assert sim.stats["shell"] > 0
+    data = ck.dumps(sim)
+    _, arrays = ck._read_npz(data, "x")
+    assert int(np.frombuffer(arrays["engine_state"], np.int32, 1, CAP_AT)[0]) == 32
+
+    def with_cap(cap):
+        def edit(state):
+            state[CAP_AT : CAP_AT + 4] = np.int32(cap).tobytes()
+
+        return _rewrite_state(data, edit)
+
+    path = tmp_path / "cap.npz"
+    path.write_bytes(with_cap(64))  # reachable: loads, and runs on as the original
+    loaded = Simulation.load(path)
+    more = {"events": 600}
+    _assert_same_trajectory(sim.run(stop_when=more), loaded.run(stop_when=more))
+    for cap in (128, 16384, 48, 2**31 - 1):
+        path.write_bytes(with_cap(cap))
+        with pytest.raises(CheckpointError, match=r"neighbour-list capacity \(header field cap\)"):
+            Simulation.load(path)
+
+
+def test_a_restitution_law_other_than_the_saved_one_is_refused(tmp_path):
+    """The engine state holds the laws (kind, parameters, table); a file whose scene
+    description names another law (the JSON edited, the engine state untouched), or an
+    engine built with another law, is refused, as a different scalar restitution is."""
+    law = TabulatedRestitution([0.0, 0.5, 2.0], [1.0, 0.9, 0.7])
+    wall = Viscoelastic.from_restitution(0.9, 1.0)
+    base = Scene.random(
+        100, 0.02, dim=2, boundary="walls", restitution=law, wall_restitution=wall, seed=16
+    )
+    sim = Simulation(base)
+    sim.run(0.3)
+    data = ck.dumps(sim)
+    assert ck.loads(data).stats == sim.stats  # the unaltered bytes load
+    meta, _ = ck._read_npz(data, "x")
+    others = {
+        "restitution": (
+            TabulatedRestitution([0.0, 0.5, 2.0], [1.0, 0.9, 0.69]),  # one value
+            TabulatedRestitution([0.0, 0.5, 2.0, 3.0], [1.0, 0.9, 0.7, 0.7]),  # one more point
+            Viscoelastic.from_restitution(0.9, 1.0),  # another kind
+            0.9,  # a number
+        ),
+        "wall_restitution": (
+            Viscoelastic.from_restitution(0.91, 1.0),  # another damping
+            TabulatedRestitution([0.0], [0.9]),
+        ),
+    }
+    path = tmp_path / "law.npz"
+    state = bytes(ck._read_npz(data, "x")[1]["engine_state"])
+    for name, laws in others.items():
+        for other in laws:
+            scene = dict(meta["scene"], **{name: granular.restitution.describe(other)})
+            path.write_bytes(_rewrite_meta(data, scene=scene))
+            with pytest.raises(CheckpointError, match="restitution law"):
+                Simulation.load(path)
+            with pytest.raises(ValueError, match="restitution law"):
+                Simulation(base.replace(**{name: other}))._engine.restore_state(state)
+
+
+# the counters the engine state holds, in order, from `events` on (csrc/checkpoint.c)
+COUNTERS = ("events", "pair", "wall", "invalid", "elastic_tc", "law_clamped")
+
+
+@pytest.mark.parametrize("name", COUNTERS)
+def test_negative_or_overflowing_counters_are_refused(saved, name, tmp_path):
+    """Counters start at 0 and grow by one: a file with one negative, or past
+    INT64_MAX / 2 where the next increments could overflow, is corrupt; INT64_MAX / 2
+    itself loads.  The counters are found by their values (events, pair and wall
+    collisions side by side as int64)."""
+    stats = ck.loads(saved).stats
+    _, arrays = ck._read_npz(saved, "x")
+    known = np.array(
+        [stats["events"], stats["pair_collisions"], stats["wall_collisions"]], np.int64
+    ).tobytes()
+    at = bytes(arrays["engine_state"]).find(known)
+    assert at > 0 and bytes(arrays["engine_state"]).count(known) == 1
+    at += 8 * COUNTERS.index(name)
+    path = tmp_path / "count.npz"
+
+    def with_value(v):
+        def edit(state):
+            state[at : at + 8] = np.int64(v).tobytes()
+
+        return _rewrite_state(saved, edit)
+
+    path.write_bytes(with_value(2**62 - 1))  # INT64_MAX // 2
+    Simulation.load(path)
+    for v in (-1, -(2**63), 2**62, 2**63 - 1):
+        path.write_bytes(with_value(v))
+        with pytest.raises(CheckpointError, match=f"counter {name} is negative or past"):
+            Simulation.load(path)
+
+
+@pytest.mark.parametrize("field", ["count", "pcount"])
+def test_negative_or_overflowing_particle_counters_are_refused(field, tmp_path):
+    """Each particle's collision counter (and the copy of its partner's its prediction
+    keeps) likewise.  Two disks stopped right after their one collision: each scheduling
+    state holds t_last = that time then count = 1, pcount (csrc/schedstate.h)."""
+    s = Scene([[0.3, 0.5], [0.7, 0.5]], [[1.0, 0.0], [-1.0, 0.0]], 0.05, boundary="walls")
+    sim = Simulation(s)
+    sim.run(stop_when={"collisions_per_particle": 1e-9})
+    assert sim.stats["pair_collisions"] == 1
+    data = ck.dumps(sim)
+    state = bytes(ck._read_npz(data, "x")[1]["engine_state"])
+    known = np.float64(sim.time).tobytes() + np.int64(1).tobytes()
+    assert state.count(known) == 2
+    at = state.find(known) + 8 + (8 if field == "pcount" else 0)
+    path = tmp_path / "count.npz"
+    for v in (-1, 2**62):
+
+        def edit(state, v=v):
+            state[at : at + 8] = np.int64(v).tobytes()
+
+        path.write_bytes(_rewrite_state(data, edit))
+        with pytest.raises(CheckpointError, match=r"collision counter .*negative or past"):
+            Simulation.load(path)
+
+
 def test_corrupted_engine_states_never_crash_the_core():
     """Thousands of corrupted engine states (truncated, bytes flipped, words overwritten
     with indices just out of range, NaN and inf), fed straight to the C restore past the

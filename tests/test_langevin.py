@@ -537,6 +537,24 @@ def test_bad_input(kwargs, match):
         langevin.run(10, **base)
 
 
+def test_theory_ergodicity_breaking_refuses_a_fixed_speed_start():
+    """The EB theory rests on Isserlis' theorem, so on Gaussian initial velocities: a run
+    from initial="fixed" (one speed for every particle) gets a ValueError saying so, not
+    a number; Gaussian starts ("thermal", "udsbm") get finite positive numbers."""
+    kw = dict(gamma0=G0, D0=D0, dt=0.01, t_stop=2.0, tamsd_lags=[0.1, 0.5], seed=3)
+    fixed = langevin.run(50, initial="fixed", **kw)
+    assert fixed.initial == "fixed"
+    with pytest.raises(ValueError, match=r"Gaussian initial velocities.*initial='fixed'"):
+        fixed.theory_ergodicity_breaking()
+    with pytest.raises(ValueError, match="Isserlis"):
+        fixed.theory_ergodicity_breaking([0.5])
+    for initial, extra in (("thermal", {}), ("udsbm", dict(model="udsbm", tau0=1.0))):
+        r = langevin.run(50, initial=initial, **kw, **extra)
+        assert r.initial == initial
+        eb = r.theory_ergodicity_breaking()
+        assert eb.shape == (2,) and np.all(np.isfinite(eb) & (eb > 0))
+
+
 def test_every_window_of_a_huge_lag_is_refused_before_allocating():
     """Every window of a lag of 2**30 steps needs a ring of 2**31 positions (48 GiB in 3D)
     per thread: refused with the size and the way out, before anything is allocated."""

@@ -221,6 +221,54 @@ def test_the_tc_model_still_makes_quick_repeats_elastic():
         Simulation(line.replace(contact_duration=0.0)).run(t_stop=1.0)
 
 
+# a law whose series ends at max_speed ~ 1e-6: every collision of a gas at T = 1 is past it
+# (P(v_n < 1e-6) ~ 1e-12 per collision), so each one either gets the clamped eps or is
+# made elastic by the TC model -- never both
+FAST = Viscoelastic(4.0, 1.0)
+
+
+@pytest.mark.filterwarnings("ignore:.*faster than the viscoelastic law's range")
+@pytest.mark.parametrize("contact_duration", [1e-3, 1e6])
+def test_clamps_count_only_collisions_that_get_the_clamped_eps(contact_duration):
+    """law_clamped_collisions counts the collisions whose eps came from the clamped law:
+    by construction (FAST) that is every pair collision the TC model did not make
+    elastic, pair - tc_elastic, exactly.  With t_c longer than the run only collisions
+    of two particles that never collided before are inelastic: at most n / 2."""
+    assert FAST.max_speed < 1e-6
+    s = Scene.random(200, 0.02, dim=2, restitution=FAST, contact_duration=contact_duration, seed=3)
+    sim = Simulation(s)
+    sim.run(stop_when={"collisions_per_particle": 20}, store=())
+    st = sim.stats
+    pair, tc = st["pair_collisions"], st["tc_elastic_collisions"]
+    assert 0 < tc < pair
+    assert st["law_clamped_collisions"] == pair - tc
+    if contact_duration > 1.0:
+        assert pair - tc <= s.n // 2
+
+
+@pytest.mark.filterwarnings("ignore:.*faster than the viscoelastic law's range")
+def test_wall_clamps_count_only_wall_hits_that_get_the_clamped_eps():
+    """One disk between walls with a FAST wall law and t_c longer than the run: its first
+    hit gets the clamped e_w, every later one is within t_c of it and elastic, so one
+    clamp however many hits."""
+    s = Scene(
+        [[0.5, 0.5]],
+        [[1.0, 0.3]],
+        0.05,
+        boundary="walls",
+        wall_restitution=FAST,
+        contact_duration=1e6,
+    )
+    sim = Simulation(s)
+    sim.run(t_stop=20.0, store=())
+    assert sim.stats["wall_collisions"] > 10
+    assert sim.stats["law_clamped_collisions"] == 1
+    e_w = float(FAST(FAST.max_speed))
+    np.testing.assert_allclose(
+        np.abs(sim.scene.velocities[0]), e_w * np.array([1.0, 0.3]), rtol=1e-14
+    )
+
+
 # -- physics: no inelastic collapse -------------------------------------------------------
 
 
