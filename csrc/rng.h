@@ -85,8 +85,8 @@ static inline double gr_normal(gr_stream *s)
  * gr_normal's own slow path from the stream state gr_normal would have there, and the
  * stream's later draws by gr_normal (the slow path draws more, shifting them).  On x86-64
  * with GCC or Clang the batch exists plain, compiled for AVX2, and written for AVX-512
- * with intrinsics (8 streams a vector, the tables gathered); gr_rng_init picks the widest
- * the CPU runs (rng.c).  Only integer work and that lone multiply happen there, and the
+ * with intrinsics (16 streams at once, the tables held in registers); gr_rng_init picks
+ * the widest the CPU runs (rng.c).  Only integer work and that lone multiply happen there, and the
  * particle update stays in portable code: nothing can be fused or reordered. */
 #define GR_NORMAL_BATCH 16
 #define GR_NORMAL_BATCH_MAX_M 6
