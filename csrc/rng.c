@@ -145,28 +145,27 @@ static GR_AVX512 inline __m512i mix8(__m512i z)
     return _mm512_xor_si512(z, _mm512_srli_epi64(z, 31));
 }
 
-/* The 128 entries of w for 8 draws at once, in registers: vpermt2pd picks from 16 entries
- * (a pair of vectors) by bits 0..3 of each 64-bit index (the higher bits ignored), and
- * bits 4, 5, 6 of iz choose among the 8 pairs -- the very doubles a gather would load. */
-static GR_AVX512 inline __m512d lookup_w8(const __m512d *wt, __m512i iz)
+/* Entry iz (0..127) of a table of 128 x 32 bits held in 8 vectors, for 16 lanes at once:
+ * vpermt2d picks from 32 entries (a pair of vectors) by bits 0..4 of each index (the
+ * higher bits ignored), b5 and b6 (bits 5 and 6 of iz) choose among the 4 pairs. */
+static GR_AVX512 inline __m512i lookup128(const __m512i *t, __m512i iz, __mmask16 b5,
+                                          __mmask16 b6)
 {
-    const __mmask8 b4 = _mm512_test_epi64_mask(iz, _mm512_set1_epi64(16));
-    const __mmask8 b5 = _mm512_test_epi64_mask(iz, _mm512_set1_epi64(32));
-    const __mmask8 b6 = _mm512_test_epi64_mask(iz, _mm512_set1_epi64(64));
-    __m512d p[4];
-    for (int q = 0; q < 4; q++)
-        p[q] = _mm512_mask_blend_pd(b4, _mm512_permutex2var_pd(wt[4 * q], iz, wt[4 * q + 1]),
-                                    _mm512_permutex2var_pd(wt[4 * q + 2], iz, wt[4 * q + 3]));
-    return _mm512_mask_blend_pd(b6, _mm512_mask_blend_pd(b5, p[0], p[1]),
-                                _mm512_mask_blend_pd(b5, p[2], p[3]));
+    return _mm512_mask_blend_epi32(
+        b6,
+        _mm512_mask_blend_epi32(b5, _mm512_permutex2var_epi32(t[0], iz, t[1]),
+                                _mm512_permutex2var_epi32(t[2], iz, t[3])),
+        _mm512_mask_blend_epi32(b5, _mm512_permutex2var_epi32(t[4], iz, t[5]),
+                                _mm512_permutex2var_epi32(t[6], iz, t[7])));
 }
 
 /* Why permutes and not gathers: the tables are 512 B (k) and 1 KB (w), 24 vectors, loaded
- * once a call; a look-up is 4 vpermt2d and 3 blends for 16 draws (k), 8 vpermt2pd and 7
- * blends for 8 (w), against gathers that stall (the batch took 100 ns a call with them,
- * 67 with permutes, m = 6).  The draw counter is a vector add and z a moving pointer, not
- * (k + 1) golden and z + k B: with -fwrapv (Python's CFLAGS, which the extension inherits)
- * GCC 12 compiled the indexed form into a loop 12 M steps/s slower. */
+ * once a call; w is held as its low and its high 32-bit halves, so each of the three
+ * look-ups is 4 vpermt2d and 3 blends for 16 draws (and 2 vpermt2d put w's halves back
+ * together), against gathers that stall (the batch took 100 ns a call with gathers, 67
+ * with permutes of w as doubles, m = 6).  The draw counter is a vector add and z a moving
+ * pointer, not (k + 1) golden and z + k B: with -fwrapv (in Python's CFLAGS, which the
+ * extension inherits) GCC 12 compiled the indexed form into a loop 12 M steps/s slower. */
 static GR_AVX512 uint32_t batch_avx512(uint64_t key, uint64_t step0, uint64_t particle, int m,
                                        double *restrict z, uint64_t *restrict seed,
                                        uint32_t *restrict miss)
@@ -174,50 +173,55 @@ static GR_AVX512 uint32_t batch_avx512(uint64_t key, uint64_t step0, uint64_t pa
     const __m512i golden = _mm512_set1_epi64((long long)GR_GOLDEN);
     const __m512i lane = _mm512_mullo_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), golden);
     const uint64_t c0 = step0 * GR_GOLDEN + particle;
-    /* the tables in registers: kt[q] holds k's entries 16 q .. 16 q + 15, wt[q] w's entries
-     * 8 q .. 8 q + 7 (loaded once a call, 24 vectors for 16 x m draws) */
-    __m512i kt[8];
-    __m512d wt[16];
-    for (int q = 0; q < 8; q++) kt[q] = _mm512_loadu_si512((const void *)(gr_zig_k + 16 * q));
-    for (int q = 0; q < 16; q++) wt[q] = _mm512_loadu_pd(gr_zig_w + 8 * q);
-    /* the 16 streams' seeds, 8 a vector */
-    __m512i s[2];
-    for (int h = 0; h < 2; h++) {
-        const __m512i c =
-            _mm512_add_epi64(_mm512_set1_epi64((long long)(c0 + (uint64_t)(8 * h) * GR_GOLDEN)), lane);
-        s[h] = mix8(_mm512_add_epi64(_mm512_set1_epi64((long long)key),
-                                     _mm512_mullo_epi64(mix8(c), golden)));
-        _mm512_storeu_si512((void *)(seed + 8 * h), s[h]);
-    }
-    /* the low and the high 32 bits of the 16 draws of the two vectors, streams in order */
-    const __m512i even = _mm512_set_epi32(30, 28, 26, 24, 22, 20, 18, 16, 14, 12, 10, 8, 6, 4, 2, 0);
+    /* the low and the high 32 bits of 16 64-bit lanes a, b (a's first), and back */
+    const __m512i even =
+        _mm512_set_epi32(30, 28, 26, 24, 22, 20, 18, 16, 14, 12, 10, 8, 6, 4, 2, 0);
     const __m512i odd = _mm512_add_epi32(even, _mm512_set1_epi32(1));
+    const __m512i join0 =
+        _mm512_set_epi32(23, 7, 22, 6, 21, 5, 20, 4, 19, 3, 18, 2, 17, 1, 16, 0);
+    const __m512i join1 = _mm512_add_epi32(join0, _mm512_set1_epi32(8));
+    /* the tables in registers: kt[q] holds k's entries 16 q .. 16 q + 15, wlo[q] and whi[q]
+     * the low and the high halves of w's */
+    __m512i kt[8], wlo[8], whi[8];
+    for (int q = 0; q < 8; q++) {
+        kt[q] = _mm512_loadu_si512((const void *)(gr_zig_k + 16 * q));
+        const __m512i a = _mm512_loadu_si512((const void *)(gr_zig_w + 16 * q));
+        const __m512i b = _mm512_loadu_si512((const void *)(gr_zig_w + 16 * q + 8));
+        wlo[q] = _mm512_permutex2var_epi32(a, even, b);
+        whi[q] = _mm512_permutex2var_epi32(a, odd, b);
+    }
+    /* the 16 streams' seeds, 8 a vector */
+    __m512i s0, s1;
+    {
+        const __m512i c = _mm512_add_epi64(_mm512_set1_epi64((long long)c0), lane);
+        s0 = mix8(_mm512_add_epi64(_mm512_set1_epi64((long long)key),
+                                   _mm512_mullo_epi64(mix8(c), golden)));
+        const __m512i c8 = _mm512_add_epi64(c, _mm512_set1_epi64((long long)(8 * GR_GOLDEN)));
+        s1 = mix8(_mm512_add_epi64(_mm512_set1_epi64((long long)key),
+                                   _mm512_mullo_epi64(mix8(c8), golden)));
+    }
+    _mm512_storeu_si512((void *)seed, s0);
+    _mm512_storeu_si512((void *)(seed + 8), s1);
     uint32_t bad = 0;
-    __m512i s0 = s[0], s1 = s[1];
     for (int k = 0; k < m; k++) {
-        s0 = _mm512_add_epi64(s0, golden); /* the stream's state at its draw k */
+        s0 = _mm512_add_epi64(s0, golden); /* the streams' states at their draw k */
         s1 = _mm512_add_epi64(s1, golden);
         const __m512i u0 = mix8(s0), u1 = mix8(s1);
-        /* the fast-path test of all 16 streams at once, in 32-bit lanes: k[iz] by vpermt2d
-         * (bits 0..4 of iz) from 4 pairs, bits 5 and 6 choosing the pair */
-        const __m512i hz = _mm512_permutex2var_epi32(u0, even, u1); /* the low 32 bits */
+        /* 16 draws in 32-bit lanes, streams in order: hz the low halves, iz the top 7 bits */
+        const __m512i hz = _mm512_permutex2var_epi32(u0, even, u1);
         const __m512i iz = _mm512_srli_epi32(_mm512_permutex2var_epi32(u0, odd, u1), 25);
-        const __m512i mag = _mm512_abs_epi32(hz); /* -2^31 stays 2^31 unsigned */
         const __mmask16 b5 = _mm512_test_epi32_mask(iz, _mm512_set1_epi32(32));
         const __mmask16 b6 = _mm512_test_epi32_mask(iz, _mm512_set1_epi32(64));
-        const __m512i kz = _mm512_mask_blend_epi32(
-            b6,
-            _mm512_mask_blend_epi32(b5, _mm512_permutex2var_epi32(kt[0], iz, kt[1]),
-                                    _mm512_permutex2var_epi32(kt[2], iz, kt[3])),
-            _mm512_mask_blend_epi32(b5, _mm512_permutex2var_epi32(kt[4], iz, kt[5]),
-                                    _mm512_permutex2var_epi32(kt[6], iz, kt[7])));
-        const uint32_t mk = _mm512_cmpge_epu32_mask(mag, kz);
+        const __m512i mag = _mm512_abs_epi32(hz); /* -2^31 stays 2^31 unsigned */
+        const uint32_t mk = _mm512_cmpge_epu32_mask(mag, lookup128(kt, iz, b5, b6));
         miss[k] = mk;
         bad |= mk;
-        const __m512d w0 = lookup_w8(wt, _mm512_srli_epi64(u0, 57));
-        const __m512d w1 = lookup_w8(wt, _mm512_srli_epi64(u1, 57));
+        const __m512i lo = lookup128(wlo, iz, b5, b6), hi = lookup128(whi, iz, b5, b6);
+        const __m512d w0 = _mm512_castsi512_pd(_mm512_permutex2var_epi32(lo, join0, hi));
+        const __m512d w1 = _mm512_castsi512_pd(_mm512_permutex2var_epi32(lo, join1, hi));
         _mm512_storeu_pd(z, _mm512_mul_pd(_mm512_cvtepi32_pd(_mm512_castsi512_si256(hz)), w0));
-        _mm512_storeu_pd(z + 8, _mm512_mul_pd(_mm512_cvtepi32_pd(_mm512_extracti64x4_epi64(hz, 1)), w1));
+        _mm512_storeu_pd(z + 8,
+                         _mm512_mul_pd(_mm512_cvtepi32_pd(_mm512_extracti64x4_epi64(hz, 1)), w1));
         z += B;
     }
     return bad;
