@@ -53,6 +53,8 @@ extern int gr_rng_ready;
 extern uint32_t gr_zig_k[128];
 extern double gr_zig_w[128], gr_zig_f[128];
 void gr_rng_init(void);
+/* The slow path of gr_normal: the tail, the wedges (their test calls exp only when a
+ * bracket of it cannot decide, with the same answer -- rng.c) and the redraws. */
 double gr_normal_tail(gr_stream *s, int64_t hz, int iz);
 
 /* A standard normal variate. */
