@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "big.h"
+#include "cells.h"
 #include "checkpoint.h"
 #include "common.h"
 #include "edmd.h"
@@ -799,6 +800,7 @@ PyMODINIT_FUNC PyInit__core(void)
     PyModule_AddIntConstant(m, "STOP_ENERGY", GR_STOP_ENERGY);
     PyModule_AddIntConstant(m, "STOP_IDLE", GR_STOP_IDLE);
     PyModule_AddIntConstant(m, "BIG_MAX", GR_BIG_MAX);
+    PyModule_AddIntConstant(m, "HEADS_CACHED", (long)GR_HEADS_CACHED);
     PyObject *layout = PyLong_FromUnsignedLongLong(gr_checkpoint_layout());
     if (!layout || PyModule_AddObjectRef(m, "CHECKPOINT_LAYOUT", layout) < 0) {
         Py_XDECREF(layout);

@@ -132,6 +132,11 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         gr_edmd_free(s);
         return status;
     }
+    /* Events are prefetched ahead where the grid is out of cache (cells.h); they need
+     * the ids of the next events at hand (calendar.h). */
+    s->lookahead = s->nl.shell == 0.0 && s->cells.prefetch_heads;
+    s->queue.depth = s->lookahead ? GR_CQ_AHEAD + 1 : 1;
+    s->foreseen[0] = s->foreseen[1] = -1;
 
     double v2m = 0.0, msum = 0.0;
     for (int32_t i = 0; i < n; i++) {

@@ -221,6 +221,7 @@ static void rebuild(gr_cq *q)
 int gr_cq_init(gr_cq *q, int32_t n)
 {
     q->n = n;
+    q->depth = 1;
     q->nb = 16;
     while (q->nb < GR_CQ_SLOTS_PER_ID * (int64_t)n && q->nb < (1 << 30)) q->nb <<= 1;
     q->item = gr_big_alloc((size_t)n * sizeof *q->item);
@@ -261,8 +262,9 @@ int32_t gr_cq_top_slow(gr_cq *q, double *t)
         return q->nan_id;
     }
     if (q->changes >= q->rebuild_at) rebuild(q);
-    while (q->n_near == 0) {
+    while (q->n_near < q->depth) {
         if (q->n_list == 0) {
+            if (q->n_near > 0) break;
             if (q->n_over == 0) {
                 *t = INFINITY;
                 return -1;

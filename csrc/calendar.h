@@ -22,6 +22,7 @@
 #ifndef GR_CALENDAR_H
 #define GR_CALENDAR_H
 
+#include <math.h>
 #include <stdint.h>
 
 typedef struct {
@@ -50,6 +51,7 @@ typedef struct {
     int32_t n_near;
     int32_t nan_id;    /* an id whose key is NaN, -1 if none */
     int64_t changes, rebuild_at;
+    int32_t depth;     /* the near heap is topped up below this many keys (see gr_cq_top) */
 } gr_cq;
 
 /* Allocate a queue of n ids, all with key +inf.  Returns GR_OK or GR_ERR_NOMEM. */
@@ -62,10 +64,13 @@ int32_t gr_cq_top_slow(gr_cq *q, double *t);
 
 /* The id with the smallest key (-1 if every key is +inf) and that key in *t; a NaN key
  * comes first.  Does not remove it, but may move the calendar forward or rebuild it.
- * Inline for the common case, the root of a non-empty near heap. */
+ * Inline for the common case, the root of a near heap that holds at least `depth` keys;
+ * below that it is topped up from the next buckets first (where any keys are left):
+ * depth 1 refills it only when empty, the cheapest; a caller that prefetches events
+ * ahead (gr_cq_ahead) sets depth to GR_CQ_AHEAD + 1, so the next ids are at hand. */
 static inline int32_t gr_cq_top(gr_cq *q, double *t)
 {
-    if (q->n_near > 0 && q->nan_id < 0 && q->changes < q->rebuild_at) {
+    if (q->n_near >= q->depth && q->nan_id < 0 && q->changes < q->rebuild_at) {
         *t = q->near[0].t;
         return q->near[0].id;
     }
@@ -81,13 +86,62 @@ static inline int32_t gr_cq_hint(const gr_cq *q)
     return q->head[(q->cur + 1) & (q->nb - 1)];
 }
 
+/* The ids most likely to be on top after the current top, in order (next[0] the very
+ * next), -1 where none is at hand: the smallest keys of the near heap below its root
+ * (the k-th smallest lies within its first 2^k - 1 slots).  A hint for prefetching
+ * events ahead, no promise. */
+#define GR_CQ_AHEAD 3
+static inline void gr_cq_ahead(const gr_cq *q, int32_t next[GR_CQ_AHEAD])
+{
+    double t0 = INFINITY, t1 = INFINITY, t2 = INFINITY; /* the three smallest, in order */
+    int32_t i0 = -1, i1 = -1, i2 = -1;
+    const int32_t m = q->n_near < 15 ? q->n_near : 15;
+    for (int32_t j = 1; j < m; j++) {
+        const double t = q->near[j].t;
+        const int32_t id = q->near[j].id;
+        if (!(t < t2)) continue;
+        if (t < t1) {
+            t2 = t1;
+            i2 = i1;
+            if (t < t0) {
+                t1 = t0;
+                i1 = i0;
+                t0 = t;
+                i0 = id;
+            } else {
+                t1 = t;
+                i1 = id;
+            }
+        } else {
+            t2 = t;
+            i2 = id;
+        }
+    }
+    next[0] = i0;
+    next[1] = i1;
+    next[2] = i2;
+}
+
 /* Ask the memory system for id's entry ahead of a gr_cq_update of it.  A macro: GCC
  * deletes calls to a function that does nothing but prefetch. */
 #if defined(__GNUC__) || defined(__clang__)
 #define GR_CQ_PREFETCH(q, id) __builtin_prefetch(&(q)->item[(id)])
+#define GR_CQ_PREFETCH_HEAD(q, slot) __builtin_prefetch(&(q)->head[(slot)])
 #else
 #define GR_CQ_PREFETCH(q, id) ((void)(q), (void)(id))
+#define GR_CQ_PREFETCH_HEAD(q, slot) ((void)(q), (void)(slot))
 #endif
+
+/* Ask for the bucket list head that a key t would go to (a miss at large N, whose load
+ * then overlaps the caller's work before its gr_cq_update). */
+static inline void gr_cq_prefetch_key(const gr_cq *q, double t)
+{
+    const double x = (t - q->t0) * q->inv_w;
+    if (x >= 0.0 && x < 4611686018427387904.0) {
+        const int64_t b = (int64_t)x;
+        if (b > q->cur && b < q->over_from) GR_CQ_PREFETCH_HEAD(q, b & (q->nb - 1));
+    }
+}
 
 /* After the caller renumbered its ids (id i is now newpos[i], a permutation): move
  * every key along. */

@@ -8,11 +8,6 @@
 #include "cells.h"
 #include "hugemem.h"
 
-/* Cell heads beyond this many bytes are taken as out of cache, and scans ask for the
- * occupied cells' heads ahead.  In cache the extra loop only costs (cachegrind, 2D
- * N = 1e4 with 196 kB of heads: 0.4 fewer mispredicted branches per event without it);
- * at 3D N = 1e5 (3.2 MB) it saves time. */
-#define GR_HEADS_CACHED ((size_t)1 << 20)
 
 /* Cells per axis: at least `width` wide, and not more cells than a few per particle (a
  * dilute gas in a big box must not allocate a huge empty grid; wider cells are always

@@ -17,6 +17,13 @@
 
 #include "common.h"
 
+/* Cell heads beyond this many bytes are taken as out of cache, and scans ask for the
+ * occupied cells' heads ahead.  In cache the extra loop only costs (cachegrind, 2D
+ * N = 1e4 with 196 kB of heads: 0.4 fewer mispredicted branches per event without it);
+ * at 3D N = 1e5 (3.2 MB) it saves time.  The event loop then also prefetches events
+ * ahead (edmd.c). */
+#define GR_HEADS_CACHED ((size_t)1 << 20)
+
 typedef struct {
     int nc[3];            /* cells per axis (1 beyond dim) */
     double w[3];          /* cell widths */

@@ -116,6 +116,61 @@ static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
     keep_pair(s, dim, i, best, partner);
 }
 
+/* Cell mode, at large N, prefetching events ahead: the cells the next event of i will
+ * scan (i's scheduling state must be at hand) -- the layer newly adjacent to the cell a
+ * crossing enters, or every adjacent cell before a collision -- as a base cell and
+ * offsets (away from the box edge only, the common case: returns 0 elsewhere). */
+static inline int next_scan(const gr_edmd *s, int dim, int32_t i, int32_t *base,
+                            const int32_t **off)
+{
+    const gr_cells *g = &s->cells;
+    const gr_sched *e = &s->sched[i];
+    int32_t c[3] = {e->c[0], e->c[1], e->c[2]};
+    int count = dim == 3 ? 27 : 9;
+    *off = g->off_all;
+    if (e->cross < 0) return 0;
+    if (e->t_cross < e->t_coll) {
+        const int a = e->cross >> 1, up = e->cross & 1;
+        c[a] += up ? 1 : -1;
+        *off = g->off_layer[2 * a + up];
+        count = dim == 3 ? 9 : 3;
+    }
+    if (!cell_interior(g, dim, c)) return 0;
+    *base = cell_of(g, dim, c);
+    return count;
+}
+
+/* Two events ahead: ask for the heads of the occupied cells i's next event will scan
+ * (and of the cell a crossing enters), and note those cells for prefetch_firsts. */
+static inline void prefetch_heads(gr_edmd *s, int dim, int32_t i)
+{
+    int32_t base;
+    const int32_t *off;
+    const int count = next_scan(s, dim, i, &base, &off);
+    int m = 0;
+    if (count) GR_PREFETCH(&s->cells.head[base]);
+    for (int k = 0; k < count; k++) {
+        const int32_t cell = base + off[k];
+        s->ahead_cells[m] = cell;
+        m += cell_occupied(&s->cells, cell);
+    }
+    for (int k = 0; k < m; k++) GR_PREFETCH(&s->cells.head[s->ahead_cells[k]]);
+    s->ahead_m = m;
+}
+
+/* One event ahead, the heads asked for by prefetch_heads being at hand: ask for the
+ * first particle of each of those cells (most hold one at most; a cell emptied since
+ * has head -1). */
+static inline void prefetch_firsts(const gr_edmd *s)
+{
+    for (int k = 0; k < s->ahead_m; k++) {
+        const int32_t j = s->cells.head[s->ahead_cells[k]];
+        if (j < 0) continue;
+        GR_PREFETCH(rec(s, j));
+        GR_PREFETCH(&s->cells.next[j]);
+    }
+}
+
 /* Cell mode, big particle i: the cells within its reach, the block of R cells each way
  * (axis < 0), or the layer of it newly reached after crossing along `axis` in direction
  * `dir`.  gr_big_choose keeps the block narrower than the box, so a periodic block never

@@ -216,6 +216,22 @@ def test_renumbering_large_systems_continue_bit_for_bit(tmp_path):
     assert sim.stats["events"] > 3 * 16 * 5000 and sim.time > t1
 
 
+def test_a_grid_out_of_cache_continues_bit_for_bit(tmp_path):
+    """A cell grid past _core.HEADS_CACHED bytes: the event loop prefetches events ahead
+    and its queue keeps more keys at hand (calendar.h's depth), state a checkpoint must
+    carry exactly."""
+    n = 40_000
+    scene = Scene.random(n, (0.05 / (n * 4 / 3 * math.pi)) ** (1 / 3), restitution=0.9, seed=14)
+    sim = Simulation(scene)
+    assert 4 * math.prod(sim.stats["cells"]) > _core.HEADS_CACHED
+    sim.run(stop_when={"events": 100_000})
+    sim.save(tmp_path / "grid.ckpt")
+    loaded = Simulation.load(tmp_path / "grid.ckpt")
+    budget = {"events": 200_000}
+    _assert_same_trajectory(sim.run(stop_when=budget), loaded.run(stop_when=budget))
+    _assert_same_state(sim, loaded)
+
+
 def test_saving_changes_nothing_and_a_split_run_equals_one_run(tmp_path):
     """Saving only reads the engine; and stopping at t1 does not perturb the dynamics, so
     run(t1), save, load, run(t2) equals a single run(t2) of a Simulation that never
