@@ -492,7 +492,7 @@ static inline void predict_wall(gr_edmd *s, int dim, int32_t i)
 }
 
 /* Cell mode: next cell crossing of i from its current position, cell and velocity. */
-static inline void predict_cross(gr_edmd *s, int dim, int32_t i)
+static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dim, int32_t i, const int periodic)
 {
     /* Without branches on the signs of the velocity: they differ from one event to the
      * next at random, and a mispredicted branch costs more than the arithmetic. */
@@ -504,18 +504,27 @@ static inline void predict_cross(gr_edmd *s, int dim, int32_t i)
     for (int a = 0; a < dim; a++) {
         const double v = VEL(p, dim)[a];
         const int up = v > 0.0;
-        /* a wall has no cell behind it */
-        const int open = s->cfg.periodic | (up & (c[a] < g->nc[a] - 1)) | (!up & (c[a] > 0));
         const double bound = s->cfg.lo[a] + (c[a] + up) * g->w[a];
         double dt = (bound - p[a]) / (v != 0.0 ? v : 1.0);
         dt = dt < 0.0 ? 0.0 : dt; /* rounding left it a hair past the boundary */
-        dt = (v != 0.0) & open ? dt : INFINITY;
+        int open = v != 0.0;
+        if (!periodic) /* a wall has no cell behind it */
+            open &= (up & (c[a] < g->nc[a] - 1)) | (!up & (c[a] > 0));
+        dt = open ? dt : INFINITY;
         const int32_t earlier = dt < best;
         code += earlier * (2 * a + up - code); /* arithmetic: a select compiles to a branch */
         best = earlier ? dt : best;
     }
     s->sched[i].t_cross = TIME(p, dim) + best;
     s->sched[i].cross = (int8_t)code;
+}
+
+/* Compiled apart for periodic boxes, which have no walls to test for (3D, N = 1e3: 1365
+ * -> 1287 instructions an event). */
+static inline void predict_cross(gr_edmd *s, int dim, int32_t i)
+{
+    if (s->cfg.periodic) predict_cross_in(s, dim, i, 1);
+    else predict_cross_in(s, dim, i, 0);
 }
 
 /* ---- the start ---- */
