@@ -235,6 +235,8 @@ static inline void set_centre(gr_edmd *s, int dim, int32_t i)
     cell_coords(&s->cells, dim, p, s->sched[i].c);
 }
 
+static int link_all(gr_edmd *s, int dim, int32_t i, int32_t m, gr_error *err);
+
 /* List mode: list i and every particle whose centre is within r_i + r_j + 2 delta of
  * i's (only those numbered above i if `above`: building all lists at once). */
 static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
@@ -242,11 +244,32 @@ static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
     const gr_cells *g = &s->cells;
     const double *ci = s->nl.centre + (size_t)i * (dim + 1);
     const double reach = ci[dim] + 2.0 * s->nl.shell;
-    gr_nbr nb[27];
-    const int count = cell_neighbours(g, dim, s->sched[i].c, -1, 0, nb);
     /* first the new neighbours, kept or not without a branch (about one candidate in
      * six is kept: as good as random) */
     int32_t m = 0, *near = s->nl.near;
+    if (cell_interior(g, dim, s->sched[i].c)) {
+        /* away from the box edge (the common case): no image shifts, no wrapping */
+        const int32_t base = cell_of(g, dim, s->sched[i].c);
+        const int32_t code = dim == 3 ? 13 : 4; /* no shift on any axis */
+        for (int k = 0; k < (dim == 3 ? 27 : 9); k++) {
+            const int32_t cell = base + g->off_all[k];
+            if (!cell_occupied(g, cell)) continue;
+            for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
+                const double *cj = s->nl.centre + (size_t)j * (dim + 1);
+                double d2 = 0.0;
+                for (int a = 0; a < dim; a++) {
+                    const double d = cj[a] - ci[a];
+                    d2 += d * d;
+                }
+                const double cut = cj[dim] + reach;
+                near[m] = (j << GR_NL_BITS) | code;
+                m += (d2 < cut * cut) & (j != i) & (!above | (j > i));
+            }
+        }
+        return link_all(s, dim, i, m, err);
+    }
+    gr_nbr nb[27];
+    const int count = cell_neighbours(g, dim, s->sched[i].c, -1, 0, nb);
     for (int k = 0; k < count; k++) {
         int32_t code = 0;
         for (int a = dim - 1; a >= 0; a--)
@@ -263,6 +286,13 @@ static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
             m += (d2 < cut * cut) & (j != i) & (!above | (j > i));
         }
     }
+    return link_all(s, dim, i, m, err);
+}
+
+/* List mode: link i with the m neighbours link_near found (in s->nl.near). */
+static int link_all(gr_edmd *s, int dim, int32_t i, int32_t m, gr_error *err)
+{
+    const int32_t *near = s->nl.near;
     for (int32_t k = 0; k < m; k++) {
         int status = nl_link(&s->nl, dim, s->n, s->sched, i, near[k] >> GR_NL_BITS,
                              near[k] & GR_NL_CODE_MASK);
