@@ -112,8 +112,9 @@ static inline int cell_interior(const gr_cells *g, int dim, const int32_t *c)
  * Returns the count.  The general way, for cells at the box edge: every candidate cell
  * is looked at in a loop of fixed length and kept or not without a branch, because
  * which of them are occupied, or beyond a wall, is as good as random. */
-static inline int cell_neighbours(const gr_cells *g, int dim, const int32_t *c, int axis,
-                                  int dir, gr_nbr *out)
+static GR_ALWAYS_INLINE int cell_neighbours_in(const gr_cells *g, int dim, const int32_t *c,
+                                               int axis, int dir, gr_nbr *out,
+                                               const int periodic)
 {
     /* the offsets along each axis: -1, 0, 1, or along `axis` only dir (three times) */
     int d[3][3];
@@ -129,7 +130,8 @@ static inline int cell_neighbours(const gr_cells *g, int dim, const int32_t *c, 
             const double sh1 = g->nb_shift[1][3 * c[1] + d[1][k1] + 1];
             for (int k0 = 0; k0 < n0; k0++) {
                 const int32_t q0 = g->nb_cell[0][3 * c[0] + d[0][k0] + 1];
-                const int inside = (q0 >= 0) & (q1 >= 0) & (q2 >= 0); /* not beyond a wall */
+                /* not beyond a wall (a periodic box has none) */
+                const int inside = periodic | ((q0 >= 0) & (q1 >= 0) & (q2 >= 0));
                 const int32_t cell = inside ? (q2 * g->nc[1] + q1) * g->nc[0] + q0 : 0;
                 out[m].cell = cell;
                 out[m].shift[0] = g->nb_shift[0][3 * c[0] + d[0][k0] + 1];
@@ -140,6 +142,15 @@ static inline int cell_neighbours(const gr_cells *g, int dim, const int32_t *c, 
         }
     }
     return m;
+}
+
+/* Compiled apart for periodic boxes, where no neighbour lies beyond a wall (3D,
+ * N = 1e3, where 27 % of the cells are at the edge: 1287 -> 1204 instructions an event). */
+static inline int cell_neighbours(const gr_cells *g, int dim, const int32_t *c, int axis,
+                                  int dir, gr_nbr *out)
+{
+    return g->periodic ? cell_neighbours_in(g, dim, c, axis, dir, out, 1)
+                       : cell_neighbours_in(g, dim, c, axis, dir, out, 0);
 }
 
 #endif

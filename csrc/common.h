@@ -28,6 +28,14 @@ typedef struct {
     const char *what;  /* static string describing the problem, or NULL */
 } gr_error;
 
+/* For the few helpers whose inlined copies must each see constant arguments (a
+ * dimension, a periodic flag) to be compiled apart. */
+#if defined(__GNUC__) || defined(__clang__)
+#define GR_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define GR_ALWAYS_INLINE inline
+#endif
+
 static inline void gr_error_set(gr_error *e, int code, int64_t i, int64_t j, double t,
                                 double value, const char *what)
 {

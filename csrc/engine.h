@@ -69,14 +69,11 @@ struct gr_edmd {
 /* Prefetching: at large N the particle an event touches is a cache miss in every
  * per-particle array; asking for them one event ahead (and for a pair's partner before
  * the first of them is used) overlaps those misses with useful work.  A hint only:
- * compilers without the builtin lose speed, not correctness.  GR_ALWAYS_INLINE for the
- * few helpers whose inlined copies must each see constant arguments. */
+ * compilers without the builtin lose speed, not correctness. */
 #if defined(__GNUC__) || defined(__clang__)
 #define GR_PREFETCH(p) __builtin_prefetch(p)
-#define GR_ALWAYS_INLINE inline __attribute__((always_inline))
 #else
 #define GR_PREFETCH(p) ((void)(p))
-#define GR_ALWAYS_INLINE inline
 #endif
 
 /* the parts of record p, for dimension dim */
