@@ -57,22 +57,25 @@ int gr_cells_build(gr_cells *g, int dim, int32_t n, const double *lo, const doub
     }
     g->head = gr_big_alloc((size_t)g->ncells * sizeof *g->head);
     g->prefetch_heads = (size_t)g->ncells * sizeof *g->head > GR_HEADS_CACHED;
-    g->occ = calloc(((size_t)g->ncells + 63) / 64, sizeof *g->occ);
+    g->occ = calloc(cell_occ_words(g->ncells), sizeof *g->occ);
     g->next = gr_big_alloc((size_t)n * sizeof *g->next);
     g->prev = gr_big_alloc((size_t)n * sizeof *g->prev);
     if (!g->head || !g->occ || !g->next || !g->prev) return GR_ERR_NOMEM;
     for (int32_t c = 0; c < g->ncells; c++) g->head[c] = -1;
     int k_all = 0, k_layer[6] = {0, 0, 0, 0, 0, 0};
+    int r_all = 0, r_layer[6] = {0, 0, 0, 0, 0, 0};
     for (int d2 = (dim == 3 ? -1 : 0); d2 <= (dim == 3 ? 1 : 0); d2++)
         for (int d1 = -1; d1 <= 1; d1++)
             for (int d0 = -1; d0 <= 1; d0++) {
                 int32_t off = d0 + g->nc[0] * (d1 + g->nc[1] * d2);
                 int dd[3] = {d0, d1, d2};
                 g->off_all[k_all++] = off;
+                if (d0 == 0) g->row_all[r_all++] = off;
                 for (int a = 0; a < dim; a++)
                     if (dd[a] != 0) {
                         int layer = 2 * a + (dd[a] > 0);
                         g->off_layer[layer][k_layer[layer]++] = off;
+                        if (a > 0 && d0 == 0) g->row_layer[layer][r_layer[layer]++] = off;
                     }
             }
     for (int a = 0; a < dim; a++) {
@@ -100,7 +103,7 @@ int gr_cells_build(gr_cells *g, int dim, int32_t n, const double *lo, const doub
 void gr_cells_clear(gr_cells *g)
 {
     for (int32_t c = 0; c < g->ncells; c++) g->head[c] = -1;
-    memset(g->occ, 0, ((size_t)g->ncells + 63) / 64 * sizeof *g->occ);
+    memset(g->occ, 0, cell_occ_words(g->ncells) * sizeof *g->occ);
 }
 
 void gr_cells_free(gr_cells *g)

@@ -41,6 +41,11 @@ typedef struct {
      * the layer newly adjacent after a crossing along axis a in direction up/down. */
     int32_t off_all[27];
     int32_t off_layer[6][9];
+    /* The same cells as rows of three along x, by the offset of each row's middle cell
+     * (the layers across y and z; a layer across x has no such rows), in the same order:
+     * a scan reads a row's occupancy in one go (cell_row). */
+    int32_t row_all[9];
+    int32_t row_layer[6][3];
 } gr_cells;
 
 /* An occupied cell next to another and the image shift to add to positions found there. */
@@ -69,6 +74,18 @@ static inline int32_t cell_of(const gr_cells *g, int dim, const int32_t *c)
 static inline int cell_occupied(const gr_cells *g, int32_t c)
 {
     return (int)((g->occ[c >> 6] >> (c & 63)) & 1);
+}
+
+/* 64-bit words of occupancy bits for ncells cells, with one to spare: cell_row reads
+ * the word after the last cell's. */
+static inline size_t cell_occ_words(int32_t ncells) { return ((size_t)ncells + 63) / 64 + 1; }
+
+/* The occupancy of cells mid - 1, mid, mid + 1 (mid >= 1) as bits 0, 1, 2. */
+static inline unsigned cell_row(const gr_cells *g, int32_t mid)
+{
+    const uint32_t k = (uint32_t)mid - 1, sh = k & 63;
+    const uint64_t lo = g->occ[k >> 6], hi = g->occ[(k >> 6) + 1];
+    return (unsigned)(((lo >> sh) | (hi << (63 - sh) << 1)) & 7);
 }
 
 static inline void cell_insert(gr_cells *g, int32_t i, int32_t c)

@@ -325,7 +325,7 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     t->cells.head = gr_big_alloc((size_t)s->cells.ncells * sizeof(int32_t));
     t->cells.next = gr_big_alloc(n * sizeof(int32_t));
     t->cells.prev = gr_big_alloc(n * sizeof(int32_t));
-    t->cells.occ = calloc(((size_t)s->cells.ncells + 63) / 64, sizeof(uint64_t));
+    t->cells.occ = calloc(cell_occ_words(s->cells.ncells), sizeof(uint64_t));
     const int lists = s->nl.shell > 0.0;
     t->nl.centre = lists ? gr_big_alloc(n * (d + 1) * sizeof(double)) : NULL;
     t->nl.rows = lists ? gr_big_alloc(n * (size_t)cap * sizeof(int32_t)) : NULL;

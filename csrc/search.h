@@ -90,19 +90,35 @@ static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
         scan_block(s, dim, i, axis, dir, &best, &partner);
     } else if (cell_interior(g, dim, c)) {
         const int32_t base = cell_of(g, dim, c);
-        const int32_t *off = axis < 0 ? g->off_all : g->off_layer[2 * axis + (dir > 0)];
-        const int count = axis < 0 ? (dim == 3 ? 27 : 9) : (dim == 3 ? 9 : 3);
+        /* the occupied cells, kept or not without a branch (which are occupied is as
+         * good as random), read a row of three at a time where the cells form rows */
+        int32_t full[27];
+        int m = 0;
+        if (axis == 0) {
+            const int32_t *off = g->off_layer[dir > 0];
+            for (int k = 0; k < (dim == 3 ? 9 : 3); k++) {
+                const int32_t cell = base + off[k];
+                full[m] = cell;
+                m += cell_occupied(g, cell);
+            }
+        } else {
+            const int32_t *row = axis < 0 ? g->row_all : g->row_layer[2 * axis + (dir > 0)];
+            const int rows = axis < 0 ? (dim == 3 ? 9 : 3) : (dim == 3 ? 3 : 1);
+            for (int k = 0; k < rows; k++) {
+                const int32_t mid = base + row[k];
+                const unsigned bits = cell_row(g, mid);
+                full[m] = mid - 1;
+                m += bits & 1;
+                full[m] = mid;
+                m += (bits >> 1) & 1;
+                full[m] = mid + 1;
+                m += bits >> 2;
+            }
+        }
         /* in a grid too large for the cache, the occupied cells' heads first, all at
          * once: they are misses, and the chained loads of the scan would otherwise wait
          * for them one by one (in a small grid the loop costs more than it saves: its
          * length, the number of occupied cells, is a branch mispredicted often) */
-        int32_t full[27];
-        int m = 0;
-        for (int k = 0; k < count; k++) {
-            int32_t cell = base + off[k];
-            full[m] = cell;
-            m += cell_occupied(g, cell);
-        }
         if (g->prefetch_heads)
             for (int k = 0; k < m; k++) GR_PREFETCH(&g->head[full[k]]);
         for (int k = 0; k < m; k++) scan_cell(s, dim, i, p, full[k], NULL, &best, &partner);
