@@ -20,6 +20,8 @@ enum { GR_CQ_LIST = -1, GR_CQ_OVER = -2, GR_CQ_NONE = -3 };
  * (mean time to a key) / (nb w) ~ n / (GR_CQ_PER_BUCKET nb): 4 slots per id keep it
  * near 1/8 for 16 bytes per id. */
 #define GR_CQ_SLOTS_PER_ID 4
+/* Key changes per id between rebuilds, at first (see rebuild()). */
+#define GR_CQ_REBUILD 4
 /* Keys sampled to estimate their spread when choosing the width. */
 #define GR_CQ_SAMPLE 1024
 /* Beyond this, bucket numbers saturate (a key that far ahead only needs to be in the
@@ -198,6 +200,7 @@ static void rebuild(gr_cq *q)
             w = GR_CQ_PER_BUCKET * spread / nf;
         }
     }
+    const double inv_w_before = q->inv_w;
     q->inv_w = 1.0 / w;
     if (!(w > 0.0) || !isfinite(q->inv_w)) q->inv_w = 1.0; /* all keys equal: any width */
     memset(q->head, 0xff, (size_t)q->nb * sizeof *q->head); /* every byte 0xff: -1 */
@@ -214,8 +217,17 @@ static void rebuild(gr_cq *q)
         else if (t != INFINITY) place(q, id);
     }
     q->changes = 0;
-    /* no keys yet: rebuild once the caller has set them */
-    q->rebuild_at = nf > 0 ? 4 * (int64_t)n + 64 : 0;
+    /* No keys yet: rebuild once the caller has set them.  Else after GR_CQ_REBUILD n key
+     * changes; while the width comes out within 20 % of the last one (a gas in a steady
+     * state) the interval doubles, up to 16 times that, and it starts again at the first
+     * width that has moved (a gas that cools or heats is rebuilt as often as before).  A
+     * rebuild reads every key and, at large N, misses on most of them. */
+    const int64_t first = GR_CQ_REBUILD * (int64_t)n + 64;
+    const double moved = q->inv_w / inv_w_before;
+    if (nf == 0) q->rebuild_at = 0;
+    else if (q->rebuild_at >= first && moved > 1.0 / 1.2 && moved < 1.2)
+        q->rebuild_at = q->rebuild_at < 8 * first ? 2 * q->rebuild_at : 16 * first;
+    else q->rebuild_at = first;
 }
 
 int gr_cq_init(gr_cq *q, int32_t n)

@@ -9,7 +9,8 @@
  * in one overflow list.  A change of key is an unlink and a push, O(1); the near heap is
  * refilled from the next bucket when it runs empty.  w is chosen from the spread of the
  * keys whenever the queue is rebuilt (so that a bucket holds a few keys), and the queue
- * rebuilds itself every few N key changes, so it follows a system that cools or heats.
+ * rebuilds itself every 4 N key changes (up to 64 N while the width holds), so it follows
+ * a system that cools or heats.
  *
  * Invariants (cur = the current bucket number, over_from = the first bucket number of
  * the overflow, cur < over_from <= cur + nb, bucket(t) = floor((t - t0) / w)):
