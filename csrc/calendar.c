@@ -24,9 +24,6 @@ enum { GR_CQ_LIST = -1, GR_CQ_OVER = -2, GR_CQ_NONE = -3 };
 #define GR_CQ_REBUILD 4
 /* Keys sampled to estimate their spread when choosing the width. */
 #define GR_CQ_SAMPLE 1024
-/* Beyond this, bucket numbers saturate (a key that far ahead only needs to be in the
- * overflow; saturation keeps bucket() monotonic and avoids an overflowing conversion). */
-#define GR_CQ_FAR 4611686018427387904.0 /* 2^62 */
 
 /* Monotonic non-decreasing in t, which is all the ordering needs; truncation rather
  * than floor (keys before t0 share bucket 0, harmlessly). */
@@ -234,6 +231,8 @@ int gr_cq_init(gr_cq *q, int32_t n)
 {
     q->n = n;
     q->depth = 1;
+    q->inv_w = 1.0;     /* rebuild() compares the width it finds with these */
+    q->rebuild_at = 0;
     q->nb = 16;
     while (q->nb < GR_CQ_SLOTS_PER_ID * (int64_t)n && q->nb < (1 << 30)) q->nb <<= 1;
     q->item = gr_big_alloc((size_t)n * sizeof *q->item);

@@ -26,6 +26,10 @@
 #include <math.h>
 #include <stdint.h>
 
+/* Beyond this, bucket numbers saturate (a key that far ahead only needs to be in the
+ * overflow; saturation keeps bucket() monotonic and avoids an overflowing conversion). */
+#define GR_CQ_FAR 4611686018427387904.0 /* 2^62 */
+
 typedef struct {
     double t;       /* key */
     int32_t next;   /* links in a bucket or overflow list, -1 at the ends */
@@ -138,7 +142,7 @@ static inline void gr_cq_ahead(const gr_cq *q, int32_t next[GR_CQ_AHEAD])
 static inline void gr_cq_prefetch_key(const gr_cq *q, double t)
 {
     const double x = (t - q->t0) * q->inv_w;
-    if (x >= 0.0 && x < 4611686018427387904.0) {
+    if (x >= 0.0 && x < GR_CQ_FAR) {
         const int64_t b = (int64_t)x;
         if (b > q->cur && b < q->over_from) GR_CQ_PREFETCH_HEAD(q, b & (q->nb - 1));
     }
