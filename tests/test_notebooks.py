@@ -11,10 +11,9 @@ nbclient = pytest.importorskip("nbclient")
 NOTEBOOKS = sorted((Path(__file__).parent.parent / "notebooks").glob("*.ipynb"))
 # A run's saved text (everything but images and widget state): the notebooks print tables of a
 # few kB (10.2 kB for notebook 02, the largest, since its tables gained the viscoelastic and
-# Langevin rows; the digits of its numbers move it by tens of bytes from one engine change to
-# the next). tqdm without ipywidgets writes text bars instead of widgets, a line every 0.1 s
-# into the saved output (1.4 MB in notebook 02 at full size): the limit is there to catch
-# those, at twice the largest table.
+# Langevin rows: a 10 kB limit failed on it). tqdm without ipywidgets writes text bars
+# instead of widgets, a line every 0.1 s into the saved output (1.4 MB in notebook 02 at full
+# size): the limit is there to catch those, at twice the largest table.
 TEXT_LIMIT = 20_000  # bytes per notebook
 COMMITTED_LIMIT = 20_000  # bytes per committed (stripped) .ipynb; all are under 6 kB
 
