@@ -76,6 +76,20 @@ static inline int cell_occupied(const gr_cells *g, int32_t c)
     return (int)((g->occ[c >> 6] >> (c & 63)) & 1);
 }
 
+/* The occupied ones among the count cells base + off[k], in that order, written to out
+ * without a branch (which are occupied is as good as random); returns how many. */
+static inline int cells_occupied(const gr_cells *g, int32_t base, const int32_t *off,
+                                 int count, int32_t *out)
+{
+    int m = 0;
+    for (int k = 0; k < count; k++) {
+        const int32_t cell = base + off[k];
+        out[m] = cell;
+        m += cell_occupied(g, cell);
+    }
+    return m;
+}
+
 /* 64-bit words of occupancy bits for ncells cells, with one to spare: cell_row reads
  * the word after the last cell's. */
 static inline size_t cell_occ_words(int32_t ncells) { return ((size_t)ncells + 63) / 64 + 1; }

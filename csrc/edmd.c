@@ -142,7 +142,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
         s->events++;
         gr_sched *e = &s->sched[i];
         if (s->lookahead) prefetch_ahead(s, dim);
-        if (s->order.scratch) { /* a system large enough to renumber: out of L2 */
+        if (s->n >= GR_RENUMBER_MIN_N) { /* below, everything sits in L2 */
             int32_t h = gr_cq_hint(&s->queue);
             if (h >= 0) PREFETCH_PARTICLE(s, h);
             if (e->t_coll <= e->t_cross && e->partner >= 0) PREFETCH_PARTICLE(s, e->partner);

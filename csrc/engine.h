@@ -40,7 +40,7 @@ struct gr_edmd {
     gr_big big;           /* none with lists */
     gr_nlist nl;          /* nl.shell == 0: cell-crossing mode */
     gr_renumbering order;
-    int lookahead;        /* prefetch two events ahead (cells, large grid) */
+    int lookahead;        /* prefetch three events ahead (cells, large grid) */
     int32_t foreseen[2];  /* the particles whose heads and state were asked for ahead */
     int32_t ahead_cells[27], ahead_m; /* the occupied cells foreseen[0]'s event scans */
 

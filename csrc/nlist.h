@@ -44,6 +44,9 @@ typedef struct {
     double img[32][3];/* image code -> shift, code = sum over axes of (s_a + 1) 3^a */
 } gr_nlist;
 
+/* The image code of no shift on any axis (every s_a = 0): the middle of the 3^dim. */
+#define GR_NL_CODE_NONE(dim) ((dim) == 3 ? 13 : 4)
+
 /* Lists with a shell delta (> 0) for n particles in a box of sides L.  GR_OK or
  * GR_ERR_NOMEM. */
 int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *L);
@@ -66,7 +69,7 @@ static inline int nl_link(gr_nlist *nl, int dim, int32_t n, gr_sched *sched, int
         int status = gr_nlist_grow(nl, n, sched);
         if (status != GR_OK) return status;
     }
-    const int32_t opposite = (dim == 3 ? 26 : 8) - code;
+    const int32_t opposite = 2 * GR_NL_CODE_NONE(dim) - code; /* every s_a negated */
     nl_row(nl, i)[sched[i].nn++] = (j << GR_NL_BITS) | code;
     nl_row(nl, j)[sched[j].nn++] = (i << GR_NL_BITS) | opposite;
     return GR_OK;

@@ -95,12 +95,7 @@ static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
         int32_t full[27];
         int m = 0;
         if (axis == 0) {
-            const int32_t *off = g->off_layer[dir > 0];
-            for (int k = 0; k < (dim == 3 ? 9 : 3); k++) {
-                const int32_t cell = base + off[k];
-                full[m] = cell;
-                m += cell_occupied(g, cell);
-            }
+            m = cells_occupied(g, base, g->off_layer[dir > 0], dim == 3 ? 9 : 3, full);
         } else {
             const int32_t *row = axis < 0 ? g->row_all : g->row_layer[2 * axis + (dir > 0)];
             const int rows = axis < 0 ? (dim == 3 ? 9 : 3) : (dim == 3 ? 3 : 1);
@@ -163,13 +158,8 @@ static inline void prefetch_heads(gr_edmd *s, int dim, int32_t i)
     int32_t base;
     const int32_t *off;
     const int count = next_scan(s, dim, i, &base, &off);
-    int m = 0;
     if (count) GR_PREFETCH(&s->cells.head[base]);
-    for (int k = 0; k < count; k++) {
-        const int32_t cell = base + off[k];
-        s->ahead_cells[m] = cell;
-        m += cell_occupied(&s->cells, cell);
-    }
+    const int m = cells_occupied(&s->cells, base, off, count, s->ahead_cells);
     for (int k = 0; k < m; k++) GR_PREFETCH(&s->cells.head[s->ahead_cells[k]]);
     s->ahead_m = m;
 }
@@ -253,6 +243,31 @@ static inline void set_centre(gr_edmd *s, int dim, int32_t i)
 
 static int link_all(gr_edmd *s, int dim, int32_t i, int32_t m, gr_error *err);
 
+/* List mode, for link_near: append to s->nl.near (m entries so far) every particle j of
+ * one cell, seen through an image shift (NULL: none) with image code `code`, whose centre
+ * is within cj[dim] + reach of ci; kept or not without a branch (about one candidate in
+ * six is kept: as good as random).  Returns the new count. */
+static GR_ALWAYS_INLINE int32_t near_in_cell(const gr_edmd *s, int dim, int32_t i,
+                                             const double *ci, double reach, int32_t cell,
+                                             const double *shift, int32_t code, int above,
+                                             int32_t m)
+{
+    const gr_cells *g = &s->cells;
+    int32_t *near = s->nl.near;
+    for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
+        const double *cj = s->nl.centre + (size_t)j * (dim + 1);
+        double d2 = 0.0;
+        for (int a = 0; a < dim; a++) {
+            const double d = (shift ? cj[a] + shift[a] : cj[a]) - ci[a];
+            d2 += d * d;
+        }
+        const double cut = cj[dim] + reach;
+        near[m] = (j << GR_NL_BITS) | code;
+        m += (d2 < cut * cut) & (j != i) & (!above | (j > i));
+    }
+    return m;
+}
+
 /* List mode: list i and every particle whose centre is within r_i + r_j + 2 delta of
  * i's (only those numbered above i if `above`: building all lists at once). */
 static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
@@ -260,27 +275,15 @@ static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
     const gr_cells *g = &s->cells;
     const double *ci = s->nl.centre + (size_t)i * (dim + 1);
     const double reach = ci[dim] + 2.0 * s->nl.shell;
-    /* first the new neighbours, kept or not without a branch (about one candidate in
-     * six is kept: as good as random) */
-    int32_t m = 0, *near = s->nl.near;
+    /* first the new neighbours (near_in_cell), then the links */
+    int32_t m = 0;
     if (cell_interior(g, dim, s->sched[i].c)) {
         /* away from the box edge (the common case): no image shifts, no wrapping */
         const int32_t base = cell_of(g, dim, s->sched[i].c);
-        const int32_t code = dim == 3 ? 13 : 4; /* no shift on any axis */
         for (int k = 0; k < (dim == 3 ? 27 : 9); k++) {
             const int32_t cell = base + g->off_all[k];
-            if (!cell_occupied(g, cell)) continue;
-            for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
-                const double *cj = s->nl.centre + (size_t)j * (dim + 1);
-                double d2 = 0.0;
-                for (int a = 0; a < dim; a++) {
-                    const double d = cj[a] - ci[a];
-                    d2 += d * d;
-                }
-                const double cut = cj[dim] + reach;
-                near[m] = (j << GR_NL_BITS) | code;
-                m += (d2 < cut * cut) & (j != i) & (!above | (j > i));
-            }
+            if (cell_occupied(g, cell))
+                m = near_in_cell(s, dim, i, ci, reach, cell, NULL, GR_NL_CODE_NONE(dim), above, m);
         }
         return link_all(s, dim, i, m, err);
     }
@@ -290,17 +293,7 @@ static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
         int32_t code = 0;
         for (int a = dim - 1; a >= 0; a--)
             code = 3 * code + (nb[k].shift[a] > 0.0) - (nb[k].shift[a] < 0.0) + 1;
-        for (int32_t j = g->head[nb[k].cell]; j >= 0; j = g->next[j]) {
-            const double *cj = s->nl.centre + (size_t)j * (dim + 1);
-            double d2 = 0.0;
-            for (int a = 0; a < dim; a++) {
-                const double d = cj[a] + nb[k].shift[a] - ci[a];
-                d2 += d * d;
-            }
-            const double cut = cj[dim] + reach;
-            near[m] = (j << GR_NL_BITS) | code;
-            m += (d2 < cut * cut) & (j != i) & (!above | (j > i));
-        }
+        m = near_in_cell(s, dim, i, ci, reach, nb[k].cell, nb[k].shift, code, above, m);
     }
     return link_all(s, dim, i, m, err);
 }
