@@ -97,10 +97,9 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     int wall_status = copy_law(&s->cfg.wall_law); /* always: it drops the caller's pointers */
     if (status == GR_OK) status = wall_status;
     s->dim = d;
-    s->stride = 2 * d + 2;
     s->n = n;
     for (int a = 0; a < 3; a++) s->L[a] = a < d ? cfg->hi[a] - cfg->lo[a] : 1.0;
-    size_t bytes = ((size_t)n * s->stride * sizeof(double) + 63) / 64 * 64;
+    size_t bytes = ((size_t)n * GR_STRIDE(d) * sizeof(double) + 63) / 64 * 64;
     s->P = gr_big_alloc(bytes); /* records on cache-line boundaries: a 3D record is one line */
     s->mass = gr_big_alloc((size_t)n * sizeof *s->mass);
     s->image = calloc((size_t)n * d, sizeof *s->image);
@@ -140,7 +139,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
 
     double v2m = 0.0, msum = 0.0;
     for (int32_t i = 0; i < n; i++) {
-        double *p = rec(s, i);
+        double *p = rec(s, d, i);
         for (int a = 0; a < d; a++) {
             p[a] = pos[i * d + a];
             p[d + a] = vel[i * d + a];
@@ -164,7 +163,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->eps_t = vrms > 0.0 ? 1e-9 * sigma_min / vrms : 0.0;
     s->t_prev_event = -INFINITY;
 
-    status = gr_find_overlap(d, n, s->P, (size_t)s->stride, s->P + 2 * d + 1, (size_t)s->stride,
+    status = gr_find_overlap(d, n, s->P, (size_t)GR_STRIDE(d), s->P + 2 * d + 1, (size_t)GR_STRIDE(d),
                              cfg->periodic, s->L, &s->cells, &s->big, err);
     if (status == GR_OK) status = gr_predict_all(s, err);
     if (status != GR_OK) {

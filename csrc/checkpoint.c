@@ -126,7 +126,7 @@ static header header_of(const gr_edmd *s, size_t total)
     h.total = total;
     h.n = s->n;
     h.dim = s->dim;
-    h.stride = s->stride;
+    h.stride = GR_STRIDE(s->dim);
     h.lists = s->nl.shell > 0.0;
     h.nb = s->queue.nb;
     h.ncells = s->cells.ncells;
@@ -196,7 +196,7 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, s->order.next);
     IO(c, s->nl.broken);
 
-    io(c, s->P, (size_t)n * s->stride * sizeof *s->P);
+    io(c, s->P, (size_t)n * GR_STRIDE(s->dim) * sizeof *s->P);
     io(c, s->mass, (size_t)n * sizeof *s->mass);
     io(c, s->image, (size_t)n * d * sizeof *s->image);
     io(c, s->sched, (size_t)n * sizeof *s->sched);
@@ -313,7 +313,7 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     const size_t n = (size_t)s->n;
     const int d = s->dim;
     *t = *s;
-    t->P = gr_big_alloc((n * s->stride * sizeof(double) + 63) / 64 * 64);
+    t->P = gr_big_alloc((n * GR_STRIDE(s->dim) * sizeof(double) + 63) / 64 * 64);
     t->mass = gr_big_alloc(n * sizeof(double));
     t->image = calloc(n * d, sizeof(int64_t));
     t->sched = gr_big_alloc(n * sizeof(gr_sched));
@@ -394,7 +394,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
     int32_t big = 0;
     for (int32_t i = 0; i < n; i++) {
         const int32_t k = skel[t->order.id_of[i]];
-        if (!same_double(RAD(rec(t, i), d), RAD(rec(s, k), d)) ||
+        if (!same_double(RAD(rec(t, d, i), d), RAD(rec(s, d, k), d)) ||
             !same_double(t->mass[i], s->mass[k]) || t->big.is_big[i] != s->big.is_big[k])
             return "a particle's radius, mass or bigness differs from the scene's";
         big += t->big.is_big[i];
@@ -418,7 +418,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         t->t_prev_event != t->t_prev_event)
         return "its time or energy counters are not finite";
     for (int32_t i = 0; i < n; i++) {
-        const double *p = rec(t, i);
+        const double *p = rec(t, d, i);
         if (!(TIME(p, d) >= 0.0 && TIME(p, d) <= t->t)) return "a particle's clock is out of range";
         for (int k = 0; k < d; k++) {
             const double L = s->L[k];
@@ -444,7 +444,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         if (e->partner < -1 - 2 * d || e->partner >= n || e->last < -1 - 2 * d || e->last >= n)
             return "a particle's partner index is out of range";
         /* predictions are made from the particle's clock on (NaN is reported by the loop) */
-        const double clock = TIME(rec(t, i), d);
+        const double clock = TIME(rec(t, d, i), d);
         if (e->t_coll < clock || e->t_cross < clock) return "a particle's next event lies in its past";
         if (e->partner == -1 && e->t_coll != INFINITY)
             return "a particle has a collision time but no partner";

@@ -23,8 +23,11 @@
 static inline int gr_pair_beats(int dim, const double *dr, const double *dv, double sigma,
                                 double horizon, double *dt)
 {
-    double b = 0.0, dr2 = 0.0, dv2 = 0.0;
-    for (int a = 0; a < dim; a++) {
+    /* sums started from the first terms, not from 0.0: without -ffast-math the compiler
+     * must keep an addition of 0.0 (it turns -0.0 into +0.0), three more instructions
+     * for every candidate of every scan */
+    double b = dr[0] * dv[0], dr2 = dr[0] * dr[0], dv2 = dv[0] * dv[0];
+    for (int a = 1; a < dim; a++) {
         b += dr[a] * dv[a];
         dr2 += dr[a] * dr[a];
         dv2 += dv[a] * dv[a];

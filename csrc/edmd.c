@@ -32,13 +32,13 @@
 /* Everything an event of particle i is about to read or write, requested at once.  A
  * macro, not a function: GCC takes a function that only prefetches for one without
  * effects and deletes the calls (seen with GCC 12 at -O3: none of these was emitted). */
-#define PREFETCH_PARTICLE(s, i)                                                          \
+#define PREFETCH_PARTICLE(s, dim, i)                                                    \
     do {                                                                                \
-        GR_PREFETCH(rec((s), (i)));                                                      \
-        GR_PREFETCH(&(s)->sched[(i)]);                                                      \
-        GR_PREFETCH(&(s)->cells.next[(i)]);                                              \
-        GR_PREFETCH(&(s)->cells.prev[(i)]);                                              \
-        GR_CQ_PREFETCH(&(s)->queue, (i));                                                \
+        GR_PREFETCH(rec((s), (dim), (i)));                                              \
+        GR_PREFETCH(&(s)->sched[(i)]);                                                  \
+        GR_PREFETCH(&(s)->cells.next[(i)]);                                             \
+        GR_PREFETCH(&(s)->cells.prev[(i)]);                                             \
+        GR_CQ_PREFETCH(&(s)->queue, (i));                                               \
         if ((s)->nl.shell > 0.0) GR_PREFETCH(nl_row(&(s)->nl, (i)));                    \
     } while (0)
 
@@ -55,14 +55,14 @@ static GR_ALWAYS_INLINE void prefetch_ahead(gr_edmd *s, int dim)
 {
     int32_t ahead[GR_CQ_AHEAD];
     gr_cq_ahead(&s->queue, ahead);
-    if (ahead[0] >= 0 && ahead[0] == s->foreseen[0]) prefetch_firsts(s);
+    if (ahead[0] >= 0 && ahead[0] == s->foreseen[0]) prefetch_firsts(s, dim);
     s->ahead_m = 0;
     if (ahead[1] >= 0 && ahead[1] == s->foreseen[1]) {
         prefetch_heads(s, dim, ahead[1]);
         const gr_sched *f = &s->sched[ahead[1]];
-        if (f->t_coll <= f->t_cross && f->partner >= 0) PREFETCH_PARTICLE(s, f->partner);
+        if (f->t_coll <= f->t_cross && f->partner >= 0) PREFETCH_PARTICLE(s, dim, f->partner);
     }
-    if (ahead[2] >= 0) PREFETCH_PARTICLE(s, ahead[2]);
+    if (ahead[2] >= 0) PREFETCH_PARTICLE(s, dim, ahead[2]);
     s->foreseen[0] = ahead[1];
     s->foreseen[1] = ahead[2];
 }
@@ -144,8 +144,8 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
         if (s->lookahead) prefetch_ahead(s, dim);
         if (s->n >= GR_RENUMBER_MIN_N) { /* below, everything sits in L2 */
             int32_t h = gr_cq_hint(&s->queue);
-            if (h >= 0) PREFETCH_PARTICLE(s, h);
-            if (e->t_coll <= e->t_cross && e->partner >= 0) PREFETCH_PARTICLE(s, e->partner);
+            if (h >= 0) PREFETCH_PARTICLE(s, dim, h);
+            if (e->t_coll <= e->t_cross && e->partner >= 0) PREFETCH_PARTICLE(s, dim, e->partner);
         }
         int status = GR_OK;
         if (e->t_cross < e->t_coll) {
@@ -154,7 +154,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
         } else if (e->partner >= 0) {
             if (s->sched[e->partner].count != e->pcount) { /* partner collided since: stale */
                 s->invalid++;
-                move(dim, rec(s, i), te);
+                move(dim, rec(s, dim, i), te);
                 predict(s, dim, i);
                 continue;
             }
@@ -227,7 +227,7 @@ static inline double next_sample(const gr_edmd_samples *smp)
 
 static inline double kinetic_of(const gr_edmd *s, int dim, int32_t i)
 {
-    const double *v = VEL(rec(s, i), dim);
+    const double *v = VEL(rec(s, dim, i), dim);
     double v2 = 0.0;
     for (int a = 0; a < dim; a++) v2 += v[a] * v[a];
     return 0.5 * s->mass[i] * v2;
@@ -263,7 +263,7 @@ static double pair_law(const gr_edmd *s, int dim, const double *dr, const double
 static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
                                     double t, gr_error *err)
 {
-    double *p = rec(s, i), *q = rec(s, j);
+    double *p = rec(s, dim, i), *q = rec(s, dim, j);
     move(dim, p, t);
     move(dim, q, t);
     double dr[3];
@@ -316,7 +316,7 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, in
 static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall,
                                     double t, gr_error *err)
 {
-    double *p = rec(s, i), *v = VEL(p, dim);
+    double *p = rec(s, dim, i), *v = VEL(p, dim);
     const int a = wall >> 1, up = wall & 1;
     move(dim, p, t);
     double before = kinetic_of(s, dim, i), vn = v[a];
@@ -362,7 +362,7 @@ static void schedule(gr_edmd *s, int32_t i);
 /* Cell mode: i moves into the next cell, wrapping around a periodic box. */
 static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 {
-    double *p = rec(s, i);
+    double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
     int32_t *c = e->c;
     const int a = e->cross >> 1, dir = (e->cross & 1) ? 1 : -1;
@@ -399,7 +399,7 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t,
                                           gr_error *err)
 {
-    double *p = rec(s, i);
+    double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
     move(dim, p, t);
     const int32_t *row = nl_row(&s->nl, i);
@@ -445,7 +445,7 @@ static void predict(gr_edmd *s, int dim, int32_t i)
 {
     predict_wall(s, dim, i);
     if (s->nl.shell > 0.0) {
-        const double *p = rec(s, i);
+        const double *p = rec(s, dim, i);
         s->sched[i].t_cross = TIME(p, dim) + nl_exit_time(&s->nl, dim, p, VEL(p, dim),
                                                        s->nl.centre + (size_t)i * (dim + 1));
         scan_list(s, dim, i);
@@ -467,7 +467,7 @@ static inline void schedule(gr_edmd *s, int32_t i)
 /* i's next wall collision (none in a periodic box), replacing its prediction. */
 static inline void predict_wall(gr_edmd *s, int dim, int32_t i)
 {
-    const double *p = rec(s, i), *v = VEL(p, dim);
+    const double *p = rec(s, dim, i), *v = VEL(p, dim);
     gr_sched *e = &s->sched[i];
     e->t_coll = INFINITY;
     e->partner = -1;
@@ -497,7 +497,7 @@ static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dim, int32_t i, co
     /* Without branches on the signs of the velocity: they differ from one event to the
      * next at random, and a mispredicted branch costs more than the arithmetic. */
     const gr_cells *g = &s->cells;
-    const double *p = rec(s, i);
+    const double *p = rec(s, dim, i);
     const int32_t *c = s->sched[i].c;
     double best = INFINITY;
     int32_t code = -1;

@@ -1,7 +1,7 @@
 /* engine.h -- the inside of a gr_edmd, shared by the engine's C files (not by the
  * binding, which sees edmd.h only).
  *
- * A particle record is P[i*stride ...] = x[dim] v[dim] t r: position at the particle's
+ * A particle record is P[i*GR_STRIDE(dim) ...] = x[dim] v[dim] t r: position at the particle's
  * own time t, velocity, radius.  Times are absolute.  Functions take the dimension as
  * an argument `dim`; the event loop (edmd.c) is compiled once for dim = 2 and once for
  * dim = 3 (advance_2d, advance_3d), and the helpers it calls are inlined or cloned by
@@ -28,10 +28,10 @@ typedef struct {
 
 struct gr_edmd {
     gr_edmd_config cfg;
-    int dim, stride;      /* stride = doubles per particle record: x[dim] v[dim] t r */
+    int dim;
     int32_t n;
     double L[3];
-    double *P;            /* n * stride, 64-byte aligned */
+    double *P;            /* n records (rec), 64-byte aligned */
     double *mass;
     int64_t *image;       /* n * dim periodic image counters */
     gr_sched *sched;      /* n: each particle's scheduling state */
@@ -81,7 +81,16 @@ struct gr_edmd {
 #define TIME(p, dim) ((p)[2 * (dim)])
 #define RAD(p, dim) ((p)[2 * (dim) + 1])
 
-static inline double *rec(const gr_edmd *s, int32_t i) { return s->P + (size_t)i * s->stride; }
+/* doubles per particle record: x[dim] v[dim] t r */
+#define GR_STRIDE(dim) (2 * (dim) + 2)
+
+/* Particle i's record.  With dim a constant of the loop the stride is too: the address
+ * is a shift, not a multiplication waiting on a load of the stride (in the scans, that
+ * address is on the path from the list entry to the candidate's data). */
+static inline double *rec(const gr_edmd *s, int dim, int32_t i)
+{
+    return s->P + (size_t)i * GR_STRIDE(dim);
+}
 
 /* The caller's index of internal particle i (negative codes pass through). */
 static inline int64_t uid(const gr_edmd *s, int32_t i) { return i < 0 ? -1 : s->order.id_of[i]; }

@@ -49,7 +49,7 @@ int gr_renumber(gr_edmd *s)
                    (width) * sizeof(type));                                             \
         memcpy((arr), tmp, (size_t)n * (width) * sizeof(type));                          \
     } while (0)
-    PERMUTE(s->P, double, (size_t)s->stride);
+    PERMUTE(s->P, double, (size_t)GR_STRIDE(s->dim));
     PERMUTE(s->mass, double, 1);
     PERMUTE(s->image, int64_t, (size_t)d);
     PERMUTE(s->order.id_of, int32_t, 1);

@@ -11,7 +11,7 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
     const size_t base = (size_t)k * s->n * dim;
     double kin = 0.0, mom[3] = {0.0, 0.0, 0.0};
     for (int32_t i = 0; i < s->n; i++) {
-        const double *p = rec(s, i);
+        const double *p = rec(s, dim, i);
         const double dt = ts - TIME(p, dim), m = s->mass[i];
         const size_t out = base + (size_t)s->order.id_of[i] * dim;
         for (int a = 0; a < dim; a++) {
@@ -37,7 +37,7 @@ void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image)
 {
     const int d = s->dim;
     for (int32_t i = 0; i < s->n; i++) {
-        const double *p = rec(s, i);
+        const double *p = rec(s, d, i);
         double dt = s->t - TIME(p, d);
         for (int a = 0; a < d; a++) {
             double x = p[a] + VEL(p, d)[a] * dt;
@@ -71,7 +71,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->kinetic_time = s->kinetic_time;
     double k = 0.0;
     for (int32_t i = 0; i < s->n; i++) {
-        const double *p = rec(s, i);
+        const double *p = rec(s, s->dim, i);
         double v2 = 0.0;
         for (int a = 0; a < s->dim; a++) v2 += VEL(p, s->dim)[a] * VEL(p, s->dim)[a];
         k += 0.5 * s->mass[i] * v2;

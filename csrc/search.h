@@ -30,7 +30,7 @@ static GR_ALWAYS_INLINE void try_pair(const gr_edmd *s, int dim, int32_t i, cons
                                       int32_t j, const double *shift, int nearest,
                                       double *best, int32_t *partner)
 {
-    const double *q = rec(s, j);
+    const double *q = rec(s, dim, j);
     double dtj = TIME(p, dim) - TIME(q, dim), dr[3], dv[3];
     for (int a = 0; a < dim; a++) {
         dr[a] = q[a] + VEL(q, dim)[a] * dtj - p[a];
@@ -51,7 +51,7 @@ static inline void keep_pair(gr_edmd *s, int dim, int32_t i, double best, int32_
 {
     if (partner < 0) return;
     gr_sched *e = &s->sched[i];
-    e->t_coll = TIME(rec(s, i), dim) + best;
+    e->t_coll = TIME(rec(s, dim, i), dim) + best;
     e->partner = partner;
     e->pcount = s->sched[partner].count;
 }
@@ -81,7 +81,7 @@ static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, 
 static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
 {
     const gr_cells *g = &s->cells;
-    const double *p = rec(s, i);
+    const double *p = rec(s, dim, i);
     const int32_t *c = s->sched[i].c;
     gr_sched *e = &s->sched[i];
     double best = e->t_coll - TIME(p, dim);
@@ -167,12 +167,12 @@ static inline void prefetch_heads(gr_edmd *s, int dim, int32_t i)
 /* One event ahead, the heads asked for by prefetch_heads being at hand: ask for the
  * first particle of each of those cells (most hold one at most; a cell emptied since
  * has head -1). */
-static inline void prefetch_firsts(const gr_edmd *s)
+static inline void prefetch_firsts(const gr_edmd *s, int dim)
 {
     for (int k = 0; k < s->ahead_m; k++) {
         const int32_t j = s->cells.head[s->ahead_cells[k]];
         if (j < 0) continue;
-        GR_PREFETCH(rec(s, j));
+        GR_PREFETCH(rec(s, dim, j));
         GR_PREFETCH(&s->cells.next[j]);
     }
 }
@@ -185,7 +185,7 @@ static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, 
                        int32_t *partner)
 {
     const gr_cells *g = &s->cells;
-    const double *p = rec(s, i);
+    const double *p = rec(s, dim, i);
     const int32_t *c = s->sched[i].c;
     int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int a = 0; a < dim; a++) {
@@ -220,7 +220,7 @@ static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, 
  * need not be found now: most candidates then fail the cheap test). */
 static void scan_list(gr_edmd *s, int dim, int32_t i)
 {
-    const double *p = rec(s, i);
+    const double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
     const int32_t *row = nl_row(&s->nl, i);
     double best = (e->t_coll < e->t_cross ? e->t_coll : e->t_cross) - TIME(p, dim);
@@ -234,7 +234,7 @@ static void scan_list(gr_edmd *s, int dim, int32_t i)
 /* List mode: make i's position (in the box) its list centre and file it in that cell. */
 static inline void set_centre(gr_edmd *s, int dim, int32_t i)
 {
-    const double *p = rec(s, i);
+    const double *p = rec(s, dim, i);
     double *centre = s->nl.centre + (size_t)i * (dim + 1);
     centre[dim] = RAD(p, dim);
     for (int a = 0; a < dim; a++) centre[a] = p[a];
@@ -259,7 +259,7 @@ static GR_ALWAYS_INLINE int32_t near_in_cell(const gr_edmd *s, int dim, int32_t 
         double d2 = 0.0;
         for (int a = 0; a < dim; a++) {
             const double d = (shift ? cj[a] + shift[a] : cj[a]) - ci[a];
-            d2 += d * d;
+            d2 = a ? d2 + d * d : d * d; /* from the first term (collide.h) */
         }
         const double cut = cj[dim] + reach;
         near[m] = (j << GR_NL_BITS) | code;
