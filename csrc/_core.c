@@ -828,6 +828,12 @@ PyMODINIT_FUNC PyInit__core(void)
         return NULL;
     }
     gr_rng_init();
+    gr_scan_init();
+    /* which compilation of the neighbour-list scan runs here (edmd.c): for tests */
+    if (PyModule_AddStringConstant(m, "SCAN_KERNEL", gr_scan_kernel()) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
     /* which compilation of the batched normals runs here (rng.c): for tests and reports */
     if (PyModule_AddStringConstant(m, "RNG_KERNEL", gr_normal_batch_kernel()) < 0) {
         Py_DECREF(m);

@@ -24,6 +24,7 @@
  * block; a neighbour list), the earliest collision on their current straight lines is no
  * earlier than the queue key of one of the two. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "engine.h"
@@ -437,6 +438,24 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double
 
 /* ---- predictions ---- */
 
+/* The list scan's compilation in use: AVX2's four lanes where the CPU has them, unless
+ * GRANULAR_SCAN_KERNEL=plain (the tests run both: the bits must not depend on it). */
+static int scan_avx2;
+
+void gr_scan_init(void)
+{
+#ifdef GR_SCAN_X86
+    const char *want = getenv("GRANULAR_SCAN_KERNEL");
+    __builtin_cpu_init();
+    scan_avx2 = __builtin_cpu_supports("avx2") && !(want && strcmp(want, "plain") == 0);
+#endif
+}
+
+const char *gr_scan_kernel(void)
+{
+    return scan_avx2 ? "avx2" : "plain";
+}
+
 static void predict_wall(gr_edmd *s, int dim, int32_t i);
 
 /* Full prediction for i, whose clock must be the current time: walls, then pair
@@ -448,7 +467,11 @@ static void predict(gr_edmd *s, int dim, int32_t i)
         const double *p = rec(s, dim, i);
         s->sched[i].t_cross = TIME(p, dim) + nl_exit_time(&s->nl, dim, p, VEL(p, dim),
                                                        s->nl.centre + (size_t)i * (dim + 1));
-        scan_list(s, dim, i);
+#ifdef GR_SCAN_X86
+        if (dim == 3 && scan_avx2) scan_list_avx2(s, i);
+        else
+#endif
+            scan_list(s, dim, i);
     } else {
         predict_cross(s, dim, i); /* first: its bucket is asked for while the scan runs */
         if (s->lookahead) gr_cq_prefetch_key(&s->queue, s->sched[i].t_cross);

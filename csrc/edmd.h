@@ -122,6 +122,11 @@ size_t gr_edmd_bytes_per_particle(int dim, int lists);
  * returns GR_ERR_NOMEM). */
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err);
 
+/* Choose the compilation of the neighbour-list scan this CPU runs (call once, before the
+ * first run); gr_scan_kernel names it: "avx2" or "plain". */
+void gr_scan_init(void);
+const char *gr_scan_kernel(void);
+
 /* The state at the current time: positions wrapped into the box (pos), velocities, and
  * image counters (unwrapped = pos + image * box length).  Any pointer may be NULL.
  * Does not change the system. */

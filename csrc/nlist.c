@@ -18,7 +18,7 @@ int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *
     nl->rows = gr_big_alloc((size_t)n * nl->cap * sizeof *nl->rows);
     nl->near = malloc((size_t)n * sizeof *nl->near);
     for (int code = 0; code < 32; code++)
-        for (int a = 0, k = code; a < 3; a++, k /= 3)
+        for (int a = 0, k = code; a < 4; a++, k /= 3)
             nl->img[code][a] = a < dim ? (double)(k % 3 - 1) * L[a] : 0.0;
     return nl->centre && nl->rows && nl->near ? GR_OK : GR_ERR_NOMEM;
 }

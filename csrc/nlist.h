@@ -41,7 +41,8 @@ typedef struct {
     int32_t cap;
     int32_t *near;    /* n: room for a rebuild's new neighbours */
     int broken;       /* a list could not grow: lists are incomplete, no more events */
-    double img[32][3];/* image code -> shift, code = sum over axes of (s_a + 1) 3^a */
+    double img[32][4];/* image code -> shift, code = sum over axes of (s_a + 1) 3^a; the
+                       * fourth column 0, for loads of four (scan_avx2.h) */
 } gr_nlist;
 
 /* The image code of no shift on any axis (every s_a = 0): the middle of the 3^dim. */

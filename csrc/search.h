@@ -231,6 +231,9 @@ static void scan_list(gr_edmd *s, int dim, int32_t i)
     keep_pair(s, dim, i, best, partner);
 }
 
+/* scan_list four candidates at a time, for x86-64 CPUs with AVX2 (chosen in edmd.c) */
+#include "scan_avx2.h"
+
 /* List mode: make i's position (in the box) its list centre and file it in that cell. */
 static inline void set_centre(gr_edmd *s, int dim, int32_t i)
 {

@@ -3,7 +3,12 @@ cell-crossing mode and as the slow reference, conservation and no overlaps where
 matter (dense 3D), lists that grow, periodic wrapping at rebuilds, and the automatic
 choice."""
 
+import json
 import math
+import os
+import subprocess
+import sys
+import textwrap
 
 import numpy as np
 import pytest
@@ -156,6 +161,67 @@ def test_same_result_bit_for_bit_and_continued_runs():
     b = sim.run(t_stop=0.2, sample_times=[0.2])
     np.testing.assert_array_equal(np.concatenate([a.positions, b.positions]), one.positions)
     np.testing.assert_array_equal(np.concatenate([a.velocities, b.velocities]), one.velocities)
+
+
+# Dense 3D list-mode runs whose bits must not depend on how the list scan is compiled:
+# periodic and walled, elastic and inelastic, a mixture (contact distances differ per
+# pair; rows grow), lists of every length mod 4 (the AVX2 scan takes four at a time).
+_KERNEL_SCENES = textwrap.dedent(
+    """
+    import hashlib, math
+    import numpy as np
+    from granular import Scene, Simulation
+
+    def dense(n, eta, seed, **kw):
+        r = (eta / (n * 4 / 3 * math.pi)) ** (1 / 3)
+        return Scene.random(n, r, seed=seed, **kw)
+
+    def mixture():
+        s = dense(600, 0.4, seed=4, restitution=0.9)
+        radii = s.radii * np.where(np.arange(600) % 3 == 0, 1.0, 0.8)
+        return Scene(s.positions, s.velocities, radii, restitution=0.9)
+
+    def digests():
+        out = {}
+        for name, scene in (
+            ("periodic", dense(800, 0.45, seed=1)),
+            ("walls-inelastic", dense(800, 0.42, seed=2, boundary="walls", restitution=0.8)),
+            ("mixture", mixture()),
+        ):
+            sim = Simulation(scene, shell=0.25)
+            assert sim.stats["shell"] == 0.25  # lists, not declined for a small box
+            tr = sim.run(stop_when={"collisions_per_particle": 20}, sample_times=[0.01])
+            h = hashlib.sha256()
+            for a in (tr.positions, tr.velocities, sim.scene.positions, sim.scene.velocities):
+                h.update(np.ascontiguousarray(a).tobytes())
+            out[name] = (h.hexdigest(), sim.stats["pair_collisions"], sim.stats["stale_events"])
+        return out
+    """
+)
+
+
+def test_every_compilation_of_the_list_scan_gives_the_same_bits():
+    """The 3D list scan runs four candidates at a time in AVX2's lanes where the CPU has
+    them (search.h, scan_avx2.h); GRANULAR_SCAN_KERNEL=plain asks for the scalar loop (the
+    choice is made at import, so in its own process).  Both give the same bits over 20
+    collisions per particle in each scene, where chaos would make any difference in one
+    rounding visible."""
+    if granular._core.SCAN_KERNEL == "plain":
+        pytest.skip("this CPU runs the plain list scan only")
+    env = dict(os.environ, GRANULAR_SCAN_KERNEL="plain")
+    script = _KERNEL_SCENES + "\nimport json, granular._core\n" + (
+        "print(granular._core.SCAN_KERNEL)\nprint(json.dumps(digests()))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True
+    ).stdout.splitlines()
+    assert out[0] == "plain"
+    here = {}
+    exec(_KERNEL_SCENES, here)
+    wide = here["digests"]()
+    plain = {k: tuple(v) for k, v in json.loads(out[1]).items()}
+    assert wide == plain
+    assert all(stale > 0 for _, _, stale in wide.values())
 
 
 def test_collapse_is_detected_and_the_tc_model_finishes():
