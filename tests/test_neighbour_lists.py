@@ -209,8 +209,10 @@ def test_every_compilation_of_the_list_scan_gives_the_same_bits():
     if granular._core.SCAN_KERNEL == "plain":
         pytest.skip("this CPU runs the plain list scan only")
     env = dict(os.environ, GRANULAR_SCAN_KERNEL="plain")
-    script = _KERNEL_SCENES + "\nimport json, granular._core\n" + (
-        "print(granular._core.SCAN_KERNEL)\nprint(json.dumps(digests()))\n"
+    script = _KERNEL_SCENES + (
+        "import json, granular._core\n"
+        "print(granular._core.SCAN_KERNEL)\n"
+        "print(json.dumps(digests()))\n"
     )
     out = subprocess.run(
         [sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True
