@@ -173,7 +173,8 @@ class Simulation:
         """Counters since the start: events, pair_collisions, wall_collisions,
         cell_crossings (cell mode), shell_exits (neighbour lists: each rebuilds one
         list), stale_events,
-        tc_elastic_collisions, law_clamped_collisions (past a viscoelastic law's
+        tc_elastic_collisions (pair collisions the TC model made elastic; a wall collision
+        it made elastic is not counted), law_clamped_collisions (past a viscoelastic law's
         range, see ``granular.Viscoelastic``), virial, wall_impulse, kinetic_energy,
         kinetic_time_integral, time, cells, shell (0: cells); and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
