@@ -297,6 +297,20 @@ int32_t gr_cq_top_slow(gr_cq *q, double *t)
             spill(q);
         }
         int32_t *head = &q->head[q->cur & (q->nb - 1)];
+        if (q->depth > 1) {
+            /* Where the caller prefetches events ahead (large N), draining a bucket was a
+             * chain of misses: its slot, then each key's item.  The next buckets are asked
+             * for in stages, each reading what the stage before asked for a drain ago (a
+             * drain every few events): the slot three buckets on, the first item two on,
+             * the item after that one on.  Written out here, not in a helper: GCC deletes
+             * calls to a function that only prefetches (see edmd.c). */
+            const int32_t mask = q->nb - 1;
+            GR_CQ_PREFETCH_HEAD(q, (q->cur + 3) & mask);
+            const int32_t first2 = q->head[(q->cur + 2) & mask];
+            if (first2 >= 0) GR_CQ_PREFETCH(q, first2);
+            const int32_t first1 = q->head[(q->cur + 1) & mask];
+            if (first1 >= 0 && q->item[first1].next >= 0) GR_CQ_PREFETCH(q, q->item[first1].next);
+        }
         while (*head >= 0) {
             int32_t id = *head;
             *head = q->item[id].next;
