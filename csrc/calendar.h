@@ -56,7 +56,8 @@ typedef struct {
     int32_t n_near;
     int32_t nan_id;    /* an id whose key is NaN, -1 if none */
     int64_t changes, rebuild_at;
-    int32_t depth;     /* the near heap is topped up below this many keys (see gr_cq_top) */
+    int32_t depth;     /* the near heap is topped up below this many keys (see gr_cq_top);
+                        * > 1 (a caller that prefetches): a drain asks for the next buckets */
 } gr_cq;
 
 /* Allocate a queue of n ids, all with key +inf.  Returns GR_OK or GR_ERR_NOMEM. */
