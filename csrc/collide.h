@@ -8,6 +8,17 @@
 
 #include <math.h>
 
+/* gr_pair_beats' cheap test, on b = dr . dv, c = |dr|^2 - sigma^2 and disc = b^2 - |dv|^2 c:
+ * approaching, and touching already or possibly before `horizon` (the root is at least
+ * c / (-2 b)).  False for a pair that cannot touch before it; the root decides the rest.
+ * The tests are combined without branches (see gr_pair_beats). */
+static inline int gr_pair_may_beat(double b, double c, double disc, double horizon)
+{
+    const int touching = c <= 0.0;
+    const int soon = (c < -2.0 * b * horizon) & (disc > 0.0);
+    return (b < 0.0) & (touching | soon);
+}
+
 /* Whether two spheres on straight lines touch before `horizon`, given their separation
  * dr = x_j - x_i, relative velocity dv = v_j - v_i and contact distance sigma (thesis
  * 2.16-2.20); if so, *dt is the time until they touch.
@@ -34,10 +45,8 @@ static inline int gr_pair_beats(int dim, const double *dr, const double *dv, dou
     }
     double c = dr2 - sigma * sigma;
     double disc = b * b - dv2 * c;
-    int touching = c <= 0.0;
-    int soon = (c < -2.0 * b * horizon) & (disc > 0.0);
-    if (!((b < 0.0) & (touching | soon))) return 0;
-    double t = touching ? 0.0 : c / (-b + sqrt(disc));
+    if (!gr_pair_may_beat(b, c, disc, horizon)) return 0;
+    double t = c <= 0.0 ? 0.0 : c / (-b + sqrt(disc));
     *dt = t;
     return t < horizon;
 }

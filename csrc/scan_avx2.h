@@ -113,9 +113,7 @@ static GR_AVX2 void scan_list_avx2(gr_edmd *s, int32_t i)
         for (; mask; mask &= mask - 1) {
             const int l = __builtin_ctz(mask);
             /* gr_pair_beats' test against the best so far, on the lane's values */
-            const int touch = cl[l] <= 0.0;
-            const int soon_l = (cl[l] < -2.0 * bl[l] * best) & (dl[l] > 0.0);
-            if (!((bl[l] < 0.0) & (touch | soon_l)) || !(tl[l] < best)) continue;
+            if (!gr_pair_may_beat(bl[l], cl[l], dl[l], best) || !(tl[l] < best)) continue;
             if (rebound_now(s, i, j[l], TIME(p, dim), tl[l])) continue;
             best = tl[l];
             partner = j[l];

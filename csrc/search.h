@@ -138,6 +138,7 @@ static inline int next_scan(const gr_edmd *s, int dim, int32_t i, int32_t *base,
     const gr_sched *e = &s->sched[i];
     int32_t c[3] = {e->c[0], e->c[1], e->c[2]};
     int count = dim == 3 ? 27 : 9;
+    *base = 0; /* defined even where no cells are returned */
     *off = g->off_all;
     if (e->cross < 0) return 0;
     if (e->t_cross < e->t_coll) {
