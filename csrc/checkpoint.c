@@ -489,6 +489,57 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
     return NULL;
 }
 
+/* Whether row i lists entry e. */
+static int listed(const gr_edmd *t, int32_t i, int32_t e)
+{
+    const int32_t *row = nl_row(&t->nl, i);
+    for (int k = 0; k < t->sched[i].nn; k++)
+        if (row[k] == e) return 1;
+    return 0;
+}
+
+/* List mode, on a state whose numbers, cells and occupancy bits are right: whether its
+ * neighbour lists are what the engine keeps (nlist.h) -- every entry listed back the
+ * other way through the opposite image, and every pair whose centres lie within
+ * r_i + r_j + 2 delta of each other listed (up to rounding: a pair within a billionth
+ * of that distance of the edge may be missing; it cannot touch before one of the two
+ * leaves its shell).  A list that missed a pair would let it pass through each other.
+ * NULL if so, else what is wrong. */
+static const char *check_lists(const gr_edmd *t)
+{
+    const int d = t->dim;
+    for (int32_t i = 0; i < t->n; i++) {
+        const int32_t *row = nl_row(&t->nl, i);
+        for (int k = 0; k < t->sched[i].nn; k++) {
+            const int32_t j = row[k] >> GR_NL_BITS, code = row[k] & GR_NL_CODE_MASK;
+            if (j == i || !listed(t, j, (i << GR_NL_BITS) | (2 * GR_NL_CODE_NONE(d) - code)))
+                return "a neighbour list is not listed back the other way";
+        }
+    }
+    for (int32_t i = 0; i < t->n; i++) {
+        const double *ci = t->nl.centre + (size_t)i * (d + 1);
+        gr_nbr nb[27];
+        const int count = cell_neighbours(&t->cells, d, t->sched[i].c, -1, 0, nb);
+        for (int k = 0; k < count; k++) {
+            int32_t code = 0;
+            for (int a = d - 1; a >= 0; a--)
+                code = 3 * code + (nb[k].shift[a] > 0.0) - (nb[k].shift[a] < 0.0) + 1;
+            for (int32_t j = t->cells.head[nb[k].cell]; j >= 0; j = t->cells.next[j]) {
+                const double *cj = t->nl.centre + (size_t)j * (d + 1);
+                double d2 = 0.0;
+                for (int a = 0; a < d; a++) {
+                    const double x = cj[a] + nb[k].shift[a] - ci[a];
+                    d2 += x * x;
+                }
+                const double cut = (ci[d] + cj[d] + 2.0 * t->nl.shell) * (1.0 - 1e-9);
+                if (j != i && d2 < cut * cut && !listed(t, i, (j << GR_NL_BITS) | code))
+                    return "a neighbour list misses a particle within reach";
+            }
+        }
+    }
+    return NULL;
+}
+
 int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error *err)
 {
     cursor c = {NULL, buf, size, 0, 0, 0};
@@ -540,6 +591,11 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
     /* the occupancy bits follow from the lists */
     for (int32_t cell = 0; cell < t.cells.ncells; cell++)
         if (t.cells.head[cell] >= 0) t.cells.occ[cell >> 6] |= (uint64_t)1 << (cell & 63);
+    if (t.nl.shell > 0.0 && (what = check_lists(&t)) != NULL) {
+        free_state(&t);
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, what);
+        return GR_ERR_VALUE;
+    }
     free_state(s);
     *s = t;
     return GR_OK;

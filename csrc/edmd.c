@@ -396,31 +396,40 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t)
 
 /* List mode: i (clock at t) has left its shell.  Its list is rebuilt about its present
  * position, which is first brought back into a periodic box (between rebuilds a
- * particle may stray up to delta beyond the box: pair tests take the nearest image). */
+ * particle may stray up to delta beyond the box: pair tests take the nearest image).
+ * Brought back, i is seen from its neighbours through other images: it is taken off
+ * every neighbour's row and linked anew; otherwise only the neighbours that leave or
+ * join its list change (relink, search.h). */
 static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t,
                                           gr_error *err)
 {
     double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
     move(dim, p, t);
-    const int32_t *row = nl_row(&s->nl, i);
-    /* the neighbours' list lengths and rows are misses: ask for all of them first */
-    for (int k = 0; k < e->nn; k++) {
-        GR_PREFETCH(&s->sched[row[k] >> GR_NL_BITS]);
-        GR_PREFETCH(nl_row(&s->nl, row[k] >> GR_NL_BITS));
-    }
-    for (int k = 0; k < e->nn; k++) nl_unlink(&s->nl, s->sched, row[k] >> GR_NL_BITS, i);
-    e->nn = 0;
+    int wrapped = 0;
     if (s->cfg.periodic) {
         for (int a = 0; a < dim; a++) {
             if (p[a] >= s->cfg.hi[a]) {
                 p[a] -= s->L[a];
                 s->image[(size_t)i * dim + a]++;
+                wrapped = 1;
             } else if (p[a] < s->cfg.lo[a]) {
                 p[a] += s->L[a];
                 s->image[(size_t)i * dim + a]--;
+                wrapped = 1;
             }
         }
+    }
+    /* the neighbours' list lengths and rows are misses: ask for all of them first (with
+     * relinking, for the few that leave; the search for new ones gives them time) */
+    const int32_t *row = nl_row(&s->nl, i);
+    for (int k = 0; k < e->nn; k++) {
+        GR_PREFETCH(&s->sched[row[k] >> GR_NL_BITS]);
+        GR_PREFETCH(nl_row(&s->nl, row[k] >> GR_NL_BITS));
+    }
+    if (wrapped) {
+        for (int k = 0; k < e->nn; k++) nl_unlink(&s->nl, s->sched, row[k] >> GR_NL_BITS, i);
+        e->nn = 0;
     }
     const int32_t old = cell_of(&s->cells, dim, e->c);
     set_centre(s, dim, i);
@@ -429,7 +438,8 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double
         cell_remove(&s->cells, i, old);
         cell_insert(&s->cells, i, cell);
     }
-    int status = link_near(s, dim, i, 0, err);
+    const int32_t m = find_near(s, dim, i, 0);
+    int status = wrapped ? link_all(s, dim, i, m, err) : relink(s, dim, i, m, err);
     if (status != GR_OK) return status;
     s->shell_exits++;
     predict(s, dim, i);
@@ -557,7 +567,7 @@ static int start(gr_edmd *s, int dim, gr_error *err)
     if (s->nl.shell > 0.0) {
         for (int32_t i = 0; i < s->n; i++) set_centre(s, dim, i); /* the cells as filed */
         for (int32_t i = 0; i < s->n; i++) {
-            int status = link_near(s, dim, i, 1, err);
+            int status = link_all(s, dim, i, find_near(s, dim, i, 1), err);
             if (status != GR_OK) return status;
         }
     }

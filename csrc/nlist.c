@@ -17,10 +17,11 @@ int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *
     nl->centre = gr_big_alloc((size_t)n * (dim + 1) * sizeof *nl->centre);
     nl->rows = gr_big_alloc((size_t)n * nl->cap * sizeof *nl->rows);
     nl->near = malloc((size_t)n * sizeof *nl->near);
+    nl->mark = calloc((size_t)n, 1);
     for (int code = 0; code < 32; code++)
         for (int a = 0, k = code; a < 4; a++, k /= 3)
             nl->img[code][a] = a < dim ? (double)(k % 3 - 1) * L[a] : 0.0;
-    return nl->centre && nl->rows && nl->near ? GR_OK : GR_ERR_NOMEM;
+    return nl->centre && nl->rows && nl->near && nl->mark ? GR_OK : GR_ERR_NOMEM;
 }
 
 void gr_nlist_free(gr_nlist *nl)
@@ -28,6 +29,7 @@ void gr_nlist_free(gr_nlist *nl)
     free(nl->centre);
     free(nl->rows);
     free(nl->near);
+    free(nl->mark);
 }
 
 int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *sched)

@@ -40,6 +40,7 @@ typedef struct {
     int32_t *rows;    /* n * cap: i's neighbours from rows[i * cap] on, sched[i].nn of them */
     int32_t cap;
     int32_t *near;    /* n: room for a rebuild's new neighbours */
+    uint8_t *mark;    /* n, all 0 but during a shell exit's relinking (search.h) */
     int broken;       /* a list could not grow: lists are incomplete, no more events */
     double img[32][4];/* image code -> shift, code = sum over axes of (s_a + 1) 3^a; the
                        * fourth column 0, for loads of four (scan_avx2.h) */

@@ -1,6 +1,6 @@
 /* search.h -- the pair searches of the event loop: who could i hit next, among the
  * adjacent cells (scan_cells), a big particle's block (scan_block) or a neighbour list
- * (scan_list); and building a neighbour list (link_near).
+ * (scan_list); and building or mending a neighbour list (find_near, link_all, relink).
  *
  * Static functions included by edmd.c only: in the loop's translation unit the compiler
  * inlines them, or clones them for dim = 2 and dim = 3, as it does the loop's own. */
@@ -245,9 +245,7 @@ static inline void set_centre(gr_edmd *s, int dim, int32_t i)
     cell_coords(&s->cells, dim, p, s->sched[i].c);
 }
 
-static int link_all(gr_edmd *s, int dim, int32_t i, int32_t m, gr_error *err);
-
-/* List mode, for link_near: append to s->nl.near (m entries so far) every particle j of
+/* List mode, for find_near: append to s->nl.near (m entries so far) every particle j of
  * one cell, seen through an image shift (NULL: none) with image code `code`, whose centre
  * is within cj[dim] + reach of ci; kept or not without a branch (about one candidate in
  * six is kept: as good as random).  Returns the new count. */
@@ -272,9 +270,10 @@ static GR_ALWAYS_INLINE int32_t near_in_cell(const gr_edmd *s, int dim, int32_t 
     return m;
 }
 
-/* List mode: list i and every particle whose centre is within r_i + r_j + 2 delta of
- * i's (only those numbered above i if `above`: building all lists at once). */
-static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
+/* List mode: every particle whose centre is within r_i + r_j + 2 delta of i's (only those
+ * numbered above i if `above`: building all lists at once), as list entries in s->nl.near;
+ * returns how many. */
+static int32_t find_near(gr_edmd *s, int dim, int32_t i, int above)
 {
     const gr_cells *g = &s->cells;
     const double *ci = s->nl.centre + (size_t)i * (dim + 1);
@@ -289,7 +288,7 @@ static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
             if (cell_occupied(g, cell))
                 m = near_in_cell(s, dim, i, ci, reach, cell, NULL, GR_NL_CODE_NONE(dim), above, m);
         }
-        return link_all(s, dim, i, m, err);
+        return m;
     }
     gr_nbr nb[27];
     const int count = cell_neighbours(g, dim, s->sched[i].c, -1, 0, nb);
@@ -299,22 +298,69 @@ static int link_near(gr_edmd *s, int dim, int32_t i, int above, gr_error *err)
             code = 3 * code + (nb[k].shift[a] > 0.0) - (nb[k].shift[a] < 0.0) + 1;
         m = near_in_cell(s, dim, i, ci, reach, nb[k].cell, nb[k].shift, code, above, m);
     }
-    return link_all(s, dim, i, m, err);
+    return m;
 }
 
-/* List mode: link i with the m neighbours link_near found (in s->nl.near). */
+/* The error of a list that could not grow. */
+static int link_failed(const gr_edmd *s, int32_t i, int status, gr_error *err)
+{
+    gr_error_set(err, status, uid(s, i), -1, s->t, (double)s->nl.cap,
+                 "a neighbour list could not grow (out of memory, or past "
+                 GR_XSTR(GR_NL_CAP_MAX) " entries); the system cannot go on");
+    return status;
+}
+
+/* List mode: link i with the m neighbours find_near found (in s->nl.near), both ways. */
 static int link_all(gr_edmd *s, int dim, int32_t i, int32_t m, gr_error *err)
 {
     const int32_t *near = s->nl.near;
     for (int32_t k = 0; k < m; k++) {
         int status = nl_link(&s->nl, dim, s->n, s->sched, i, near[k] >> GR_NL_BITS,
                              near[k] & GR_NL_CODE_MASK);
-        if (status != GR_OK) {
-            gr_error_set(err, status, uid(s, i), -1, s->t, (double)s->nl.cap,
-                         "a neighbour list could not grow (out of memory, or past "
-                         GR_XSTR(GR_NL_CAP_MAX) " entries); the system cannot go on");
-            return status;
+        if (status != GR_OK) return link_failed(s, i, status, err);
+    }
+    return GR_OK;
+}
+
+/* List mode, a shell exit that did not bring i back into the box: i's list becomes the m
+ * neighbours find_near found, and only the neighbours that leave or join it have their
+ * rows changed.  Most of i's neighbours stay (its centre moved by delta, its reach is
+ * sigma + 2 delta), and each keeps its entry of i as it is: with neither centre moved
+ * into the box since that entry was made, the image that brings i next to it is the same
+ * (two images cannot both be within reach: the box is wider than twice the reach,
+ * build.c).  So a shell exit reads and writes i's row and the rows of those few, where
+ * taking i off every neighbour's row and appending it again searched each of them. */
+static int relink(gr_edmd *s, int dim, int32_t i, int32_t m, gr_error *err)
+{
+    gr_nlist *nl = &s->nl;
+    gr_sched *e = &s->sched[i];
+    const int32_t *near = nl->near, *row = nl_row(nl, i);
+    const int listed = e->nn; /* a local: the marks' byte stores may alias anything */
+    uint8_t *mark = nl->mark; /* all 0 between shell exits */
+    for (int k = 0; k < listed; k++) mark[row[k] >> GR_NL_BITS] = 1;
+    for (int32_t k = 0; k < m; k++) {
+        uint8_t *mk = &mark[near[k] >> GR_NL_BITS];
+        *mk = *mk ? 2 : 0; /* listed and staying: 2; joining: 0 */
+    }
+    for (int k = 0; k < listed; k++) { /* leaving (still 1): off their rows */
+        const int32_t j = row[k] >> GR_NL_BITS;
+        if (mark[j] == 1) {
+            nl_unlink(nl, s->sched, j, i);
+            mark[j] = 0;
         }
+    }
+    e->nn = 0;
+    for (int32_t k = 0; k < m; k++) {
+        const int32_t j = near[k] >> GR_NL_BITS, code = near[k] & GR_NL_CODE_MASK;
+        int status = GR_OK;
+        if (mark[j]) { /* staying: its row keeps i's entry */
+            mark[j] = 0;
+            if (e->nn == nl->cap) status = gr_nlist_grow(nl, s->n, s->sched);
+            if (status == GR_OK) nl_row(nl, i)[e->nn++] = near[k];
+        } else {
+            status = nl_link(nl, dim, s->n, s->sched, i, j, code);
+        }
+        if (status != GR_OK) return link_failed(s, i, status, err);
     }
     return GR_OK;
 }

@@ -131,6 +131,41 @@ def test_unwrapped_positions_through_rebuilds():
     assert crossed.sum() >= 10  # some particles did cross the periodic boundary
 
 
+@pytest.mark.parametrize("boundary", ["periodic", "walls"])
+def test_lists_mended_at_shell_exits_stay_complete(boundary):
+    """A shell exit rebuilds one list and changes only the rows of the neighbours that
+    leave or join it (unless the particle was wrapped back into the box, when its image
+    codes change and it is linked anew).  After thousands of such exits, in a dense gas
+    whose particles also get renumbered (N = 5000), the engine's own check on loading a
+    state (csrc/checkpoint.c, check_lists) must find every listed pair listed back the
+    other way and every pair of centres within r_i + r_j + 2 delta listed."""
+    s = _dense(5000, 0.4 if boundary == "walls" else 0.45, boundary=boundary, seed=8)
+    sim = _lists(s)
+    sim.run(stop_when={"collisions_per_particle": 30.0}, store=())
+    assert sim.stats["shell_exits"] > 2 * s.n
+    sim._engine.restore_state(sim._engine.save_state())  # raises if a list is wrong
+
+
+def test_a_list_that_misses_a_pair_is_refused():
+    """The check itself: two spheres within reach (0.12 apart, reach 0.1 + 2 x 0.025) list each other through the image code
+    of no shift (13 in 3D); the same pair listed through another image, both ways, is
+    symmetric but misses the pair that can collide, and is refused.  The rows are the
+    engine state's last bytes (csrc/checkpoint.c: one entry each here, j << 5 | code)."""
+    s = Scene([[0.44, 0.5, 0.5], [0.56, 0.5, 0.5]], [[1.0, 0, 0], [-1.0, 0, 0]], 0.05)
+    sim = _lists(s)
+    state = bytearray(sim._engine.save_state())
+    rows = np.frombuffer(bytes(state[-8:]), np.int32)
+    assert sorted(rows >> 5) == [0, 1] and list(rows & 31) == [13, 13]
+    sim._engine.restore_state(bytes(state))  # as saved: fine
+    elsewhere = (rows & ~31) | np.array([14, 12], np.int32)  # shifted by +-L along x
+    state[-8:] = elsewhere.astype(np.int32).tobytes()
+    with pytest.raises(ValueError, match="misses a particle within reach"):
+        sim._engine.restore_state(bytes(state))
+    state[-8:] = ((rows & ~31) | 14).astype(np.int32).tobytes()  # not the opposite codes
+    with pytest.raises(ValueError, match="not listed back the other way"):
+        sim._engine.restore_state(bytes(state))
+
+
 def test_lists_grow_around_a_large_particle():
     """A particle 8 times wider than the rest with lists: its list must hold every
     particle whose centre is within R + r + 2 delta (delta = 0.25 * 2R) of its own --
