@@ -147,10 +147,12 @@ def test_lists_mended_at_shell_exits_stay_complete(boundary):
 
 
 def test_a_list_that_misses_a_pair_is_refused():
-    """The check itself: two spheres within reach (0.12 apart, reach 0.1 + 2 x 0.025) list each other through the image code
-    of no shift (13 in 3D); the same pair listed through another image, both ways, is
-    symmetric but misses the pair that can collide, and is refused.  The rows are the
-    engine state's last bytes (csrc/checkpoint.c: one entry each here, j << 5 | code)."""
+    """The check itself: two spheres within reach (centres 0.12 apart, reach 0.1 + 2 x 0.025)
+    list each other through the image code of no shift (13 in 3D); the same pair listed
+    through another image, both ways, is symmetric but misses the pair that can collide,
+    and is refused; codes that are not each other's opposite are not listed back.  The
+    rows are the engine state's last bytes (csrc/checkpoint.c: one entry each here,
+    j << 5 | code)."""
     s = Scene([[0.44, 0.5, 0.5], [0.56, 0.5, 0.5]], [[1.0, 0, 0], [-1.0, 0, 0]], 0.05)
     sim = _lists(s)
     state = bytearray(sim._engine.save_state())
