@@ -521,9 +521,7 @@ static const char *check_lists(const gr_edmd *t)
         gr_nbr nb[27];
         const int count = cell_neighbours(&t->cells, d, t->sched[i].c, -1, 0, nb);
         for (int k = 0; k < count; k++) {
-            int32_t code = 0;
-            for (int a = d - 1; a >= 0; a--)
-                code = 3 * code + (nb[k].shift[a] > 0.0) - (nb[k].shift[a] < 0.0) + 1;
+            const int32_t code = nl_code(d, nb[k].shift);
             for (int32_t j = t->cells.head[nb[k].cell]; j >= 0; j = t->cells.next[j]) {
                 const double *cj = t->nl.centre + (size_t)j * (d + 1);
                 double d2 = 0.0;

@@ -49,6 +49,14 @@ typedef struct {
 /* The image code of no shift on any axis (every s_a = 0): the middle of the 3^dim. */
 #define GR_NL_CODE_NONE(dim) ((dim) == 3 ? 13 : 4)
 
+/* The image code of a shift (each axis -L, 0 or +L, as cells.h gives them). */
+static inline int32_t nl_code(int dim, const double *shift)
+{
+    int32_t code = 0;
+    for (int a = dim - 1; a >= 0; a--) code = 3 * code + (shift[a] > 0.0) - (shift[a] < 0.0) + 1;
+    return code;
+}
+
 /* Lists with a shell delta (> 0) for n particles in a box of sides L.  GR_OK or
  * GR_ERR_NOMEM. */
 int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *L);

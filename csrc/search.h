@@ -293,9 +293,7 @@ static int32_t find_near(gr_edmd *s, int dim, int32_t i, int above)
     gr_nbr nb[27];
     const int count = cell_neighbours(g, dim, s->sched[i].c, -1, 0, nb);
     for (int k = 0; k < count; k++) {
-        int32_t code = 0;
-        for (int a = dim - 1; a >= 0; a--)
-            code = 3 * code + (nb[k].shift[a] > 0.0) - (nb[k].shift[a] < 0.0) + 1;
+        const int32_t code = nl_code(dim, nb[k].shift);
         m = near_in_cell(s, dim, i, ci, reach, nb[k].cell, nb[k].shift, code, above, m);
     }
     return m;
