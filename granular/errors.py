@@ -85,3 +85,10 @@ class CheckpointError(GranularError, ValueError):
     """A checkpoint (``Simulation.load``, an ensemble's ``save_to`` directory) cannot be
     used: not a checkpoint, truncated or corrupt, written by another version of granular,
     or made for another model."""
+
+
+class GSDFileError(GranularError, ValueError):
+    """A GSD file cannot be read (``granular.read``, ``Scene.from_gsd``): not a GSD file,
+    truncated or corrupt, not written by granular, or holding a field that is missing, of the
+    wrong shape or an impossible value.  The message names the file, the frame and the
+    field."""

@@ -3,6 +3,10 @@ MDAnalysis): ``Trajectory.write("run.gsd")``, ``granular.read("run.gsd")`` and
 ``Scene.from_gsd("run.gsd", frame=-1)``.  Needs the ``gsd`` package
 (``pip install 'granular[gsd]'``).
 
+Files are written whole or not at all (beside the path, then renamed onto it), with the
+permissions a plain ``open()`` gives (0o666 less the umask).  Reading checks every frame
+as a Scene is checked and refuses a damaged or impossible file with ``GSDFileError``.
+
 What each frame holds.  The HOOMD schema fixes the standard fields to float32, so these are
 for viewers and analysis tools (OVITO, freud, MDAnalysis), good to about 7 digits:
 
@@ -11,8 +15,15 @@ for viewers and analysis tools (OVITO, freud, MDAnalysis), good to about 7 digit
 - ``particles/image`` (int32): periodic image flags, unwrapped = position + image * L
   (always 0 in a walled box)
 - ``particles/velocity``, ``particles/diameter``, ``particles/mass``
-- ``configuration/box`` (2D: Lz = 0, ``configuration/dimensions`` = 2) and
-  ``configuration/step`` = the sample's index
+- ``configuration/box`` and ``configuration/dimensions``; ``configuration/step`` = the
+  sample's index
+- 2D: ``configuration/dimensions`` = 2 and a box ``[Lx, Ly, max(Lx, Ly), 0, 0, 0]``.
+  HOOMD itself writes Lz = 0 in 2D, but its readers take ``dimensions`` = 2 first and set
+  Lz to 0 themselves (as for HOOMD 2's files, which kept an Lz), and gsd.hoomd does too;
+  MDAnalysis reads the box as it stands, and an Lz of 0 is a volume of 0, which its
+  analyses divide by.  So MDAnalysis gets the box ``Trajectory.to_universe`` gives (see
+  ``granular.interop``).  freud: ``freud.box.Box.from_box(box, dimensions=2)`` (it warns
+  that the Lz has no effect).
 
 The exact float64 (and int64) values granular reads back live in the log section:
 
@@ -32,11 +43,17 @@ and its writers.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import secrets
+import stat
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from .errors import GSDFileError
+from .interop import box_lengths_3d
 
 FORMAT = 1  # the version of the log layout above
 _COUNTERS = (
@@ -50,14 +67,17 @@ _COUNTERS = (
 _INT_COUNTERS = ("pair_collisions", "wall_collisions")
 
 
-def _gsd_hoomd():
+def _gsd():
+    """The gsd package, with its modules gsd.hoomd (frames, for writing) and gsd.fl (chunks,
+    for reading)."""
     try:
+        import gsd.fl
         import gsd.hoomd
     except ImportError as exc:
         raise ImportError(
             "GSD files need the gsd package: pip install gsd (or pip install 'granular[gsd]')"
         ) from exc
-    return gsd.hoomd
+    return gsd
 
 
 def _check_suffix(path: str | os.PathLike) -> Path:
@@ -96,13 +116,6 @@ def _wrap(positions: np.ndarray, lower: np.ndarray, upper: np.ndarray, periodic:
     return wrapped, images
 
 
-def _box(lower, upper):
-    lengths = np.asarray(upper, dtype=np.float64) - np.asarray(lower, dtype=np.float64)
-    if len(lengths) == 2:
-        return [float(lengths[0]), float(lengths[1]), 0.0, 0.0, 0.0, 0.0], 2
-    return [float(v) for v in lengths] + [0.0, 0.0, 0.0], 3
-
-
 def _pad3(a, dtype=np.float32):
     a = np.asarray(a)
     if a.shape[-1] == 2:
@@ -110,168 +123,427 @@ def _pad3(a, dtype=np.float32):
     return np.ascontiguousarray(a, dtype=dtype)
 
 
+def _frame(hoomd, traj, k, lower, upper):
+    """Sample ``k`` of ``traj`` as a HOOMD frame (see the module docstring for the fields)."""
+    centre = 0.5 * (lower + upper)
+    periodic = traj.boundary == "periodic"
+    half = (0.5 * (upper - lower)).astype(np.float32)
+    n = traj.n
+    frame = hoomd.Frame()
+    frame.configuration.step = k
+    frame.configuration.box = [*box_lengths_3d(upper - lower), 0.0, 0.0, 0.0]
+    frame.configuration.dimensions = traj.dim
+    frame.particles.N = n
+    frame.particles.types = ["A"]
+    frame.particles.typeid = np.zeros(n, dtype=np.uint32)
+    x = traj.positions[k]
+    wrapped, images = _wrap(x, lower, upper, periodic)
+    position = (wrapped - centre).astype(np.float32)
+    if periodic:
+        # a centre just under the upper face can round to +L/2 in float32, outside
+        # HOOMD's [-L/2, L/2): move it to -L/2 and count the image
+        high = position >= half
+        position = np.where(high, -half, position)
+        images = images + high
+    frame.particles.position = _pad3(position)
+    frame.particles.image = _pad3(images, np.int32)
+    frame.particles.diameter = np.asarray(2.0 * traj.radii, dtype=np.float32)
+    frame.particles.mass = np.asarray(traj.masses, dtype=np.float32)
+    log = {
+        "granular/time": np.array([traj.times[k]], dtype=np.float64),
+        "granular/unwrapped_positions": np.ascontiguousarray(x, dtype=np.float64),
+    }
+    if traj.velocities is not None:
+        frame.particles.velocity = _pad3(traj.velocities[k])
+        log["granular/velocities"] = np.ascontiguousarray(traj.velocities[k], dtype=np.float64)
+    for name in _COUNTERS:
+        dtype = np.int64 if name in _INT_COUNTERS else np.float64
+        log[f"granular/{name}"] = np.atleast_1d(np.asarray(getattr(traj, name)[k], dtype))
+    if k == 0:
+        log.update(
+            {
+                "granular/format": np.array([FORMAT], dtype=np.int64),
+                "granular/lower": lower,
+                "granular/upper": upper,
+                "granular/radii": np.asarray(traj.radii, dtype=np.float64),
+                "granular/masses": np.asarray(traj.masses, dtype=np.float64),
+                "granular/boundary": _text(traj.boundary),
+                "granular/stop_reason": _text(traj.stop_reason),
+            }
+        )
+    frame.log = log
+    return frame
+
+
+def _temporary(path: Path) -> Path:
+    """A new empty file beside ``path`` with the mode a plain ``open(path, "w")`` would give
+    ``path``: 0o666 less the umask (``os.open`` applies it), or the mode of the file it
+    replaces.  gsd creates its files 0o660 less the umask, and keeps the mode of a file it
+    truncates; a rename keeps it too."""
+    while True:
+        tmp = path.with_name(f".tmp-{secrets.token_hex(8)}-{path.name}")
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        except FileExistsError:  # 64 random bits taken: draw again
+            continue
+        try:
+            with contextlib.suppress(FileNotFoundError):
+                os.fchmod(fd, stat.S_IMODE(os.stat(path).st_mode))
+        finally:
+            os.close(fd)
+        return tmp
+
+
 def write(traj: Any, path: str | os.PathLike) -> None:
-    """Write a Trajectory to a GSD file (see the module docstring for the fields); the
-    trajectory must have stored positions (velocities are written when stored)."""
+    """Write a Trajectory to a GSD file (see the module docstring for the fields).
+
+    The file is written beside ``path`` and renamed onto it when complete, so an error or an
+    interruption never leaves a half-written file (an older file at ``path`` survives); it
+    gets the permissions a plain ``open()`` would give it (0o666 less the umask, or those of
+    the file it replaces).
+
+    Parameters
+    ----------
+    traj : Trajectory
+        With stored positions (velocities are written when stored).
+    path : str or os.PathLike
+        Ending in ``.gsd``.
+    """
     path = _check_suffix(path)
     if traj.positions is None:
         raise ValueError(
             "this trajectory did not store positions, which a GSD file needs; run with "
             "store including 'positions' (and 'velocities')"
         )
-    hoomd = _gsd_hoomd()
+    hoomd = _gsd().hoomd
     lower = np.asarray(traj.lower, dtype=np.float64)
     upper = np.asarray(traj.upper, dtype=np.float64)
-    centre = 0.5 * (lower + upper)
-    box, dimensions = _box(lower, upper)
-    periodic = traj.boundary == "periodic"
-    half = (0.5 * (upper - lower)).astype(np.float32)
-    n = traj.n
-    with hoomd.open(name=str(path), mode="w") as f:
-        for k in range(len(traj.times)):
-            frame = hoomd.Frame()
-            frame.configuration.step = k
-            frame.configuration.box = box
-            frame.configuration.dimensions = dimensions
-            frame.particles.N = n
-            frame.particles.types = ["A"]
-            frame.particles.typeid = np.zeros(n, dtype=np.uint32)
-            x = traj.positions[k]
-            wrapped, images = _wrap(x, lower, upper, periodic)
-            position = (wrapped - centre).astype(np.float32)
-            if periodic:
-                # a centre just under the upper face can round to +L/2 in float32, outside
-                # HOOMD's [-L/2, L/2): move it to -L/2 and count the image
-                high = position >= half
-                position = np.where(high, -half, position)
-                images = images + high
-            frame.particles.position = _pad3(position)
-            frame.particles.image = _pad3(images, np.int32)
-            frame.particles.diameter = np.asarray(2.0 * traj.radii, dtype=np.float32)
-            frame.particles.mass = np.asarray(traj.masses, dtype=np.float32)
-            log = {
-                "granular/time": np.array([traj.times[k]], dtype=np.float64),
-                "granular/unwrapped_positions": np.ascontiguousarray(x, dtype=np.float64),
-            }
-            if traj.velocities is not None:
-                frame.particles.velocity = _pad3(traj.velocities[k])
-                log["granular/velocities"] = np.ascontiguousarray(
-                    traj.velocities[k], dtype=np.float64
-                )
-            for name in _COUNTERS:
-                dtype = np.int64 if name in _INT_COUNTERS else np.float64
-                log[f"granular/{name}"] = np.atleast_1d(np.asarray(getattr(traj, name)[k], dtype))
-            if k == 0:
-                log.update(
-                    {
-                        "granular/format": np.array([FORMAT], dtype=np.int64),
-                        "granular/lower": lower,
-                        "granular/upper": upper,
-                        "granular/radii": np.asarray(traj.radii, dtype=np.float64),
-                        "granular/masses": np.asarray(traj.masses, dtype=np.float64),
-                        "granular/boundary": _text(traj.boundary),
-                        "granular/stop_reason": _text(traj.stop_reason),
-                    }
-                )
-            frame.log = log
-            f.append(frame)
+    tmp = _temporary(path)
+    try:
+        with hoomd.open(name=str(tmp), mode="w") as f:  # "w" truncates: tmp keeps its mode
+            for k in range(len(traj.times)):
+                f.append(_frame(hoomd, traj, k, lower, upper))
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
 
 
-def _open(path):
-    path = _check_suffix(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"no GSD file at {str(path)!r}")
-    return _gsd_hoomd().open(name=str(path), mode="r")
+class _File:
+    """A GSD file open for reading chunk by chunk (gsd.fl).  Only the chunks asked for are
+    read (gsd.hoomd's frames would allocate every standard field for the N a frame claims,
+    whatever the file holds), and all of them together no more than twice the file's size:
+    each chunk lies inside the file (gsd checks) and a sound file stores each once, so more
+    is a corrupt index whose chunks overlap."""
+
+    def __init__(self, path: str | os.PathLike) -> None:
+        self.path = _check_suffix(path)
+        if not self.path.is_file():
+            raise FileNotFoundError(f"no GSD file at {str(self.path)!r}")
+        self.where = repr(str(self.path))
+        fl = _gsd().fl
+        try:
+            self._f = fl.open(name=str(self.path), mode="r")
+        except (PermissionError, FileNotFoundError):
+            raise
+        except (OSError, RuntimeError, ValueError, MemoryError, UnicodeError) as exc:
+            raise GSDFileError(f"{self.where} is not a readable GSD file: {exc}") from exc
+        self.frames = int(self._f.nframes)
+        # a sound file's chunks, each read once (frame 0's positions twice), fit in it twice
+        self._budget = 2 * self.path.stat().st_size
+
+    def __enter__(self) -> _File:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self._f.close()
+
+    def error(self, frame: int, name: str, what: str) -> GSDFileError:
+        return GSDFileError(f"{self.where}, frame {frame}: {name} {what}")
+
+    def has(self, frame: int, name: str) -> bool:
+        return bool(self._f.chunk_exists(frame=frame, name=name))
+
+    def raw(self, frame: int, name: str) -> np.ndarray:
+        """Chunk ``name`` of ``frame`` as stored (GSDFileError if missing or unreadable)."""
+        if not self.has(frame, name):
+            raise self.error(frame, name, "is missing")
+        try:
+            a = self._f.read_chunk(frame=frame, name=name)
+        except (OSError, RuntimeError, ValueError, KeyError, MemoryError) as exc:
+            raise self.error(frame, name, f"cannot be read ({exc})") from exc
+        self._budget -= a.nbytes
+        if self._budget < 0:
+            raise self.error(
+                frame, name, "takes the data read past twice the file's size: its index is corrupt"
+            )
+        return a
+
+    def array(self, frame: int, name: str, shape: tuple, integer: bool = False) -> np.ndarray:
+        """Chunk ``name`` of ``frame`` as float64 (int64 if ``integer``) of ``shape``."""
+        a = self.raw(frame, name)
+        if a.dtype.kind not in ("iu" if integer else "fiu"):
+            kind = "integers" if integer else "numbers"
+            raise self.error(frame, name, f"holds {a.dtype} values, not {kind}")
+        if a.shape != shape:
+            raise self.error(frame, name, f"has shape {a.shape}, expected {shape}")
+        return a.astype(np.int64 if integer else np.float64)
+
+    def text(self, frame: int, name: str) -> str:
+        a = self.raw(frame, name)
+        if a.dtype.kind not in "iu" or a.dtype.itemsize != 1 or a.ndim != 1:
+            raise self.error(frame, name, f"is not text (a {a.dtype} array of shape {a.shape})")
+        try:
+            return bytes(a.astype(np.uint8)).decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise self.error(frame, name, f"is not UTF-8 text ({exc})") from exc
 
 
-def _params(first, path):
-    log = first.log
-    if "granular/format" not in log:
-        raise ValueError(
-            f"{str(path)!r} was not written by granular (no log/granular/format); read it "
+def _log(name: str) -> str:
+    return f"log/granular/{name}"
+
+
+def _params(f: _File) -> dict[str, Any]:
+    """The scene's fields from frame 0 of a file granular wrote."""
+    if not f.has(0, _log("format")):
+        raise GSDFileError(
+            f"{f.where} was not written by granular (no log/granular/format); read it "
             "with gsd.hoomd.open, or take one frame with Scene.from_gsd"
         )
-    version = int(np.asarray(log["granular/format"]).ravel()[0])
+    version = int(f.array(0, _log("format"), (1,), integer=True)[0])
     if version != FORMAT:
-        raise ValueError(
-            f"{str(path)!r} has granular GSD layout {version}, this version reads {FORMAT}"
+        raise GSDFileError(
+            f"{f.where} has granular GSD layout {version}, this version reads {FORMAT}"
         )
+    # the particles and dimensions are those of frame 0's positions; every other array must
+    # agree with them
+    x0 = f.raw(0, _log("unwrapped_positions"))
+    if x0.ndim != 2 or x0.shape[0] < 1 or x0.shape[1] not in (2, 3):
+        raise f.error(
+            0, _log("unwrapped_positions"), f"has shape {x0.shape}, expected (N, 2) or (N, 3)"
+        )
+    n, d = x0.shape
     return dict(
-        lower=np.array(log["granular/lower"], dtype=np.float64),
-        upper=np.array(log["granular/upper"], dtype=np.float64),
-        radii=np.array(log["granular/radii"], dtype=np.float64),
-        masses=np.array(log["granular/masses"], dtype=np.float64),
-        boundary=_untext(log["granular/boundary"]),
-        stop_reason=_untext(log["granular/stop_reason"]),
+        lower=f.array(0, _log("lower"), (d,)),
+        upper=f.array(0, _log("upper"), (d,)),
+        radii=f.array(0, _log("radii"), (n,)),
+        masses=f.array(0, _log("masses"), (n,)),
+        boundary=f.text(0, _log("boundary")),
+        stop_reason=f.text(0, _log("stop_reason")),
     )
+
+
+def _wrap_checked(f: _File, k: int, x: np.ndarray, p: dict[str, Any]) -> np.ndarray:
+    """Unwrapped positions of frame ``k`` wrapped into a periodic box (as they are in a
+    walled one).  Positions that are not finite, or so far out that their image would not
+    fit an int64, are left for Scene to refuse (it names what is wrong)."""
+    if p["boundary"] != "periodic" or not np.all(np.isfinite(x)):
+        return x
+    lengths = p["upper"] - p["lower"]
+    with np.errstate(all="ignore"):
+        boxes = np.max(np.abs((x - p["lower"]) / lengths)) if lengths.all() else np.inf
+    if not boxes < 2.0**53:
+        raise f.error(
+            k,
+            _log("unwrapped_positions"),
+            f"reaches {boxes:.3g} box lengths from the box: float64 cannot wrap it back",
+        )
+    return _wrap(x, p["lower"], p["upper"], True)[0]
+
+
+def _scene(f: _File, k: int, x: np.ndarray, v: np.ndarray, p: dict[str, Any]) -> Any:
+    """Frame ``k``'s state as a Scene, which checks it as every scene is checked (finite,
+    positive radii and masses, the box, the scales, inside the box, no overlaps)."""
+    from .scene import Scene
+
+    x = _wrap_checked(f, k, x, p)
+    try:
+        return Scene(
+            x, v, p["radii"], p["masses"], box=(p["lower"], p["upper"]), boundary=p["boundary"]
+        )
+    except (ValueError, TypeError) as exc:
+        raise GSDFileError(f"{f.where}, frame {k}: not a valid state: {exc}") from exc
 
 
 def read(path: str | os.PathLike) -> Any:
     """Read a GSD file written by ``Trajectory.write`` back into a Trajectory, with the
-    exact float64 values of the log section."""
+    exact float64 values of the log section.
+
+    Every frame is checked as a Scene is (finite positions and velocities, positive radii
+    and masses, a valid box and boundary, particles inside it and not overlapping), the
+    sample times must increase and the collision counts must be whole numbers that never
+    decrease.  Only the log section is read, no more of it than the file holds.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.gsd`` file.
+
+    Returns
+    -------
+    Trajectory
+
+    Raises
+    ------
+    GSDFileError
+        Not a GSD file, truncated or corrupt, not written by granular, or a field missing,
+        of the wrong shape or an impossible value; the message names the file, the frame
+        and the field.
+    FileNotFoundError
+        No file at ``path``.
+    """
     from .trajectory import Trajectory
 
-    with _open(path) as f:
-        if len(f) == 0:
-            raise ValueError(f"{str(path)!r} holds no frames")
-        params = _params(f[0], path)
-        frames = [frame.log for frame in f]
-    times = np.array([np.asarray(log["granular/time"]).ravel()[0] for log in frames])
-    positions = np.array([log["granular/unwrapped_positions"] for log in frames], np.float64)
-    has_v = all("granular/velocities" in log for log in frames)
-    velocities = (
-        np.array([log["granular/velocities"] for log in frames], np.float64) if has_v else None
+    with _File(path) as f:
+        if f.frames == 0:
+            raise GSDFileError(f"{f.where} holds no frames")
+        p = _params(f)
+        n, d = len(p["radii"]), len(p["lower"])
+        has_v = f.has(0, _log("velocities"))
+        still = np.zeros((n, d))
+        times, positions, velocities = [], [], []
+        counters: dict[str, list] = {name: [] for name in _COUNTERS}
+        for k in range(f.frames):
+            t = f.array(k, _log("time"), (1,))[0]
+            if not np.isfinite(t):
+                raise f.error(k, _log("time"), f"is {t}, not a finite time")
+            if times and not t > times[-1]:
+                raise f.error(
+                    k,
+                    _log("time"),
+                    f"is {t}, not after frame {k - 1}'s {times[-1]}: sample times must increase",
+                )
+            times.append(t)
+            x = f.array(k, _log("unwrapped_positions"), (n, d))
+            v = still
+            if has_v:
+                v = f.array(k, _log("velocities"), (n, d))
+                velocities.append(v)
+            elif f.has(k, _log("velocities")):
+                raise f.error(k, _log("velocities"), "is there but frame 0 has none")
+            _scene(f, k, x, v, p)
+            positions.append(x)
+            for name in _COUNTERS:
+                value = _counter(f, k, name, d, counters[name])
+                counters[name].append(value)
+    return Trajectory(
+        np.array(times),
+        np.array(positions).reshape(len(times), n, d),
+        np.array(velocities).reshape(len(times), n, d) if has_v else None,
+        **{name: np.array(values) for name, values in counters.items()},
+        **p,
     )
-    counters = {}
-    for name in _COUNTERS:
-        dtype = np.int64 if name in _INT_COUNTERS else np.float64
-        values = np.array([np.asarray(log[f"granular/{name}"], dtype) for log in frames])
-        counters[name] = values if name == "momentum" else values.reshape(len(frames))
-    return Trajectory(times, positions, velocities, **counters, **params)
+
+
+def _counter(f: _File, k: int, name: str, d: int, before: list) -> Any:
+    """Frame ``k``'s value of a counter: finite; the collision counts whole, >= 0 and never
+    below the previous frame's (they count since the simulation began)."""
+    if name in _INT_COUNTERS:
+        value = int(f.array(k, _log(name), (1,), integer=True)[0])
+        if value < 0 or (before and value < before[-1]):
+            least = before[-1] if before else 0
+            raise f.error(k, _log(name), f"is {value}, below {least}: a count never decreases")
+        return value
+    value = f.array(k, _log(name), (d,) if name == "momentum" else (1,))
+    if not np.all(np.isfinite(value)):
+        raise f.error(k, _log(name), "contains NaN or infinity")
+    return value if name == "momentum" else float(value[0])
 
 
 def scene_from_gsd(path: str | os.PathLike, frame: int = -1, **params: Any) -> Any:
     """A Scene from one frame of a GSD file: exact when granular wrote it, else from the
-    float32 HOOMD fields (a periodic box centred at the origin).  ``params`` are the Scene's
-    other keywords (restitution, wall_restitution, contact_duration; boundary for a
-    foreign file)."""
+    float32 HOOMD fields (a periodic box centred at the origin).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.gsd`` file.
+    frame : int
+        The frame's index (negative: from the end).
+    **params
+        The Scene's other keywords (restitution, wall_restitution, contact_duration;
+        boundary for a foreign file), which a trajectory does not record.
+
+    Raises
+    ------
+    GSDFileError
+        The file, or the frame's state in it, is unreadable or invalid (as for ``read``).
+    IndexError
+        No such frame.
+    """
     from .scene import Scene
 
-    with _open(path) as f:
-        count = len(f)
+    with _File(path) as f:
+        count = f.frames
         if not -count <= frame < count:
-            raise IndexError(f"frame {frame} out of range: {str(path)!r} holds {count} frames")
-        first = f[0]
-        snap = f[frame % count]
-        own = "granular/format" in first.log
-        if own:
-            p = _params(first, path)
-            lower, upper = p["lower"], p["upper"]
-            periodic = p["boundary"] == "periodic"
-            x, _ = _wrap(snap.log["granular/unwrapped_positions"], lower, upper, periodic)
-            v = snap.log.get("granular/velocities")
-            if v is None:
-                v = np.zeros_like(x)
-            params.setdefault("boundary", p["boundary"])
-            return Scene(
-                x,
-                np.array(v, dtype=np.float64),
-                p["radii"],
-                p["masses"],
-                box=(lower, upper),
-                **params,
-            )
-        dim = int(snap.configuration.dimensions)
-        lengths = np.asarray(snap.configuration.box[:dim], dtype=np.float64)
-        x = np.asarray(snap.particles.position[:, :dim], dtype=np.float64)
-        v = np.asarray(snap.particles.velocity[:, :dim], dtype=np.float64)
-        lower, upper = -0.5 * lengths, 0.5 * lengths
-        x = np.where(x >= upper, x - lengths, x)
+            raise IndexError(f"frame {frame} out of range: {f.where} holds {count} frames")
+        k = frame % count
+        if f.has(0, _log("format")):
+            p = _params(f)
+            n, d = len(p["radii"]), len(p["lower"])
+            x = f.array(k, _log("unwrapped_positions"), (n, d))
+            v = np.zeros((n, d))
+            if f.has(k, _log("velocities")):
+                v = f.array(k, _log("velocities"), (n, d))
+            own = _scene(f, k, x, v, p)
+        else:
+            own = _foreign_scene(f, k)
+    params.setdefault("boundary", own.boundary)
+    return Scene(
+        own.positions,
+        own.velocities,
+        own.radii,
+        own.masses,
+        box=(own.lower, own.upper),
+        **params,
+    )
+
+
+def _foreign_scene(f: _File, k: int) -> Any:
+    """Frame ``k`` of a file granular did not write, from its float32 HOOMD fields, as a
+    periodic box centred at the origin.  A field missing from frame ``k`` is frame 0's, else
+    HOOMD's default (gsd.hoomd's rule)."""
+    from .scene import Scene
+
+    def get(name, shape, default=None):
+        for at in (k, 0):
+            if f.has(at, name):
+                return f.array(at, name, shape)
+        if default is None:
+            raise f.error(k, name, "is missing (and frame 0 has none)")
+        return np.broadcast_to(np.asarray(default, dtype=np.float64), shape)
+
+    n = int(get("particles/N", (1,))[0])
+    if n < 1:
+        raise f.error(k, "particles/N", f"is {n}: the frame holds no particles")
+    box = get("configuration/box", (6,), [1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
+    dim = int(get("configuration/dimensions", (1,), [2.0 if box[2] == 0 else 3.0])[0])
+    if dim not in (2, 3):
+        raise f.error(k, "configuration/dimensions", f"is {dim}, not 2 or 3")
+    if np.any(box[3 : 3 + (1 if dim == 2 else 3)] != 0):
+        raise f.error(
+            k,
+            "configuration/box",
+            f"has tilts {box[3:].tolist()}: granular's boxes are rectangular",
+        )
+    x = get("particles/position", (n, 3))[:, :dim]
+    v = get("particles/velocity", (n, 3), 0.0)[:, :dim]
+    lengths = box[:dim]
+    lower, upper = -0.5 * lengths, 0.5 * lengths
+    x = np.where(x >= upper, x - lengths, x)
+    try:
         return Scene(
             x,
             v,
-            0.5 * np.asarray(snap.particles.diameter, dtype=np.float64),
-            np.asarray(snap.particles.mass, dtype=np.float64),
+            0.5 * get("particles/diameter", (n,), 1.0),
+            get("particles/mass", (n,), 1.0),
             box=(lower, upper),
-            **params,
         )
+    except (ValueError, TypeError) as exc:
+        raise GSDFileError(f"{f.where}, frame {k}: not a valid state: {exc}") from exc

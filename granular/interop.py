@@ -5,6 +5,19 @@ Units: MDAnalysis counts lengths in angstrom and time in picoseconds; granular's
 coordinates in float32 (about 7 significant digits) and gives frames evenly spaced times
 (``dt``), so log-spaced samples lose their real times in a Universe -- the file written by
 ``write_trajectory`` keeps them.
+
+Boxes.  MDAnalysis (like a GSD file's ``configuration/box``) knows only three-dimensional,
+periodic boxes; granular gives it the box's edge lengths whatever its boundary, the same
+in a Universe (``to_universe``), a TRR file (``write_trajectory``) and a GSD file read by
+MDAnalysis.  In 2D the disks lie in the plane z = 0 of a box as deep as its longest edge,
+``[Lx, Ly, max(Lx, Ly), 90, 90, 90]`` (``box_lengths_3d``): a depth of 0 would give a
+volume of 0, which MDAnalysis' analyses divide by (``InterRDF``), and a depth under twice
+a distance cutoff makes its periodic neighbour searches fail or count a pair twice.  So
+MDAnalysis' densities are per volume Lx Ly Lz: ``InterRDF`` of a 2D run is the g(r) of
+disks counted in spherical shells; the 2D g(r) is it times V_shell / (Lz A_ring), with
+V_shell = 4 pi (r2^3 - r1^3) / 3 and A_ring = pi (r2^2 - r1^2) for each bin [r1, r2].  In a
+walled box MDAnalysis still wraps distances across the walls, which pairs near opposite
+walls feel.
 """
 
 from __future__ import annotations
@@ -35,12 +48,25 @@ def _as_3d(positions):
     return x
 
 
+def box_lengths_3d(lengths: ArrayLike) -> list[float]:
+    """The three edge lengths of a box as tools that know only 3D boxes (MDAnalysis, a GSD
+    file's ``configuration/box``) are given it: a 3D box's own, and for a 2D box
+    ``[Lx, Ly, max(Lx, Ly)]`` (see the module docstring for why that depth).
+
+    Parameters
+    ----------
+    lengths : array_like, shape (d,)
+        The box's edge lengths (box units), d = 2 or 3.
+    """
+    L = [float(v) for v in np.asarray(lengths, dtype=np.float64)]
+    return [*L, max(L)] if len(L) == 2 else L
+
+
 def _dimensions(box, dim):
     if box is None:
         return None
     L = np.broadcast_to(np.asarray(box, dtype=np.float64), (dim,))
-    lengths = np.concatenate([L, [1.0]]) if dim == 2 else L
-    return np.concatenate([lengths, [90.0, 90.0, 90.0]]).astype(np.float32)
+    return np.array([*box_lengths_3d(L), 90.0, 90.0, 90.0], dtype=np.float32)
 
 
 def to_universe(
@@ -50,11 +76,21 @@ def to_universe(
     radii: ArrayLike | None = None,
 ) -> Any:
     """An in-memory ``MDAnalysis.Universe`` with one atom per particle and one frame per
-    sample (unwrapped positions).
+    sample (unwrapped positions; 2D ones in the plane z = 0).
 
-    ``box``: edge lengths of a periodic box (sets the frames' dimensions), or None.
-    ``radii``: stored as the atoms' ``radii`` attribute.  Frame times are evenly spaced by
-    the mean sample spacing (MDAnalysis' MemoryReader knows only a constant dt).
+    Parameters
+    ----------
+    times : array_like, shape (T,)
+        Sample times.  Frame times are evenly spaced by their mean spacing (MDAnalysis'
+        MemoryReader knows only a constant dt).
+    positions : array_like, shape (T, N, d)
+        Positions (box units), d = 2 or 3.
+    box : array_like, shape (d,), optional
+        The box's edge lengths: the frames' dimensions, ``box_lengths_3d(box)`` and right
+        angles (in 2D ``[Lx, Ly, max(Lx, Ly), 90, 90, 90]``; see the module docstring).
+        None: no dimensions, which MDAnalysis' distance-based analyses refuse.
+    radii : array_like, shape (N,), optional
+        Stored as the atoms' ``radii`` attribute.
     """
     mda = _mda()
     from MDAnalysis.coordinates.memory import MemoryReader
@@ -82,7 +118,8 @@ def write_trajectory(
     unwrapped positions and optionally velocities, in float32.  MDAnalysis, OVITO, VMD and
     GROMACS read it; 2D scenes are written in the plane z = 0.
 
-    TRR rather than XTC because XTC compresses coordinates to a fixed precision.
+    TRR rather than XTC because XTC compresses coordinates to a fixed precision.  ``box``:
+    the box's edge lengths, written as in ``to_universe``.
     """
     mda = _mda()
     from MDAnalysis.coordinates.TRR import TRRWriter

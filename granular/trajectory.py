@@ -238,12 +238,17 @@ class Trajectory:
         )
 
     def to_universe(self) -> Any:
-        """An MDAnalysis Universe of the particles (see ``granular.interop.to_universe``)."""
+        """An MDAnalysis Universe of the particles: one atom per particle, one frame per
+        sample, unwrapped positions (see ``granular.interop.to_universe``).  Its dimensions
+        are the box's, as MDAnalysis reads them from the GSD file ``write`` makes: in 2D
+        ``[Lx, Ly, max(Lx, Ly), 90, 90, 90]``, the disks in the plane z = 0.  MDAnalysis
+        treats every box as periodic, a walled one too (see ``granular.interop``)."""
         positions = self._need("positions")
         from . import interop
 
-        box = (self.upper - self.lower) if self.boundary == "periodic" else None
-        return interop.to_universe(self.times, positions, box=box, radii=self.radii)
+        return interop.to_universe(
+            self.times, positions, box=self.upper - self.lower, radii=self.radii
+        )
 
     def write(self, path: str | os.PathLike) -> None:
         """Write the samples to a GSD file (``path`` ending in .gsd), which OVITO, freud,

@@ -1,6 +1,8 @@
 """GSD files (issue 17): Trajectory.write, granular.read and Scene.from_gsd round trip
 exactly; the file is a valid HOOMD GSD file for gsd itself and for MDAnalysis."""
 
+import os
+import stat
 import sys
 
 import gsd.hoomd
@@ -79,7 +81,9 @@ def test_gsd_reads_wrapped_float32_positions_and_image_flags(written):
             assert frame.configuration.dimensions == d
             box = np.asarray(frame.configuration.box)
             np.testing.assert_allclose(box[:d], L, rtol=1e-7)
-            assert box[2] == (0.0 if d == 2 else box[2])
+            if d == 2:  # as deep as the longest edge (MDAnalysis needs a volume)
+                assert box[2] == np.float32(L.max())
+            assert np.all(box[3:] == 0)
             assert frame.configuration.step == k
             x = frame.particles.position
             assert x.dtype == np.float32
@@ -220,3 +224,238 @@ def test_without_gsd_the_error_names_the_extra(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "gsd.hoomd", None)
     with pytest.raises(ImportError, match=r"pip install 'granular\[gsd\]'"):
         tr.write(tmp_path / "run.gsd")
+
+
+def _mode(path):
+    return stat.S_IMODE(os.stat(path).st_mode)
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o077])
+def test_a_written_file_has_the_mode_a_plain_open_gives(tmp_path, umask):
+    # gsd creates its files 0o660 less the umask: 0o640 under 022, where open() gives 0o644
+    _, tr = run_2d_walled()
+    before = os.umask(umask)
+    try:
+        tr.write(tmp_path / "run.gsd")
+        with open(tmp_path / "plain", "w"):
+            pass
+        # over an existing file: its mode stays, as open(path, "w") keeps it
+        (tmp_path / "old.gsd").write_bytes(b"old")
+        os.chmod(tmp_path / "old.gsd", 0o604)
+        tr.write(tmp_path / "old.gsd")
+    finally:
+        os.umask(before)
+    assert _mode(tmp_path / "run.gsd") == _mode(tmp_path / "plain") == 0o666 & ~umask
+    assert _mode(tmp_path / "old.gsd") == 0o604
+    np.testing.assert_array_equal(granular.read(tmp_path / "old.gsd").positions, tr.positions)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["old.gsd", "plain", "run.gsd"]
+
+
+def test_a_write_that_fails_midway_leaves_the_old_file(tmp_path, monkeypatch):
+    from granular import gsd_io
+
+    _, tr = run_2d_walled()
+    path = tmp_path / "run.gsd"
+    tr.write(path)
+    before = path.read_bytes()
+    frame = gsd_io._frame
+
+    def second_fails(hoomd, traj, k, lower, upper):
+        if k == 1:
+            raise KeyboardInterrupt  # Ctrl-C while writing
+        return frame(hoomd, traj, k, lower, upper)
+
+    monkeypatch.setattr(gsd_io, "_frame", second_fails)
+    _, other = run_3d_periodic()
+    with pytest.raises(KeyboardInterrupt):
+        other.write(path)
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["run.gsd"]
+
+
+# -- reading refuses what a sound file cannot hold ------------------------------------------
+
+LOG = "log/granular/"
+
+
+def copy_chunks(src, dst, change=lambda k, name, data: data, extra=None):
+    """Copy a GSD file chunk by chunk through ``change(frame, name, data)``, which returns the
+    data to write or None to leave the chunk out, adding the chunks ``extra[frame]`` (a dict
+    name: data): files no writer of gsd.hoomd would make."""
+    with gsd.fl.open(str(src), "r") as f:
+        names = f.find_matching_chunk_names("")
+        frames = [
+            {n: f.read_chunk(k, n) for n in names if f.chunk_exists(k, n)} for k in range(f.nframes)
+        ]
+    with gsd.fl.open(str(dst), "w", application="test", schema="hoomd", schema_version=[1, 4]) as f:
+        for k, chunks in enumerate(frames):
+            for name, data in chunks.items():
+                data = change(k, name, data.copy())
+                if data is not None:
+                    f.write_chunk(name, data)
+            for name, data in (extra or {}).get(k, {}).items():
+                f.write_chunk(name, data)
+            f.end_frame()
+    return dst
+
+
+def _set(frame, name, value):
+    def change(k, chunk, data):
+        if k == frame and chunk == LOG + name:
+            return value(data) if callable(value) else value
+        return data
+
+    return change
+
+
+def _item(index, value):
+    def set_item(data):
+        data[index] = value
+        return data
+
+    return set_item
+
+
+BAD = {
+    "nan position": (_set(2, "unwrapped_positions", _item((3, 0), np.nan)), 2, "NaN"),
+    "zero radius": (_set(0, "radii", _item(1, 0.0)), 0, "radii must be positive"),
+    "negative mass": (_set(0, "masses", _item(4, -1.0)), 0, "masses must be positive"),
+    "nan radius": (_set(0, "radii", _item(0, np.nan)), 0, "radii contains NaN"),
+    "nan mass": (_set(0, "masses", _item(0, np.nan)), 0, "masses contains NaN"),
+    "repeated time": (_set(2, "time", np.array([0.1])), 2, r"time is 0.1, not after"),
+    "earlier time": (_set(3, "time", np.array([0.05])), 3, "sample times must increase"),
+    "nan time": (_set(1, "time", np.array([np.nan])), 1, "not a finite time"),
+    "boundary": (_set(0, "boundary", np.frombuffer(b"pgriodic", np.uint8)), 0, "pgriodic"),
+    "radii short": (_set(0, "radii", lambda r: r[:-1]), 0, r"radii has shape \(59,\)"),
+    "masses long": (_set(0, "masses", lambda m: np.append(m, 1.0)), 0, r"masses has shape"),
+    "missing field": (_set(1, "virial", None), 1, "log/granular/virial is missing"),
+    "missing time": (_set(3, "time", None), 3, "log/granular/time is missing"),
+    "missing radii": (_set(0, "radii", None), 0, "log/granular/radii is missing"),
+    "wrong shape": (_set(1, "momentum", np.zeros(3)), 1, r"momentum has shape \(3,\)"),
+    "positions shape": (_set(2, "unwrapped_positions", lambda x: x[:-1]), 2, "has shape"),
+    "text field": (_set(0, "boundary", np.zeros((2, 2))), 0, "boundary is not text"),
+    "not utf-8": (_set(0, "stop_reason", np.array([0xFF], np.uint8)), 0, "not UTF-8"),
+    "text numbers": (_set(0, "radii", np.frombuffer(b"ab", np.uint8)), 0, "radii has shape"),
+    "overlap": (
+        _set(1, "unwrapped_positions", lambda x: x[[0, 0, *range(2, len(x))]]),
+        1,
+        "overlap",
+    ),
+    "outside walls": (_set(0, "unwrapped_positions", _item((5, 1), 9.0)), 0, "outside|box"),
+    "velocities gone": (_set(2, "velocities", None), 2, "velocities is missing"),
+    "velocities nan": (_set(1, "velocities", _item((0, 1), np.inf)), 1, "velocities contains"),
+    "count down": (_set(3, "pair_collisions", np.array([0], np.int64)), 3, "never decreases"),
+    "count float": (_set(1, "wall_collisions", np.array([0.5])), 1, "not integers"),
+    "counter nan": (_set(2, "kinetic_energy", np.array([np.nan])), 2, "NaN or infinity"),
+    "format": (_set(0, "format", np.array([7], np.int64)), None, "layout 7"),
+    "not granular": (_set(0, "format", None), None, "not written by granular"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_read_refuses_an_impossible_file_naming_frame_and_field(tmp_path, case):
+    change, frame, message = BAD[case]
+    _, tr = run_2d_walled()  # 60 disks, 4 frames at t = 0, 0.1, 0.7, 2
+    tr.write(tmp_path / "good.gsd")
+    bad = copy_chunks(tmp_path / "good.gsd", tmp_path / "bad.gsd", change)
+    with pytest.raises(granular.errors.GSDFileError, match=message) as info:
+        granular.read(bad)
+    assert "bad.gsd" in str(info.value)
+    if frame is not None:  # else an error of the whole file
+        assert f"frame {frame}: " in str(info.value)
+
+
+def test_copy_chunks_alone_keeps_a_readable_file(tmp_path):
+    # the cases above differ from a sound file only by their change
+    _, tr = run_2d_walled()
+    tr.write(tmp_path / "good.gsd")
+    back = granular.read(copy_chunks(tmp_path / "good.gsd", tmp_path / "copy.gsd"))
+    np.testing.assert_array_equal(back.positions, tr.positions)
+
+
+def test_velocities_in_later_frames_only_are_refused(tmp_path):
+    tr = Simulation(Scene.random(20, 0.05, seed=4)).run(
+        t_stop=1.0, sample_times=[0.0, 0.5, 1.0], store=("positions",)
+    )
+    tr.write(tmp_path / "p.gsd")
+    extra = {1: {LOG + "velocities": np.zeros((20, 3))}}
+    copy_chunks(tmp_path / "p.gsd", tmp_path / "v.gsd", extra=extra)
+    with pytest.raises(granular.errors.GSDFileError, match=r"frame 1: .*velocities is there"):
+        granular.read(tmp_path / "v.gsd")
+
+
+def test_read_allocates_what_the_file_holds_not_what_it_claims(tmp_path):
+    """A 60-disk file whose frames claim N = 5e7 particles (HOOMD's particles/N) without
+    their data: gsd.hoomd's frames would allocate every standard field for 5e7 particles
+    (about 7 GB); granular.read reads only its log chunks.  Peak of the allocations traced
+    (NumPy's included): under 1 MB, against a file of ~30 kB."""
+    import tracemalloc
+
+    _, tr = run_2d_walled()
+    tr.write(tmp_path / "good.gsd")
+
+    def claim(k, name, data):
+        if name == "particles/N":
+            return np.array([50_000_000], np.uint32)
+        return None if name.startswith("particles/") else data
+
+    path = copy_chunks(tmp_path / "good.gsd", tmp_path / "claims.gsd", claim)
+    assert path.stat().st_size < 100_000
+    tracemalloc.start()
+    try:
+        back = granular.read(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    np.testing.assert_array_equal(back.positions, tr.positions)
+    assert peak < 1_000_000, peak
+
+
+def test_overlapping_chunks_cannot_make_read_take_more_than_the_file(tmp_path):
+    # an index whose entries all point at the same bytes: each chunk lies inside the file
+    # (gsd checks that), but together they claim far more than it holds
+    _, tr = run_2d_walled()
+    tr.write(tmp_path / "good.gsd")
+    from granular import gsd_io
+
+    with gsd_io._File(tmp_path / "good.gsd") as f:
+        f._budget = 100  # as if the file were 50 bytes long
+        with pytest.raises(granular.errors.GSDFileError, match="past twice the file's size"):
+            f.raw(0, LOG + "unwrapped_positions")
+
+
+def test_scene_from_gsd_refuses_a_foreign_file_it_cannot_represent(tmp_path):
+    frame = gsd.hoomd.Frame()
+    frame.particles.N = 2
+    frame.particles.types = ["A"]
+    frame.particles.position = np.array([[-0.25, 0, 0], [0.25, 0, 0]], dtype=np.float32)
+    frame.particles.diameter = np.array([0.25, 0.25], dtype=np.float32)
+    frame.configuration.box = [1, 1, 1, 0.5, 0, 0]  # tilted: a triclinic box
+    with gsd.hoomd.open(str(tmp_path / "tilt.gsd"), "w") as f:
+        f.append(frame)
+    with pytest.raises(granular.errors.GSDFileError, match=r"frame 0: configuration/box"):
+        Scene.from_gsd(tmp_path / "tilt.gsd")
+    frame.configuration.box = [1, 1, 1, 0, 0, 0]
+    frame.particles.diameter = np.array([0.75, 0.75], dtype=np.float32)  # overlapping
+    with gsd.hoomd.open(str(tmp_path / "overlap.gsd"), "w") as f:
+        f.append(frame)
+    with pytest.raises(granular.errors.GSDFileError, match="frame 0: not a valid state"):
+        Scene.from_gsd(tmp_path / "overlap.gsd")
+    # a user's own mistake stays the Scene's error, not the file's
+    _, tr = run_2d_walled()
+    tr.write(tmp_path / "ok.gsd")
+    with pytest.raises(ValueError, match="restitution must lie") as info:
+        Scene.from_gsd(tmp_path / "ok.gsd", restitution=2.0)
+    assert not isinstance(info.value, granular.errors.GSDFileError)
+
+
+def test_a_damaged_file_is_a_gsd_file_error(tmp_path):
+    _, tr = run_2d_walled()
+    tr.write(tmp_path / "good.gsd")
+    data = (tmp_path / "good.gsd").read_bytes()
+    (tmp_path / "cut.gsd").write_bytes(data[: len(data) // 2])
+    (tmp_path / "text.gsd").write_text("not a GSD file\n")
+    (tmp_path / "empty.gsd").write_bytes(b"")
+    for name in ("cut.gsd", "text.gsd", "empty.gsd"):
+        with pytest.raises(granular.errors.GSDFileError, match=name):
+            granular.read(tmp_path / name)
