@@ -7,17 +7,17 @@ coordinates in float32 (about 7 significant digits) and gives frames evenly spac
 ``write_trajectory`` keeps them.
 
 Boxes.  MDAnalysis (like a GSD file's ``configuration/box``) knows only three-dimensional,
-periodic boxes; granular gives it the box's edge lengths whatever its boundary, the same
-in a Universe (``to_universe``), a TRR file (``write_trajectory``) and a GSD file read by
+periodic boxes; granular gives it the box's edge lengths whatever its boundary, the same in
+a Universe (``to_universe``), a TRR file (``write_trajectory``) and a GSD file read by
 MDAnalysis.  In 2D the disks lie in the plane z = 0 of a box as deep as its longest edge,
 ``[Lx, Ly, max(Lx, Ly), 90, 90, 90]`` (``box_lengths_3d``): a depth of 0 would give a
 volume of 0, which MDAnalysis' analyses divide by (``InterRDF``), and a depth under twice
-a distance cutoff makes its periodic neighbour searches fail or count a pair twice.  So
-MDAnalysis' densities are per volume Lx Ly Lz: ``InterRDF`` of a 2D run is the g(r) of
-disks counted in spherical shells; the 2D g(r) is it times V_shell / (Lz A_ring), with
-V_shell = 4 pi (r2^3 - r1^3) / 3 and A_ring = pi (r2^2 - r1^2) for each bin [r1, r2].  In a
-walled box MDAnalysis still wraps distances across the walls, which pairs near opposite
-walls feel.
+a distance cutoff makes its periodic neighbour searches fail or count pairs that the
+brute-force search does not.  So MDAnalysis' densities are per volume Lx Ly Lz:
+``InterRDF`` of a 2D run counts pairs in spherical shells, about g(r) Lz / (2r); the 2D
+g(r) is its ``rdf`` times V_shell / (Lz A_ring), with V_shell = 4 pi (r2^3 - r1^3) / 3 and
+A_ring = pi (r2^2 - r1^2) for each bin [r1, r2] (docs/files.md).  In a walled box
+MDAnalysis still wraps distances across the walls, which pairs near opposite walls feel.
 """
 
 from __future__ import annotations
