@@ -181,16 +181,17 @@ def _temporary(path: Path) -> Path:
     replaces.  gsd creates its files 0o660 less the umask, and keeps the mode of a file it
     truncates; a rename keeps it too."""
     while True:
-        tmp = path.with_name(f".tmp-{secrets.token_hex(8)}-{path.name}")
+        tmp = path.with_name(f".tmp-{secrets.token_hex(8)}.gsd")
         try:
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
         except FileExistsError:  # 64 random bits taken: draw again
             continue
         try:
             with contextlib.suppress(FileNotFoundError):
-                os.fchmod(fd, stat.S_IMODE(os.stat(path).st_mode))
-        finally:
-            os.close(fd)
+                os.chmod(tmp, stat.S_IMODE(os.stat(path).st_mode))
+        except BaseException:
+            os.unlink(tmp)
+            raise
         return tmp
 
 
