@@ -95,10 +95,6 @@ def _text(value: str) -> np.ndarray:
     return np.frombuffer(value.encode("utf-8"), dtype=np.uint8).copy()
 
 
-def _untext(value: Any) -> str:
-    return bytes(np.asarray(value, dtype=np.uint8)).decode("utf-8")
-
-
 def _wrap(positions: np.ndarray, lower: np.ndarray, upper: np.ndarray, periodic: bool):
     """Positions wrapped into [lower, upper) and their integer images, float64:
     positions == wrapped + images * (upper - lower) up to rounding."""
@@ -248,6 +244,8 @@ class _File:
         if not self.path.is_file():
             raise FileNotFoundError(f"no GSD file at {str(self.path)!r}")
         self.where = repr(str(self.path))
+        # a sound file's chunks, each read once (frame 0's positions twice), fit in it twice
+        self._budget = 2 * self.path.stat().st_size
         fl = _gsd().fl
         try:
             self._f = fl.open(name=str(self.path), mode="r")
@@ -256,8 +254,6 @@ class _File:
         except (OSError, RuntimeError, ValueError, MemoryError, UnicodeError) as exc:
             raise GSDFileError(f"{self.where} is not a readable GSD file: {exc}") from exc
         self.frames = int(self._f.nframes)
-        # a sound file's chunks, each read once (frame 0's positions twice), fit in it twice
-        self._budget = 2 * self.path.stat().st_size
 
     def __enter__(self) -> _File:
         return self
@@ -342,13 +338,14 @@ def _params(f: _File) -> dict[str, Any]:
 
 def _wrap_checked(f: _File, k: int, x: np.ndarray, p: dict[str, Any]) -> np.ndarray:
     """Unwrapped positions of frame ``k`` wrapped into a periodic box (as they are in a
-    walled one).  Positions that are not finite, or so far out that their image would not
-    fit an int64, are left for Scene to refuse (it names what is wrong)."""
-    if p["boundary"] != "periodic" or not np.all(np.isfinite(x)):
-        return x
-    lengths = p["upper"] - p["lower"]
+    walled one).  Positions or a box that are not finite are left for Scene to refuse (it
+    names what is wrong); positions so far out that float64 cannot wrap them are refused."""
     with np.errstate(all="ignore"):
-        boxes = np.max(np.abs((x - p["lower"]) / lengths)) if lengths.all() else np.inf
+        lengths = p["upper"] - p["lower"]
+        sound = np.all(np.isfinite(x)) and np.all(np.isfinite(lengths)) and np.all(lengths > 0)
+        if p["boundary"] != "periodic" or not sound:
+            return x  # Scene refuses what is not sound, and says why
+        boxes = np.max(np.abs((x - p["lower"]) / lengths))
     if not boxes < 2.0**53:
         raise f.error(
             k,

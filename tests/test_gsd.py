@@ -252,20 +252,20 @@ def test_a_written_file_has_the_mode_a_plain_open_gives(tmp_path, umask):
 
 
 def test_a_write_that_fails_midway_leaves_the_old_file(tmp_path, monkeypatch):
-    from granular import gsd_io
-
     _, tr = run_2d_walled()
     path = tmp_path / "run.gsd"
     tr.write(path)
     before = path.read_bytes()
-    frame = gsd_io._frame
+    append = gsd.hoomd.HOOMDTrajectory.append
+    calls = []
 
-    def second_fails(hoomd, traj, k, lower, upper):
-        if k == 1:
-            raise KeyboardInterrupt  # Ctrl-C while writing
-        return frame(hoomd, traj, k, lower, upper)
+    def ctrl_c_at_the_second_frame(self, frame):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return append(self, frame)
 
-    monkeypatch.setattr(gsd_io, "_frame", second_fails)
+    monkeypatch.setattr(gsd.hoomd.HOOMDTrajectory, "append", ctrl_c_at_the_second_frame)
     _, other = run_3d_periodic()
     with pytest.raises(KeyboardInterrupt):
         other.write(path)

@@ -111,7 +111,9 @@ def test_a_2d_run_reaches_mdanalysis_with_one_box_that_its_analyses_accept(tmp_p
     tr.write(tmp_path / "run.gsd")
     from_file = mda.Universe(str(tmp_path / "run.gsd"))
     in_memory = tr.to_universe()
-    for u in (from_file, in_memory):
+    trr = mda.Universe.empty(s.n, trajectory=False)
+    trr.load_new(interop.write_trajectory(tmp_path / "run.trr", times, tr.positions, box=lengths))
+    for u in (from_file, in_memory, trr):
         assert u.trajectory.n_frames == len(times)
         for ts in u.trajectory:
             np.testing.assert_array_equal(ts.dimensions, [2, 1, 2, 90, 90, 90])
