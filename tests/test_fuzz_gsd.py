@@ -30,17 +30,39 @@ LOG = "log/granular/"
 
 
 def _bases(folder):
-    """Two small sound files: 2D walls with velocities, 3D periodic without."""
+    """Three small sound files: granular's 2D walls with velocities and 3D periodic without,
+    and one granular did not write."""
     import granular
 
     walls = granular.Scene.random(6, 0.05, dim=2, boundary="walls", restitution=0.9, seed=1)
     a = granular.Simulation(walls).run(t_stop=0.5, sample_times=[0.0, 0.2, 0.5])
     gas = granular.Scene.random(5, 0.05, dim=3, seed=2)
     b = granular.Simulation(gas).run(t_stop=1.0, sample_times=[0.0, 0.5, 1.0], store=("positions",))
-    paths = [folder / "walls.gsd", folder / "periodic.gsd"]
+    paths = [folder / "walls.gsd", folder / "periodic.gsd", folder / "foreign.gsd"]
     a.write(paths[0])
     b.write(paths[1])
+    _foreign(paths[2])
     return paths
+
+
+def _foreign(path):
+    """A HOOMD-style file granular did not write: 4 particles, frame 1 without the diameters
+    (a reader takes frame 0's)."""
+    import gsd.hoomd
+
+    with gsd.hoomd.open(str(path), "w") as f:
+        for k in range(2):
+            frame = gsd.hoomd.Frame()
+            frame.configuration.box = [2.0, 2.0, 0.0, 0.0, 0.0, 0.0]
+            frame.configuration.dimensions = 2
+            frame.particles.N = 4
+            frame.particles.types = ["A"]
+            xy = np.array([[-0.5, -0.5], [0.5, -0.5], [-0.5, 0.5], [0.5, 0.5]]) + 0.1 * k
+            frame.particles.position = np.c_[xy, np.zeros(4)].astype(np.float32)
+            frame.particles.velocity = np.ones((4, 3), np.float32)
+            if k == 0:
+                frame.particles.diameter = np.full(4, 0.2, np.float32)
+            f.append(frame)
 
 
 def _chunks(path):
@@ -78,20 +100,24 @@ def _random_array(rng):
 
 def _mutate_chunks(rng, frames):
     """One chunk-level change: a field dropped, replaced by random data, scaled or spoilt in
-    one entry, or copied from another frame; or a frame dropped or repeated."""
+    one entry, or copied from another frame, particles/N set to a number the data do not
+    back; or a frame dropped or repeated."""
     frames = [dict(c) for c in frames]
     k = int(rng.integers(len(frames)))
     names = sorted(frames[k])
     name = names[int(rng.integers(len(names)))]
-    what = rng.integers(7)
-    if what == 0:
+    what = rng.integers(8)
+    if what == 7 and "particles/N" in frames[k]:  # a claim the data does not back
+        frames[k]["particles/N"] = np.array([rng.choice([0, 5, 50_000_000, 2**32 - 1])], np.uint32)
+    elif what == 0:
         del frames[k][name]
     elif what == 1:
         frames[k][name] = _random_array(rng)
     elif what == 2 and frames[k][name].dtype.kind == "f":
         data = frames[k][name].copy()
         flat = data.reshape(-1)
-        flat[int(rng.integers(flat.size))] = rng.choice([np.nan, np.inf, -1.0, 0.0, 1e200])
+        with np.errstate(over="ignore"):  # 1e200 is inf in float32: a value as good
+            flat[int(rng.integers(flat.size))] = rng.choice([np.nan, np.inf, -1.0, 0.0, 1e200])
         frames[k][name] = data
     elif what == 3:  # inconsistent frames: one frame's field in another
         j = int(rng.integers(len(frames)))
@@ -214,9 +240,10 @@ def test_damaged_gsd_files_end_in_a_clear_error_or_a_valid_trajectory():
     assert done, f"the fuzz process died (code {run.returncode}) in {last}: {stderr[-2000:]}"
     counts, peak_mb = done[0]["done"], done[0]["peak_kb"] / 1024
     assert sum(counts.values()) == COUNT
-    # both outcomes occur: the damage is not all caught by gsd, nor all harmless
+    # both outcomes occur: the damage is not all caught by gsd, nor all harmless (a foreign
+    # file is refused by read and read by Scene.from_gsd)
     assert counts.get("refused/refused", 0) > COUNT // 4, counts
-    assert counts.get("ok/ok", 0) > 0, counts
+    assert counts.get("ok/ok", 0) > 0 and counts.get("refused/ok", 0) > 0, counts
     # the interpreter, NumPy, gsd and granular take ~100 MB; files of a few kB add nothing
     assert peak_mb < 400, peak_mb
 
