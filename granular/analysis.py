@@ -12,6 +12,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .errors import shown
+
 
 def _positions(positions):
     x = np.asarray(positions, dtype=np.float64)
@@ -77,6 +79,32 @@ def _uniform(times):
     return len(dt) > 0 and np.allclose(dt, dt[0], rtol=1e-9, atol=0)
 
 
+def _nearest_on_grid(lag: float, spacing: float, k_max: int) -> str:
+    """The one or two multiples of ``spacing`` nearest to ``lag`` (below and above it),
+    from 1 to ``k_max`` of them, as text for a message."""
+    steps = lag / spacing
+    ks = {min(max(math.floor(steps), 1), k_max), min(max(math.ceil(steps), 1), k_max)}
+    return " and ".join(shown(k * spacing) for k in sorted(ks))
+
+
+def _nearest_differences(t: NDArray[np.float64], lag: float) -> list[float]:
+    """The differences of sample times nearest to ``lag``: the largest below it and the
+    smallest above it (either may be missing), in O(T log T) without forming all pairs."""
+    out = []
+    j = np.searchsorted(t, t + lag, side="right") - 1  # latest sample at or before t_i + lag
+    below = t[j] - t
+    below = below[(j > np.arange(len(t))) & (below < lag)]
+    if below.size:
+        out.append(float(below.max()))
+    j = np.searchsorted(t, t + lag, side="left")  # earliest sample at or after t_i + lag
+    ok = j < len(t)
+    above = t[j[ok]] - t[ok]
+    above = above[above > lag]
+    if above.size:
+        out.append(float(above.min()))
+    return out
+
+
 def tamsd(
     positions: ArrayLike,
     lags: ArrayLike | None = None,
@@ -123,12 +151,12 @@ def tamsd(
         k = np.atleast_1d(np.asarray(lag_samples))
         if k.size and not np.issubdtype(k.dtype, np.integer):
             if not np.all(np.isfinite(k)) or np.any(k != np.rint(k)):
-                raise ValueError(f"lag_samples must be whole numbers of samples, got {k}")
+                raise ValueError(f"lag_samples must be whole numbers of samples, got {shown(k)}")
         k = k.astype(np.int64)
         if np.any(k < 1) or np.any(k > T - 1):
             raise ValueError(
                 f"lag_samples must be between 1 and {T - 1} (the trajectory "
-                f"has {T} samples), got {k}"
+                f"has {T} samples), got {shown(k)}"
             )
         if times is not None and not uniform:
             raise ValueError("lag_samples needs uniformly spaced samples; give lags in time")
@@ -137,7 +165,7 @@ def tamsd(
     if not np.all(np.isfinite(lags)) or np.any(lags <= 0) or np.any(lags > t[-1] - t[0]):
         raise ValueError(
             f"lags must be positive and no longer than the trajectory "
-            f"({t[-1] - t[0]:g}), got {lags}"
+            f"({shown(t[-1] - t[0])}), got {shown(lags)}"
         )
     if method == "auto":
         method = "fft" if uniform else "direct"
@@ -149,11 +177,10 @@ def tamsd(
         k = np.rint(steps).astype(np.int64)
         bad = ~np.isclose(steps, k, rtol=1e-9, atol=1e-9)
         if np.any(bad):
-            lag = lags[bad][0]
-            below = math.floor(lag / spacing) * spacing
+            lag = float(lags[bad][0])
             raise ValueError(
-                f"lag {lag:g} is not a multiple of the sample spacing {spacing:g}; the "
-                f"nearest lags that are: {below:g} and {below + spacing:g} (or give "
+                f"lag {shown(lag)} is not a multiple of the sample spacing {shown(spacing)}; "
+                f"the nearest lags that are: {_nearest_on_grid(lag, spacing, T - 1)} (or give "
                 "lag_samples= in samples)"
             )
         out = _tamsd_fft(x, k)
@@ -196,7 +223,14 @@ def _tamsd_direct(x, t, lags):
         ok = np.isclose(t[pick], target, rtol=1e-9, atol=1e-12 * max(1.0, abs(t[-1])))
         i = np.nonzero(ok)[0]
         if len(i) == 0:
-            raise ValueError(f"no pair of sample times is {lag} apart")
+            near = _nearest_differences(t, lag)
+            raise ValueError(
+                f"no pair of sample times is {shown(lag)} apart (to 1e-9 relative): the "
+                f"nearest lags these samples have are {' and '.join(map(shown, near))}.  "
+                f"For a lag of {shown(lag)}, sample at uniformly spaced times (every "
+                "multiple of the spacing is then a lag), or include both t and "
+                f"t + {shown(lag)} among the sample times"
+            )
         diff = x[pick[i]] - x[i]
         out[:, m] = np.einsum("pna,pna->n", diff, diff) / len(i)
     return out

@@ -193,3 +193,21 @@ def test_tamsd_lags_in_samples_and_a_lag_off_the_grid_named():
         analysis.tamsd(x, times=t, lag_samples=[0, 101])
     with pytest.raises(ValueError, match="whole numbers"):
         analysis.tamsd(x, times=t, lag_samples=[1.5])
+
+
+def test_a_lag_no_pair_of_log_spaced_samples_has_names_the_nearest_and_the_way_out():
+    """Log-spaced samples have few exact lags: a lag none of their pairs has is refused
+    with the nearest lags the samples do have (below and above, found by brute force here)
+    and the two ways to get it (uniform samples, or t and t + lag among them)."""
+    t = np.array([0.0, 0.1, 0.3, 0.7, 1.5, 3.1])
+    x = np.random.default_rng(0).normal(size=(len(t), 4, 2))
+    with pytest.raises(ValueError) as info:
+        analysis.tamsd(x, [1.0], times=t)
+    msg = str(info.value)
+    diffs = (t[None, :] - t[:, None]).ravel()
+    below, above = diffs[diffs < 1.0].max(), diffs[diffs > 1.0].min()  # 0.8 and 1.2
+    assert f"nearest lags these samples have are {below:.12g} and {above:.12g}" in msg
+    assert "uniformly spaced" in msg and "t + 1 among the sample times" in msg
+    # a lag below the shortest difference has only a nearest above
+    with pytest.raises(ValueError, match=r"samples have are 0\.1\.  For a lag of 0\.05"):
+        analysis.tamsd(x, [0.05], times=t)
