@@ -151,6 +151,7 @@ for ax, xi in zip(axes, (1.0, 0.8)):
         "ensemble average."
     ),
     """lags = np.logspace(-2, np.log10(t_stop / 2), 15)
+lags = np.unique(np.rint(lags / 0.01)) * 0.01  # whole steps of dt, as run() needs
 c = langevin.coefficients_from_scene(eq.replace(restitution=0.8))
 u = langevin.run(
     n,
@@ -322,6 +323,7 @@ print(f"EDMD {slope:.3f}, UDSBM {slope_u:.3f}, theory {slope_th:.3f}", "(1/6 onl
     """c8 = theory.langevin_coefficients(1000, 0.025, 1.0, 0.8, 2 / 3)  # the thesis' gas, xi = 0.8
 t_sde = 100.0 if not QUICK else 10.0  # 2000 steps of dt = 0.05
 lags = np.logspace(-1, np.log10(t_sde / 4), 8 if not QUICK else 3)
+lags = np.unique(np.rint(lags / 0.05)) * 0.05  # whole steps of dt, as run() needs
 fig, axes = plt.subplots(1, 2, figsize=(11, 4), layout="constrained")
 for a in (1.0, 5 / 6):
     res = langevin.run(
