@@ -144,7 +144,7 @@ def _no_lags() -> ValueError:
         "no time-averaged MSD was accumulated (the run had no tamsd_lags): ask for it "
         "before the run, with "
         "langevin.run(..., tamsd_lags=[...]) -- lags in time, whole steps of dt, at most "
-        "t_stop (e.g. tamsd_lags=np.array([1, 10, 100]) * dt)"
+        "t_stop (e.g. tamsd_lags=[dt, 10 * dt, 100 * dt])"
     )
 
 
@@ -170,7 +170,7 @@ def _lag_steps(lags: ArrayLike, dt: float, n_steps: int, name: str) -> NDArray[n
             f"{name}: {shown(lag)} is not a whole number of steps of dt = {shown(dt)}, and the "
             f"engine samples the path at whole steps only; the nearest lags that are: "
             f"{_nearest_on_grid(lag, dt, n_steps)} (to round lags to whole steps: "
-            f"np.unique(np.rint(lags / dt)) * dt)"
+            f"numpy.unique(numpy.rint(lags / dt)) * dt)"
         )
     return k.astype(np.int64)
 
@@ -564,7 +564,7 @@ def _threads(threads: int | None) -> int:
         except AttributeError:  # not on Linux
             return max(1, os.cpu_count() or 1)
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise ValueError(f"threads must be a whole number >= 1 or None, got {threads!r}")
+        raise ValueError(f"threads must be a whole number >= 1 or None, got {shown(threads)}")
     return min(int(threads), 1024)
 
 
