@@ -285,7 +285,9 @@ class Simulation:
             raise ValueError(f"unknown stop_when keys {sorted(unknown)}; use {_STOP_KEYS}")
         store = tuple(store)
         if set(store) - set(_STORE):
-            raise ValueError(f"store may contain only {_STORE}, got {store}")
+            from .errors import shown
+
+            raise ValueError(f"store may contain only {_STORE}, got {shown(store)}")
         t_now = self.time
         t_end = math.inf if t_stop is None else float(t_stop)
         if math.isnan(t_end):

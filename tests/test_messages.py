@@ -86,6 +86,12 @@ CASES = {
         lambda: granular.Simulation(granular.Scene.random(10, 0.03, seed=1), shell=np.str_("x")),
         "got 'x'",
     ),
+    "store": (
+        lambda: granular.Simulation(granular.Scene.random(10, 0.03, dim=2, seed=1)).run(
+            t_stop=1.0, store=np.array(["positions", "speeds"])
+        ),
+        "got ('positions', 'speeds')",
+    ),
     "stop_when NaN": (
         lambda: granular.Simulation(granular.Scene.random(10, 0.03, dim=2, seed=1)).run(
             t_stop=1.0, stop_when={"kinetic_energy": f64("nan")}
