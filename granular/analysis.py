@@ -252,6 +252,45 @@ def diffusivity(times: ArrayLike, msd_values: ArrayLike, dim: int = 3) -> NDArra
     return deriv / (2.0 * dim)
 
 
+def _window(t, t_min, t_max, what):
+    """The samples with t_min <= t <= t_max (either bound may be None), at least three."""
+    sel = np.ones(len(t), dtype=bool)
+    if t_min is not None:
+        sel &= t >= t_min
+    if t_max is not None:
+        sel &= t <= t_max
+    if sel.sum() < 3:
+        raise ValueError(
+            f"{what} needs at least three points in [t_min, t_max] = [{shown(t_min)}, "
+            f"{shown(t_max)}], got {int(sel.sum())}"
+        )
+    return sel
+
+
+def _positive_for_log(x, name, t):
+    """Refuse x <= 0 (or NaN) before its logarithm: -inf would reach the least squares."""
+    bad = ~(x > 0)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        hint = "; give t_min > 0" if name == "t" else ""
+        raise ValueError(
+            f"a fit against ln {name} needs {name} > 0 in the window, got {name} = "
+            f"{shown(x[i])} at t = {shown(t[i])}{hint}"
+        )
+
+
+def _line(xs, ys):
+    """Ordinary least squares ys = slope * xs + intercept: (slope, intercept, standard
+    error of the slope from the residuals)."""
+    A = np.vstack([xs, np.ones_like(xs)]).T
+    coef, *_ = np.linalg.lstsq(A, ys, rcond=None)
+    dof = len(xs) - 2
+    resid = ys - A @ coef
+    s2 = float(resid @ resid) / dof if dof > 0 else np.nan
+    cov = s2 * np.linalg.inv(A.T @ A)
+    return float(coef[0]), float(coef[1]), float(math.sqrt(cov[0, 0]))
+
+
 def fit_slope(
     times: ArrayLike,
     values: ArrayLike,
@@ -261,28 +300,73 @@ def fit_slope(
 ) -> tuple[float, float, float]:
     """Least-squares straight line through ``values`` against ``times`` (or against
     ``ln(times)`` with ``log=True``: the long-time MSD of a granular gas grows like
-    ln t) between t_min and t_max, as in the thesis' App. F.
+    ln t) between t_min and t_max, as in the thesis' App. F.  For a power law (values
+    against t on log-log axes) see ``fit_power_law``.
 
     Returns (slope, intercept, slope_standard_error) -- the error from the residuals
     (ordinary least squares), which understates it for correlated MSD points.
     """
     t = np.asarray(times, dtype=np.float64)
     v = np.asarray(values, dtype=np.float64)
-    sel = np.ones(len(t), dtype=bool)
-    if t_min is not None:
-        sel &= t >= t_min
-    if t_max is not None:
-        sel &= t <= t_max
-    if sel.sum() < 3:
-        raise ValueError("fit_slope needs at least three points in [t_min, t_max]")
-    xs = np.log(t[sel]) if log else t[sel]
-    A = np.vstack([xs, np.ones_like(xs)]).T
-    coef, *_ = np.linalg.lstsq(A, v[sel], rcond=None)
-    dof = len(xs) - 2
-    resid = v[sel] - A @ coef
-    s2 = float(resid @ resid) / dof if dof > 0 else np.nan
-    cov = s2 * np.linalg.inv(A.T @ A)
-    return float(coef[0]), float(coef[1]), float(math.sqrt(cov[0, 0]))
+    sel = _window(t, t_min, t_max, "fit_slope")
+    if log:
+        _positive_for_log(t[sel], "t", t[sel])
+    return _line(np.log(t[sel]) if log else t[sel], v[sel])
+
+
+def fit_power_law(
+    times: ArrayLike,
+    values: ArrayLike,
+    *,
+    t_min: float | None = None,
+    t_max: float | None = None,
+) -> tuple[float, float, float]:
+    """Fit a power law ``values = prefactor * t**exponent`` between t_min and t_max: the
+    least-squares straight line through ``ln(values)`` against ``ln(t)``, the slope of
+    the curve on log-log axes.  Over a window short next to the curve's bends it is the
+    local exponent ``d ln MSD / d ln t`` there: 2 for ballistic motion, 1 for diffusion,
+    1/6 for the late MSD of a viscoelastic gas.
+
+    Parameters
+    ----------
+    times : (T,) array
+        Sample times (time units); those in the window must be > 0.
+    values : (T,) array
+        The quantity (e.g. an MSD, length^2); those in the window must be > 0.
+    t_min, t_max : float, optional
+        The window, inclusive (time units); by default every sample.  At least three
+        samples must fall in it.
+
+    Returns
+    -------
+    exponent : float
+        The fitted slope of ln(values) against ln(t) (dimensionless).
+    prefactor : float
+        ``exp(intercept)``: the fitted value at t = 1 (units of values / time^exponent).
+    exponent_standard_error : float
+        From the residuals (ordinary least squares): right for independent,
+        equally noisy logarithms (a relative error of the values the same at every
+        time), but it understates the error of an MSD, whose points are correlated.
+        For an honest error fit each run of an ensemble and take the spread of the
+        exponents (``ensemble_mean``).
+
+    Raises
+    ------
+    ValueError
+        Fewer than three samples in the window, or a time or value <= 0 (or NaN) in it.
+    """
+    t = np.asarray(times, dtype=np.float64)
+    v = np.asarray(values, dtype=np.float64)
+    if t.ndim != 1 or v.shape != t.shape:
+        raise ValueError(
+            f"times and values must be one-dimensional and of one length, got shapes "
+            f"{t.shape} and {v.shape}"
+        )
+    sel = _window(t, t_min, t_max, "fit_power_law")
+    _positive_for_log(t[sel], "t", t[sel])
+    _positive_for_log(v[sel], "values", t[sel])
+    exponent, intercept, err = _line(np.log(t[sel]), np.log(v[sel]))
+    return exponent, math.exp(intercept), err
 
 
 # -- velocities ------------------------------------------------------------------------------
