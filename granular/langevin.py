@@ -140,11 +140,11 @@ class _ArrayAndMethod(np.ndarray):
 
 
 def _no_lags() -> ValueError:
+    """The error of a TAMSD asked of a run that accumulated none (no ``tamsd_lags``)."""
     return ValueError(
         "no time-averaged MSD was accumulated (the run had no tamsd_lags): ask for it "
-        "before the run, with "
-        "langevin.run(..., tamsd_lags=[...]) -- lags in time, whole steps of dt, at most "
-        "t_stop (e.g. tamsd_lags=[dt, 10 * dt, 100 * dt])"
+        "before the run, with langevin.run(..., tamsd_lags=[...]) -- lags in time, whole "
+        "steps of dt, at most t_stop (e.g. tamsd_lags=[dt, 10 * dt, 100 * dt])"
     )
 
 
@@ -511,7 +511,9 @@ def theory_tamsd(
     reached at the window's start for the Langevin model (tau0 = inf),
     ``theory.udsbm_increment_msd`` for UDSBM.
     ``v0_sq`` is the initial mean squared velocity per component (None: thermal, or App.
-    C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD.  For UDSBM
+    C's for UDSBM).  Each lag must be a whole number of steps of ``dt`` (as ``run``'s
+    ``tamsd_lags``); any other is refused, with the nearest two that are.  Ergodic
+    Langevin from a thermal start: the ensemble MSD.  For UDSBM
     with ``exponent`` a != 1, ``theory.powerlaw_udsbm_increment_msd`` (numerical moments;
     ``v0_sq`` must then be given)."""
     from . import theory
