@@ -114,7 +114,9 @@ def _trail_particles(trails, n):
         return np.empty(0, dtype=np.intp)
     t = np.atleast_1d(np.asarray(trails))
     if t.ndim != 1 or (t.size and t.dtype.kind not in "iu"):
-        raise ValueError(f"trails must be particle indices (integers), got {trails!r}")
+        from .errors import shown
+
+        raise ValueError(f"trails must be particle indices (integers), got {shown(trails)}")
     bad = t[(t < 0) | (t >= n)]
     if bad.size:
         raise IndexError(

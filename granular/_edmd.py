@@ -51,7 +51,9 @@ def build(scene, cell_factor=1.0, big_ratio=_core.BIG_RATIO, shell="auto"):
         dense = scene.dim == 3 and scene.packing_fraction >= LIST_MIN_PACKING
         shell = LIST_SHELL if dense and not big else 0.0
     elif isinstance(shell, (bool, str)) or not isinstance(shell, (int, float, np.number)):
-        raise TypeError(f"shell must be 'auto' or a number >= 0, got {shell!r}")
+        from .errors import shown
+
+        raise TypeError(f"shell must be 'auto' or a number >= 0, got {shown(shell)}")
     elif shell > 0 and big:
         # the shell is a fraction of the largest diameter: every small particle's
         # list would reach as far as the big one's (thousands of entries each)

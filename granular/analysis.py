@@ -12,6 +12,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .errors import shown
+
 
 def _positions(positions):
     x = np.asarray(positions, dtype=np.float64)
@@ -77,6 +79,32 @@ def _uniform(times):
     return len(dt) > 0 and np.allclose(dt, dt[0], rtol=1e-9, atol=0)
 
 
+def _nearest_on_grid(lag: float, spacing: float, k_max: int) -> str:
+    """The one or two multiples of ``spacing`` nearest to ``lag`` (below and above it),
+    from 1 to ``k_max`` of them, as text for a message."""
+    steps = lag / spacing
+    ks = {min(max(math.floor(steps), 1), k_max), min(max(math.ceil(steps), 1), k_max)}
+    return " and ".join(shown(k * spacing) for k in sorted(ks))
+
+
+def _nearest_differences(t: NDArray[np.float64], lag: float) -> list[float]:
+    """The differences of sample times nearest to ``lag``: the largest below it and the
+    smallest above it (either may be missing), in O(T log T) without forming all pairs."""
+    out = []
+    j = np.searchsorted(t, t + lag, side="right") - 1  # latest sample at or before t_i + lag
+    below = t[j] - t
+    below = below[(j > np.arange(len(t))) & (below < lag)]
+    if below.size:
+        out.append(float(below.max()))
+    j = np.searchsorted(t, t + lag, side="left")  # earliest sample at or after t_i + lag
+    ok = j < len(t)
+    above = t[j[ok]] - t[ok]
+    above = above[above > lag]
+    if above.size:
+        out.append(float(above.min()))
+    return out
+
+
 def tamsd(
     positions: ArrayLike,
     lags: ArrayLike | None = None,
@@ -123,12 +151,12 @@ def tamsd(
         k = np.atleast_1d(np.asarray(lag_samples))
         if k.size and not np.issubdtype(k.dtype, np.integer):
             if not np.all(np.isfinite(k)) or np.any(k != np.rint(k)):
-                raise ValueError(f"lag_samples must be whole numbers of samples, got {k}")
+                raise ValueError(f"lag_samples must be whole numbers of samples, got {shown(k)}")
         k = k.astype(np.int64)
         if np.any(k < 1) or np.any(k > T - 1):
             raise ValueError(
                 f"lag_samples must be between 1 and {T - 1} (the trajectory "
-                f"has {T} samples), got {k}"
+                f"has {T} samples), got {shown(k)}"
             )
         if times is not None and not uniform:
             raise ValueError("lag_samples needs uniformly spaced samples; give lags in time")
@@ -137,7 +165,7 @@ def tamsd(
     if not np.all(np.isfinite(lags)) or np.any(lags <= 0) or np.any(lags > t[-1] - t[0]):
         raise ValueError(
             f"lags must be positive and no longer than the trajectory "
-            f"({t[-1] - t[0]:g}), got {lags}"
+            f"({shown(t[-1] - t[0])}), got {shown(lags)}"
         )
     if method == "auto":
         method = "fft" if uniform else "direct"
@@ -149,11 +177,10 @@ def tamsd(
         k = np.rint(steps).astype(np.int64)
         bad = ~np.isclose(steps, k, rtol=1e-9, atol=1e-9)
         if np.any(bad):
-            lag = lags[bad][0]
-            below = math.floor(lag / spacing) * spacing
+            lag = float(lags[bad][0])
             raise ValueError(
-                f"lag {lag:g} is not a multiple of the sample spacing {spacing:g}; the "
-                f"nearest lags that are: {below:g} and {below + spacing:g} (or give "
+                f"lag {shown(lag)} is not a multiple of the sample spacing {shown(spacing)}; "
+                f"the nearest lags that are: {_nearest_on_grid(lag, spacing, T - 1)} (or give "
                 "lag_samples= in samples)"
             )
         out = _tamsd_fft(x, k)
@@ -196,7 +223,14 @@ def _tamsd_direct(x, t, lags):
         ok = np.isclose(t[pick], target, rtol=1e-9, atol=1e-12 * max(1.0, abs(t[-1])))
         i = np.nonzero(ok)[0]
         if len(i) == 0:
-            raise ValueError(f"no pair of sample times is {lag} apart")
+            near = _nearest_differences(t, lag)
+            raise ValueError(
+                f"no pair of sample times is {shown(lag)} apart (to 1e-9 relative): the "
+                f"nearest lags these samples have are {' and '.join(map(shown, near))}.  "
+                f"For a lag of {shown(lag)}, sample at uniformly spaced times (every "
+                "multiple of the spacing is then a lag), or include both t and "
+                f"t + {shown(lag)} among the sample times"
+            )
         diff = x[pick[i]] - x[i]
         out[:, m] = np.einsum("pna,pna->n", diff, diff) / len(i)
     return out
@@ -218,6 +252,45 @@ def diffusivity(times: ArrayLike, msd_values: ArrayLike, dim: int = 3) -> NDArra
     return deriv / (2.0 * dim)
 
 
+def _window(t, t_min, t_max, what):
+    """The samples with t_min <= t <= t_max (either bound may be None), at least three."""
+    sel = np.ones(len(t), dtype=bool)
+    if t_min is not None:
+        sel &= t >= t_min
+    if t_max is not None:
+        sel &= t <= t_max
+    if sel.sum() < 3:
+        raise ValueError(
+            f"{what} needs at least three points in [t_min, t_max] = [{shown(t_min)}, "
+            f"{shown(t_max)}], got {int(sel.sum())}"
+        )
+    return sel
+
+
+def _positive_for_log(x, name, t):
+    """Refuse x <= 0 (or NaN) before its logarithm: -inf would reach the least squares."""
+    bad = ~(x > 0)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        hint = "; give t_min > 0" if name == "t" else ""
+        raise ValueError(
+            f"a fit against ln {name} needs {name} > 0 in the window, got {name} = "
+            f"{shown(x[i])} at t = {shown(t[i])}{hint}"
+        )
+
+
+def _line(xs, ys):
+    """Ordinary least squares ys = slope * xs + intercept: (slope, intercept, standard
+    error of the slope from the residuals)."""
+    A = np.vstack([xs, np.ones_like(xs)]).T
+    coef, *_ = np.linalg.lstsq(A, ys, rcond=None)
+    dof = len(xs) - 2
+    resid = ys - A @ coef
+    s2 = float(resid @ resid) / dof if dof > 0 else np.nan
+    cov = s2 * np.linalg.inv(A.T @ A)
+    return float(coef[0]), float(coef[1]), float(math.sqrt(cov[0, 0]))
+
+
 def fit_slope(
     times: ArrayLike,
     values: ArrayLike,
@@ -227,28 +300,73 @@ def fit_slope(
 ) -> tuple[float, float, float]:
     """Least-squares straight line through ``values`` against ``times`` (or against
     ``ln(times)`` with ``log=True``: the long-time MSD of a granular gas grows like
-    ln t) between t_min and t_max, as in the thesis' App. F.
+    ln t) between t_min and t_max, as in the thesis' App. F.  For a power law (values
+    against t on log-log axes) see ``fit_power_law``.
 
     Returns (slope, intercept, slope_standard_error) -- the error from the residuals
     (ordinary least squares), which understates it for correlated MSD points.
     """
     t = np.asarray(times, dtype=np.float64)
     v = np.asarray(values, dtype=np.float64)
-    sel = np.ones(len(t), dtype=bool)
-    if t_min is not None:
-        sel &= t >= t_min
-    if t_max is not None:
-        sel &= t <= t_max
-    if sel.sum() < 3:
-        raise ValueError("fit_slope needs at least three points in [t_min, t_max]")
-    xs = np.log(t[sel]) if log else t[sel]
-    A = np.vstack([xs, np.ones_like(xs)]).T
-    coef, *_ = np.linalg.lstsq(A, v[sel], rcond=None)
-    dof = len(xs) - 2
-    resid = v[sel] - A @ coef
-    s2 = float(resid @ resid) / dof if dof > 0 else np.nan
-    cov = s2 * np.linalg.inv(A.T @ A)
-    return float(coef[0]), float(coef[1]), float(math.sqrt(cov[0, 0]))
+    sel = _window(t, t_min, t_max, "fit_slope")
+    if log:
+        _positive_for_log(t[sel], "t", t[sel])
+    return _line(np.log(t[sel]) if log else t[sel], v[sel])
+
+
+def fit_power_law(
+    times: ArrayLike,
+    values: ArrayLike,
+    *,
+    t_min: float | None = None,
+    t_max: float | None = None,
+) -> tuple[float, float, float]:
+    """Fit a power law ``values = prefactor * t**exponent`` between t_min and t_max: the
+    least-squares straight line through ``ln(values)`` against ``ln(t)``, the slope of
+    the curve on log-log axes.  Over a window short next to the curve's bends it is the
+    local exponent ``d ln MSD / d ln t`` there: 2 for ballistic motion, 1 for diffusion,
+    1/6 for the late MSD of a viscoelastic gas.
+
+    Parameters
+    ----------
+    times : (T,) array
+        Sample times (time units); those in the window must be > 0.
+    values : (T,) array
+        The quantity (e.g. an MSD, length^2); those in the window must be > 0.
+    t_min, t_max : float, optional
+        The window, inclusive (time units); by default every sample.  At least three
+        samples must fall in it.
+
+    Returns
+    -------
+    exponent : float
+        The fitted slope of ln(values) against ln(t) (dimensionless).
+    prefactor : float
+        ``exp(intercept)``: the fitted value at t = 1 (units of values / time^exponent).
+    exponent_standard_error : float
+        From the residuals (ordinary least squares): right for independent,
+        equally noisy logarithms (a relative error of the values the same at every
+        time), but it understates the error of an MSD, whose points are correlated.
+        For an honest error fit each run of an ensemble and take the spread of the
+        exponents (``ensemble_mean``).
+
+    Raises
+    ------
+    ValueError
+        Fewer than three samples in the window, or a time or value <= 0 (or NaN) in it.
+    """
+    t = np.asarray(times, dtype=np.float64)
+    v = np.asarray(values, dtype=np.float64)
+    if t.ndim != 1 or v.shape != t.shape:
+        raise ValueError(
+            f"times and values must be one-dimensional and of one length, got shapes "
+            f"{t.shape} and {v.shape}"
+        )
+    sel = _window(t, t_min, t_max, "fit_power_law")
+    _positive_for_log(t[sel], "t", t[sel])
+    _positive_for_log(v[sel], "values", t[sel])
+    exponent, intercept, err = _line(np.log(t[sel]), np.log(v[sel]))
+    return exponent, math.exp(intercept), err
 
 
 # -- velocities ------------------------------------------------------------------------------

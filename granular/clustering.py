@@ -48,7 +48,9 @@ def wave_vectors(
     """
     lengths = np.asarray(box_lengths, dtype=np.float64)
     if lengths.ndim != 1 or lengths.size not in (2, 3) or np.any(~(lengths > 0)):
-        raise ValueError(f"box_lengths must be 2 or 3 positive lengths, got {box_lengths!r}")
+        from .errors import shown
+
+        raise ValueError(f"box_lengths must be 2 or 3 positive lengths, got {shown(box_lengths)}")
     if not n_max >= 1:
         raise ValueError(f"n_max must be at least 1, got {n_max}")
     d = lengths.size

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+import numpy as np
+
 
 class GranularError(Exception):
     """Base class of every error granular raises on its own account."""
@@ -92,3 +94,36 @@ class GSDFileError(GranularError, ValueError):
     truncated or corrupt, not written by granular, or holding a field that is missing, of the
     wrong shape or an impossible value.  The message names the file, the frame and the
     field."""
+
+
+def shown(value: object, limit: int = 8) -> str:
+    """``value`` as a message shows it: numbers plainly (``0.5``, not ``np.float64(0.5)``,
+    to 12 significant digits, which hides float64's last-bit noise such as 0.1 * 3),
+    sequences and arrays as ``[a, b, ...]`` (at most ``limit`` entries, the rest counted),
+    strings quoted, anything else as its repr.  NumPy 2 writes a scalar's repr with its
+    type, which a user reading "got np.float64(-1.0)" should not have to decode."""
+    if isinstance(value, (bool, np.bool_)):
+        return str(bool(value))
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, np.floating) and value.itemsize < 8:
+        return f"{float(value):.7g}"  # float32 and float16 hold no more digits
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.12g}"
+    if isinstance(value, (complex, np.complexfloating)):
+        return repr(complex(value))
+    if isinstance(value, np.generic):  # np.str_, np.bytes_, ...
+        return repr(value.item())
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{shown(k)}: {shown(v, limit)}" for k, v in value.items()) + "}"
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        return shown(value[()], limit)
+    if isinstance(value, (list, tuple, np.ndarray)):
+        items = list(np.asarray(value).reshape(-1)) if isinstance(value, np.ndarray) else value
+        head = [shown(v, limit) for v in items[:limit]]
+        if len(items) > limit:
+            head.append(f"... ({len(items)} in all)")
+        if isinstance(value, tuple):
+            return "(" + ", ".join(head) + ("," if len(items) == 1 else "") + ")"
+        return "[" + ", ".join(head) + "]"
+    return repr(value)

@@ -57,6 +57,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from .errors import shown
 
 if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but stay light
     from .scene import Scene
@@ -138,23 +139,61 @@ class _ArrayAndMethod(np.ndarray):
         return self.view(np.ndarray).__reduce__()
 
 
+def _no_lags() -> ValueError:
+    """The error of a TAMSD asked of a run that accumulated none (no ``tamsd_lags``)."""
+    return ValueError(
+        "no time-averaged MSD was accumulated (the run had no tamsd_lags): ask for it "
+        "before the run, with langevin.run(..., tamsd_lags=[...]) -- lags in time, whole "
+        "steps of dt, at most t_stop (e.g. tamsd_lags=[dt, 10 * dt, 100 * dt])"
+    )
+
+
+def _lag_steps(lags: ArrayLike, dt: float, n_steps: int, name: str) -> NDArray[np.int64]:
+    """Lags in time as whole numbers of steps, 1 to ``n_steps``.  The engine samples the
+    path at whole steps only, so a lag between two steps is refused with the nearest two
+    that are whole steps, rather than rounded to one of them unseen (``Trajectory.tamsd``
+    refuses a lag off its samples in the same way)."""
+    from .analysis import _nearest_on_grid
+
+    t = np.asarray(lags, dtype=np.float64).reshape(-1)
+    k = np.rint(t / dt)
+    inside = (k >= 1) & (k <= n_steps)  # NaN fails too
+    if not np.all(inside):
+        raise ValueError(
+            f"{name} must be at least dt and at most t_stop ({shown(dt)} .. "
+            f"{shown(n_steps * dt)}), got {shown(t[~inside][0])}"
+        )
+    off = ~np.isclose(t, k * dt, rtol=1e-9, atol=0.0)
+    if np.any(off):
+        lag = float(t[off][0])
+        raise ValueError(
+            f"{name}: {shown(lag)} is not a whole number of steps of dt = {shown(dt)}, and the "
+            f"engine samples the path at whole steps only; the nearest lags that are: "
+            f"{_nearest_on_grid(lag, dt, n_steps)} (to round lags to whole steps: "
+            f"numpy.unique(numpy.rint(lags / dt)) * dt)"
+        )
+    return k.astype(np.int64)
+
+
 def _lag_indices(
     available: NDArray[np.float64], dt: float, lags: ArrayLike | None, lag_samples: ArrayLike | None
 ) -> NDArray[np.intp]:
     """Indices into ``available`` (lags in time, whole multiples of ``dt``) of the lags
     asked for: all of them when neither ``lags`` (in time) nor ``lag_samples`` (in steps)
     is given.  An engine that accumulates the TAMSD on the fly has it at those lags
-    only, so any other lag is refused by name."""
+    only, so any other lag is refused by name, with the nearest that were accumulated."""
     if lags is not None and lag_samples is not None:
         raise TypeError("give at most one of lags (in time) and lag_samples (in steps)")
     have = np.rint(np.asarray(available, dtype=np.float64) / dt).astype(np.int64)
+    if len(have) == 0:
+        raise _no_lags()
     if lags is None and lag_samples is None:
         return np.arange(len(have))
     if lag_samples is not None:
         k = np.atleast_1d(np.asarray(lag_samples))
         if k.size and not np.issubdtype(k.dtype, np.integer):
             if not np.all(np.isfinite(k)) or np.any(k != np.rint(k)):
-                raise ValueError(f"lag_samples must be whole numbers of steps, got {k}")
+                raise ValueError(f"lag_samples must be whole numbers of steps, got {shown(k)}")
         k = k.astype(np.int64).reshape(-1)
     else:
         t = np.atleast_1d(np.asarray(lags, dtype=np.float64)).reshape(-1)
@@ -162,17 +201,18 @@ def _lag_indices(
         off = ~np.isclose(t, k * dt, rtol=1e-9, atol=0.0)
         k[off] = -1  # not a whole number of steps: never accumulated
     pos = np.searchsorted(have, k)
-    found = (
-        (pos < len(have)) & (have[np.minimum(pos, len(have) - 1)] == k)
-        if len(have)
-        else np.zeros(k.shape, dtype=bool)
-    )
+    found = (pos < len(have)) & (have[np.minimum(pos, len(have) - 1)] == k)
     if not np.all(found):
-        asked = (np.asarray(lag_samples) if lags is None else np.asarray(lags)).reshape(-1)
+        miss = int(np.argmin(found))
+        asked = (np.asarray(lag_samples) if lags is None else np.asarray(lags)).reshape(-1)[miss]
+        # the accumulated lags on either side of the one asked for
+        at = np.searchsorted(have, (asked if lags is None else asked / dt))
+        near = np.unique(have[[max(at - 1, 0), min(at, len(have) - 1)]])
+        unit, scale = (" steps", 1) if lags is None else ("", dt)
         raise ValueError(
-            f"lag {asked[~found][0]!r} was not accumulated: the engine keeps the TAMSD only at "
-            f"the lags given to run(tamsd_lags=...), here {list(np.asarray(available))} in time "
-            f"({list(have)} in steps)"
+            f"lag {shown(asked)}{unit} was not accumulated: the engine keeps the TAMSD only "
+            f"at the lags given to run(tamsd_lags=...); the nearest of those: "
+            f"{' and '.join(shown(k * scale) for k in near)}{unit} (all: {shown(have * scale)})"
         )
     return pos
 
@@ -277,7 +317,8 @@ class LangevinResult:
         The engine accumulates it on the fly at the lags given to ``run(tamsd_lags=...)``
         (``tamsd_lags``) and only there: by default all of them; ``lags`` (in time) or
         ``lag_samples`` (in steps, the engine's samples of the path) pick some of them,
-        and any other lag is refused.
+        and any other lag is refused, with the nearest accumulated ones.  A run given no
+        ``tamsd_lags`` raises ValueError, saying how to ask for them.
 
         Parameters
         ----------
@@ -364,6 +405,8 @@ class LangevinResult:
     def theory_tamsd(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected time-averaged MSD of this run at its lags (or at ``lags``), as the
         engine measures it: see ``theory_tamsd``."""
+        if lags is None and len(self.tamsd_lags) == 0:
+            raise _no_lags()
         return theory_tamsd(
             self.tamsd_lags if lags is None else lags,
             gamma0=self.gamma0,
@@ -411,11 +454,13 @@ class LangevinResult:
                 "(ergodicity_breaking) or run with initial='thermal'"
             )
 
-        lag_t = self.tamsd_lags if lags is None else np.atleast_1d(np.asarray(lags, float))
+        if lags is None and len(self.tamsd_lags) == 0:
+            raise _no_lags()
+        lag_t = self.tamsd_lags if lags is None else lags
         n_steps = round(self.t_stop / self.dt)
         out = []
-        for lag in lag_t:
-            k = round(lag / self.dt)
+        for k in _lag_steps(lag_t, self.dt, n_steps, "lags"):
+            k = int(k)
             starts = (
                 np.arange(
                     0,
@@ -466,15 +511,18 @@ def theory_tamsd(
     reached at the window's start for the Langevin model (tau0 = inf),
     ``theory.udsbm_increment_msd`` for UDSBM.
     ``v0_sq`` is the initial mean squared velocity per component (None: thermal, or App.
-    C's for UDSBM).  Ergodic Langevin from a thermal start: the ensemble MSD.  For UDSBM
+    C's for UDSBM).  Each lag must be a whole number of steps of ``dt`` (as ``run``'s
+    ``tamsd_lags``); any other is refused, with the nearest two that are.  Ergodic
+    Langevin from a thermal start: the ensemble MSD.  For UDSBM
     with ``exponent`` a != 1, ``theory.powerlaw_udsbm_increment_msd`` (numerical moments;
     ``v0_sq`` must then be given)."""
     from . import theory
 
     n_steps = round(t_stop / dt)
+    lag_t = np.atleast_1d(np.asarray(lags, dtype=np.float64))
     out = []
-    for lag in np.atleast_1d(np.asarray(lags, dtype=np.float64)):
-        k = round(lag / dt)
+    for lag, k in zip(lag_t, _lag_steps(lag_t, dt, n_steps, "lags"), strict=True):
+        k = int(k)
         stride = _core.sde_lag_stride(k, _estimator_code(tamsd_estimator))
         starts = np.arange(0, n_steps - k + 1, stride) * dt
         if math.isinf(tau0):
@@ -518,7 +566,7 @@ def _threads(threads: int | None) -> int:
         except AttributeError:  # not on Linux
             return max(1, os.cpu_count() or 1)
     if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise ValueError(f"threads must be a whole number >= 1 or None, got {threads!r}")
+        raise ValueError(f"threads must be a whole number >= 1 or None, got {shown(threads)}")
     return min(int(threads), 1024)
 
 
@@ -570,8 +618,12 @@ def run(
     sample_times : increasing times to sample the ensemble MSD, rounded to whole steps
         (times that round to the same step are sampled once: ``result.times`` has the
         times used); default 60 log-spaced times and 0
-    tamsd_lags : increasing lags (in time) of the time-averaged MSD over [0, t_stop],
-        rounded to whole steps like the sample times (``result.tamsd_lags``)
+    tamsd_lags : increasing lags (in time) of the time-averaged MSD over [0, t_stop]
+        (``result.tamsd_lags``), each a whole number of steps (to 1e-9 relative), from dt
+        to t_stop: the engine samples the path at whole steps, so any other lag is refused
+        before the run, with the two nearest that are whole steps (round log-spaced lags
+        with ``np.unique(np.rint(lags / dt)) * dt``).  None: no TAMSD is accumulated, and
+        ``result.tamsd()`` raises
     tamsd_estimator : "strided" (default) or "all": which windows the TAMSD averages --
         starting every power of two <= max(1, lag/4) steps, or at every step (exact, but
         one window per lag per step, and a ring of lag positions per thread; lags up to
@@ -676,10 +728,13 @@ def run(
         lag_t = np.asarray(tamsd_lags, dtype=np.float64).reshape(-1)
         if np.any(np.diff(lag_t) <= 0):
             raise ValueError("tamsd_lags must be strictly increasing")
-        lag_f = np.rint(lag_t / dt)  # whole steps, merged below
-        if not np.all((lag_f >= 1) & (lag_f <= n_steps)):  # NaN fails too
-            raise ValueError("tamsd_lags must be at least dt and at most t_stop")
-        lags = np.unique(lag_f).astype(np.int64)
+        lags = _lag_steps(lag_t, dt, n_steps, "tamsd_lags")
+        if np.any(np.diff(lags) == 0):  # two lags within 1e-9 of one step
+            same = int(np.argmin(np.diff(lags)))
+            raise ValueError(
+                f"tamsd_lags {float(lag_t[same])!r} and {float(lag_t[same + 1])!r} are the "
+                f"same number of steps of dt = {shown(dt)}: give each lag once"
+            )
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     key_seq, vel_seq = ss.spawn(2)

@@ -42,12 +42,14 @@ TABLE_MAX = 1_000_000
 
 
 def _positive(value: Any, name: str) -> float:
+    from .errors import shown
+
     try:
         x = float(value)
     except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a number, got {value!r}") from None
+        raise TypeError(f"{name} must be a number, got {shown(value)}") from None
     if not (x > 0 and math.isfinite(x)):
-        raise ValueError(f"{name} must be positive and finite, got {value!r}")
+        raise ValueError(f"{name} must be positive and finite, got {shown(value)}")
     return x
 
 
@@ -99,12 +101,14 @@ class ConstantRestitution(RestitutionLaw):
     """
 
     def __init__(self, value: float) -> None:
+        from .errors import shown
+
         try:
             v = float(value)
         except (TypeError, ValueError):
-            raise TypeError(f"a restitution must be a number, got {value!r}") from None
+            raise TypeError(f"a restitution must be a number, got {shown(value)}") from None
         if not (v >= 0 and math.isfinite(v)):
-            raise ValueError(f"a restitution must be finite and >= 0, got {value!r}")
+            raise ValueError(f"a restitution must be finite and >= 0, got {shown(value)}")
         self.value = v
 
     def __call__(self, speed: ArrayLike) -> NDArray[np.float64]:
@@ -214,7 +218,9 @@ class Viscoelastic(RestitutionLaw):
         m = _positive(mass, "mass")
         nu = float(poisson)
         if not -1.0 < nu <= 0.5:
-            raise ValueError(f"poisson must lie in (-1, 0.5], got {poisson!r}")
+            from .errors import shown
+
+            raise ValueError(f"poisson must lie in (-1, 0.5], got {shown(poisson)}")
         kappa = 1.5**1.5 * y * math.sqrt(r / 2) / ((m / 2) * (1 - nu * nu))
         return cls(damping, kappa)
 
@@ -245,9 +251,11 @@ class Viscoelastic(RestitutionLaw):
         e = float(restitution)
         lowest = 1.0 - C1 * DELTA_MAX + C2 * DELTA_MAX**2
         if not lowest <= e < 1.0:
+            from .errors import shown
+
             raise ValueError(
                 f"restitution must lie in [{lowest:.4f}, 1) for the viscoelastic series "
-                f"(delta <= {DELTA_MAX}), got {restitution!r}"
+                f"(delta <= {DELTA_MAX}), got {shown(restitution)}"
             )
         delta = (C1 - math.sqrt(C1 * C1 - 4.0 * C2 * (1.0 - e))) / (2.0 * C2)
         return cls(delta / v**0.2, 1.0)

@@ -404,7 +404,9 @@ class Scene:
         except (OverflowError, ValueError, TypeError):  # inf, nan, "ten"
             whole = False
         if not whole:
-            raise ValueError(f"n must be a whole number, got {n!r}")
+            from .errors import shown
+
+            raise ValueError(f"n must be a whole number, got {shown(n)}")
         n = int(n)
         if n < 1:
             raise ValueError(f"n must be >= 1, got {n}")

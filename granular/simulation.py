@@ -285,7 +285,9 @@ class Simulation:
             raise ValueError(f"unknown stop_when keys {sorted(unknown)}; use {_STOP_KEYS}")
         store = tuple(store)
         if set(store) - set(_STORE):
-            raise ValueError(f"store may contain only {_STORE}, got {store}")
+            from .errors import shown
+
+            raise ValueError(f"store may contain only {_STORE}, got {shown(store)}")
         t_now = self.time
         t_end = math.inf if t_stop is None else float(t_stop)
         if math.isnan(t_end):
@@ -295,7 +297,9 @@ class Simulation:
         cpp = float(crit.get("collisions_per_particle", math.inf))
         kin = float(crit.get("kinetic_energy", -1.0))
         if math.isnan(cpp) or math.isnan(kin):
-            raise ValueError(f"stop_when criteria must be numbers, got {crit}")
+            from .errors import shown
+
+            raise ValueError(f"stop_when criteria must be numbers, got {shown(crit)}")
         frozen = frozen_energy(self._initial.radii, self._initial.masses)
         if "kinetic_energy" in crit and not kin * self._initial.n > frozen:
             raise ValueError(
@@ -305,7 +309,11 @@ class Simulation:
             )
         budget = crit.get("events")
         if budget is not None and (isinstance(budget, bool) or int(budget) != budget or budget < 0):
-            raise ValueError(f"stop_when['events'] must be a whole number >= 0, got {budget!r}")
+            from .errors import shown
+
+            raise ValueError(
+                f"stop_when['events'] must be a whole number >= 0, got {shown(budget)}"
+            )
         budget = math.inf if budget is None else int(budget)
         if t_end == math.inf and cpp == math.inf and kin < 0 and budget == math.inf:
             raise ValueError("run needs a finite t_stop or a stop_when criterion")
@@ -563,10 +571,13 @@ class _StallGuard:
         if progress != self.progress:
             self.progress, self.events = progress, c["events"]
         elif c["events"] - self.events >= self.limit:
+            from .errors import shown
+
             what = "dissipative collision" if self.dissipative_only else "collision"
             raise NoProgressError(
                 f"no {what} in {c['events'] - self.events} events (t = {c['time']:.6g}): the "
-                f"stop criteria {criteria} may never be met; give t_stop or stop_when['events']",
+                f"stop criteria {shown(criteria)} may never be met; give t_stop or "
+                "stop_when['events']",
                 time=c["time"],
             )
 

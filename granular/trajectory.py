@@ -178,7 +178,8 @@ class Trajectory:
         ----------
         lags : array_like of float, optional
             Lags in time, each a difference of sample times (with uniform sampling, a
-            multiple of the spacing).
+            multiple of the spacing); any other is refused, naming the nearest lags the
+            samples have (as ``LangevinResult.tamsd`` refuses a lag it did not accumulate).
         lag_samples : array_like of int, optional
             Lags as whole numbers of samples instead (uniformly spaced samples).
         particles : array_like of int or bool, optional

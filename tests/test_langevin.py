@@ -537,6 +537,38 @@ def test_bad_input(kwargs, match):
         langevin.run(10, **base)
 
 
+def test_a_lag_between_two_steps_is_refused_before_the_run(monkeypatch):
+    """The engine samples the path at whole steps, so tamsd_lags=[0.15] with dt = 0.1 is
+    refused, naming the two lags it could have (not rounded to 0.1 unseen, as
+    Trajectory.tamsd refuses a lag off its samples), before the engine is started; so are
+    the theory's lags, and two lags that are the same step."""
+
+    def engine(*args, **kwargs):
+        raise AssertionError("the engine ran")
+
+    monkeypatch.setattr(langevin._core, "sde_run", engine)
+    kw = dict(gamma0=G0, D0=D0, dt=0.1, t_stop=1.0, seed=1)
+    msg = r"tamsd_lags: 0\.15 is not a whole number of steps of dt = 0\.1.* 0\.1 and 0\.2 "
+    with pytest.raises(ValueError, match=msg):
+        langevin.run(10, tamsd_lags=[0.1, 0.15], **kw)
+    # past the last step that fits in t_stop, only the lag below is offered
+    with pytest.raises(ValueError, match=r"nearest lags that are: 1 \("):
+        langevin.run(10, tamsd_lags=[1.04], **kw)
+    with pytest.raises(ValueError, match=r"0\.1 and 0\.1000000001 are the same number of steps"):
+        langevin.run(10, tamsd_lags=[0.1, 0.1000000001], **kw)
+    with pytest.raises(ValueError, match=r"lags: 0\.25 is not a whole number.* 0\.2 and 0\.3 "):
+        langevin.theory_tamsd([0.25], gamma0=G0, D0=D0, **{k: kw[k] for k in ("dt", "t_stop")})
+
+
+def test_a_result_without_lags_says_how_to_ask_for_them():
+    """A run given no tamsd_lags accumulated no TAMSD: tamsd() and everything built on it
+    raise, saying to pass tamsd_lags= to run, instead of returning an empty array."""
+    r = langevin.run(5, gamma0=G0, D0=D0, dt=0.01, t_stop=0.1, seed=1)
+    for method in (r.tamsd, r.ergodicity_breaking, r.theory_tamsd, r.theory_ergodicity_breaking):
+        with pytest.raises(ValueError, match=r"no time-averaged MSD .*run\(\.\.\., tamsd_lags="):
+            method()
+
+
 def test_theory_ergodicity_breaking_refuses_a_fixed_speed_start():
     """The EB theory rests on Isserlis' theorem, so on Gaussian initial velocities: a run
     from initial="fixed" (one speed for every particle) gets a ValueError saying so, not

@@ -137,6 +137,11 @@ def test_what_cannot_apply_is_refused_by_name(sde, ens, edmd_ens):
         ens.tamsd(lag_samples=[2])
     with pytest.raises(ValueError, match="not accumulated"):
         sde.tamsd([0.0105])  # not a whole number of steps
+    # the lags on either side of the one asked for, in its unit
+    with pytest.raises(ValueError, match=r"nearest of those: 0\.03 and 0\.1 \(all: \[0\.01, "):
+        sde.tamsd([0.05])
+    with pytest.raises(ValueError, match=r"nearest of those: 3 and 10 steps"):
+        ens.tamsd(lag_samples=[4])
     with pytest.raises(TypeError, match="at most one"):
         sde.tamsd(LAGS, lag_samples=LAG_STEPS)
     with pytest.raises(ValueError, match="store_positions=True"):

@@ -151,6 +151,7 @@ for ax, xi in zip(axes, (1.0, 0.8)):
         "ensemble average."
     ),
     """lags = np.logspace(-2, np.log10(t_stop / 2), 15)
+lags = np.unique(np.rint(lags / 0.01)) * 0.01  # whole steps of dt, as run() needs
 c = langevin.coefficients_from_scene(eq.replace(restitution=0.8))
 u = langevin.run(
     n,
@@ -224,7 +225,7 @@ visco = [
         "Full size this notebook takes about 15 s (11-15 s measured on a loaded 2-core "
         "machine; `GRANULAR_QUICK=1`: about 4 s)."
     ),
-    setup + "\nimport math\nimport warnings\nfrom granular import langevin",
+    setup + "\nimport math\nimport warnings\nfrom granular import analysis, langevin",
     (
         "md:## A viscoelastic gas\n"
         "The thesis' gas (N = 1000 spheres of radius 0.025 in the unit box), equilibrated, then "
@@ -303,9 +304,9 @@ ax.plot(t, asymptote, ":", label="t^(1/6) asymptote")
 ax.legend()
 late = traj.times > 10 * c.tau0
 tl = traj.times[late]
-slope = np.polyfit(np.log(tl), np.log(traj.msd()[late]), 1)[0]
-slope_u = np.polyfit(np.log(tl), np.log(np.interp(tl, u.times, u.msd())), 1)[0]
-slope_th = np.polyfit(np.log(tl), np.log(theory.msd_viscoelastic(tl, D0=c.D0, tau0=c.tau0)), 1)[0]
+slope = analysis.fit_power_law(tl, traj.msd()[late])[0]
+slope_u = analysis.fit_power_law(tl, np.interp(tl, u.times, u.msd()))[0]
+slope_th = analysis.fit_power_law(tl, theory.msd_viscoelastic(tl, D0=c.D0, tau0=c.tau0))[0]
 print(f"d ln MSD / d ln t over t in [{tl[0]:.3g}, {tl[-1]:.3g}]:")
 print(f"EDMD {slope:.3f}, UDSBM {slope_u:.3f}, theory {slope_th:.3f}", "(1/6 only as t -> inf)")""",
     (
@@ -322,6 +323,7 @@ print(f"EDMD {slope:.3f}, UDSBM {slope_u:.3f}, theory {slope_th:.3f}", "(1/6 onl
     """c8 = theory.langevin_coefficients(1000, 0.025, 1.0, 0.8, 2 / 3)  # the thesis' gas, xi = 0.8
 t_sde = 100.0 if not QUICK else 10.0  # 2000 steps of dt = 0.05
 lags = np.logspace(-1, np.log10(t_sde / 4), 8 if not QUICK else 3)
+lags = np.unique(np.rint(lags / 0.05)) * 0.05  # whole steps of dt, as run() needs
 fig, axes = plt.subplots(1, 2, figsize=(11, 4), layout="constrained")
 for a in (1.0, 5 / 6):
     res = langevin.run(

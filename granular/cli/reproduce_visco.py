@@ -37,7 +37,7 @@ import warnings
 
 import numpy as np
 
-from .. import Scene, Simulation, Viscoelastic, langevin, theory
+from .. import Scene, Simulation, Viscoelastic, analysis, langevin, theory
 from ..errors import InelasticCollapseError
 
 DENSITY, RADIUS, N = 1000.0, 0.025, 250  # the thesis' density; a box below L_c
@@ -60,8 +60,7 @@ def _equilibrated(seed=2020):
 
 def _slope(times, values, window):
     """Least-squares slope of ln values against ln t over the times in ``window``."""
-    w = (times >= window[0]) & (times <= window[1])
-    return float(np.polyfit(np.log(times[w]), np.log(values[w]), 1)[0])
+    return analysis.fit_power_law(times, values, t_min=window[0], t_max=window[1])[0]
 
 
 @functools.lru_cache(maxsize=8)

@@ -192,12 +192,6 @@ def speed_accuracy_points(quick=False):
 VISCO_EPS, VISCO_A = 0.9, 5.0 / 6.0
 
 
-def _loglog_slope(times, msd, t_fit):
-    """The late exponent d ln MSD / d ln t, fitted over t >= t_fit."""
-    sel = (times >= t_fit) & (msd > 0)
-    return float(np.polyfit(np.log(times[sel]), np.log(msd[sel]), 1)[0])
-
-
 def viscoelastic_points(quick=False):
     """The viscoelastic gas (``VISCO_EPS`` law) by EDMD (N, runs) against power-law UDSBM
     (a = 5/6, ``theory.viscoelastic_langevin_coefficients``), both schemes, against an
@@ -215,7 +209,9 @@ def viscoelastic_points(quick=False):
     ref_runs = 64 if not quick else 4
     ref, ref_cost = _edmd_msd(1000, law, ref_runs, times, seed=99)
     th = theory.msd_viscoelastic(times, D0=c.D0, tau0=c.tau0)
-    slope_ref, slope_th = _loglog_slope(times, ref, t_fit), _loglog_slope(times, th, t_fit)
+    # the late exponent d ln MSD / d ln t, fitted over t >= t_fit
+    slope_ref = analysis.fit_power_law(times, ref, t_min=t_fit)[0]
+    slope_th = analysis.fit_power_law(times, th, t_min=t_fit)[0]
     ref_info = dict(
         times=times.tolist(),
         msd=ref.tolist(),
@@ -233,7 +229,7 @@ def viscoelastic_points(quick=False):
         ok = at > 0
         e_ref = float(np.max(np.abs(msd[ok] / _loglog_interp(at[ok], times, ref) - 1)))
         th_at = theory.msd_viscoelastic(at[ok], D0=c.D0, tau0=c.tau0)
-        slope = _loglog_slope(at, msd, t_fit)
+        slope = analysis.fit_power_law(at, msd, t_min=t_fit)[0]
         points.append(
             dict(
                 gas="viscoelastic",
