@@ -412,3 +412,52 @@ def test_an_unreadable_fingerprint_is_one_error(tmp_path):
     own.symlink_to("/dev/zero")
     with pytest.raises(CheckpointError, match="not a regular file"):
         ensemble(model, 1, seed=17, backend="serial", save_to=tmp_path)
+
+
+RACE = """import sys, time
+import granular
+from granular import CheckpointError
+from helpers import ensemble_tasks
+
+if __name__ == "__main__":
+    time.sleep(max(0.0, float(sys.argv[3]) - time.time()))  # both start together
+    try:
+        granular.ensemble(ensemble_tasks.slow_draws, 10, seed=int(sys.argv[2]),
+                          backend="serial", progress=False, save_to=sys.argv[1])
+    except CheckpointError as exc:
+        print(exc)
+        sys.exit(3)
+"""
+
+
+@pytest.mark.slow
+def test_two_ensembles_started_together_on_one_directory_do_not_mix(tmp_path):
+    """Two processes with different seeds start on one directory at the same instant
+    (four trials): one finishes, the other is refused, and the directory resumes to
+    exactly the winner's ensemble (without the lock, both passed the fingerprint check
+    and wrote runs of two ensembles into one directory)."""
+    script = tmp_path / "race.py"
+    script.write_text(RACE)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(HELPERS_ROOT), *sys.path]))
+    for trial in range(4):
+        folder = tmp_path / f"trial{trial}"
+        start = time.time() + 2.0
+        procs = {
+            seed: subprocess.Popen(
+                [sys.executable, str(script), str(folder), str(seed), str(start)],
+                env=env,
+                stdout=subprocess.PIPE,
+                text=True,
+            )
+            for seed in (20 + 2 * trial, 21 + 2 * trial)
+        }
+        codes = {seed: p.wait(60) for seed, p in procs.items()}
+        outs = {seed: p.stdout.read() for seed, p in procs.items()}
+        assert sorted(codes.values()) == [0, 3], outs
+        winner = next(seed for seed, code in codes.items() if code == 0)
+        loser = next(seed for seed, code in codes.items() if code == 3)
+        assert "another ensemble" in outs[loser]
+        _same(
+            ensemble(ensemble_tasks.slow_draws, 10, seed=winner, backend="serial"),
+            ensemble(ensemble_tasks.slow_draws, 10, seed=winner, backend="serial", save_to=folder),
+        )
