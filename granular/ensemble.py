@@ -698,7 +698,7 @@ def _check_outcome(reducers, results):
         kinds = sorted({f.error_type for f in failed})
         first = failed[0]
         if len(kinds) == 1:
-            exc = next((r.first_exception for r in reducers if r.first_exception), None)
+            exc = next((r.first_exception for r in reducers if r.first_exception is not None), None)
             note = (
                 f"every one of this ensemble's {len(failed)} runs failed with {kinds[0]} "
                 f"(the first, run {first.index}: {first.error}); run {first.index}'s "
@@ -885,7 +885,7 @@ def ensemble(
     if runs < 1:
         raise ValueError(f"runs must be >= 1, got {runs}")
     if workers is not None and (
-        isinstance(workers, bool) or int(workers) != workers or workers < 1
+        isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1
     ):
         raise ValueError(f"workers must be a whole number >= 1, got {workers!r}")
     if isinstance(model, (list, tuple)):
