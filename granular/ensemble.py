@@ -11,11 +11,16 @@ however many workers ran them.
 from __future__ import annotations
 
 import ast
+import contextlib
+import math
 import os
+import pickle
 import sys
+import threading
 import traceback
+import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -23,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import ProcessBackendError
 from .scene import Scene
-from .simulation import Simulation
+from .simulation import _STOP_KEYS, Simulation
 
 EDMD_QUANTITIES = (
     "msd",
@@ -36,6 +41,9 @@ EDMD_QUANTITIES = (
     "positions",
     "velocities",
 )
+# the options an EDMD run takes from ensemble's keywords (Simulation.run's; ensemble sets
+# store= from quantities= and shows its own progress)
+RUN_OPTIONS = ("t_stop", "sample_times", "stop_when")
 
 
 @dataclass(frozen=True)
@@ -90,15 +98,23 @@ class EnsembleResult:
     runs : list of dict
         One dict of arrays per successful run, in run order (empty if ``keep_runs=False``).
     mean, error : dict
-        Per quantity: the mean over successful runs and its standard error
-        ``std(ddof=1) / sqrt(K)`` (central limit theorem, thesis 2.120-2.122); NaN error
-        for K = 1.  An entry equal in every run (inf included, e.g. a Langevin run's
-        ``tau0``) keeps that value, with error 0.
+        Per quantity: the mean over the K successful runs that returned it and its
+        standard error ``std(ddof=1) / sqrt(K)`` (central limit theorem, thesis
+        2.120-2.122); NaN error for K = 1.  An entry equal in every run (inf included,
+        e.g. a Langevin run's ``tau0``) keeps that value, with error 0.
     count : int
         Number of successful runs.
     failures : list of RunFailure
     times : ndarray or None
         The sample times, when the runs share them.
+    counts : dict
+        Per quantity of ``mean``: how many runs it is the mean of (``count`` unless some
+        runs did not return it).
+    left_out : dict
+        Quantities the runs returned that have no mean, each with the reason: their
+        shape differs between runs (e.g. runs stopped by ``stop_when`` at different
+        samples) or they are not numbers.  ``ensemble`` warns about them; each run's
+        values stay in ``runs``.
     """
 
     runs: list[dict[str, NDArray[Any]]]
@@ -107,13 +123,25 @@ class EnsembleResult:
     count: int
     failures: list[RunFailure]
     times: NDArray[np.float64] | None
+    counts: dict[str, int] = field(default_factory=dict)
+    left_out: dict[str, str] = field(default_factory=dict)
 
     def _quantity(self, name: str, hint: str) -> NDArray[np.float64]:
-        if name not in self.mean:
+        if name in self.mean:
+            return self.mean[name]
+        if name in self.left_out:
             raise ValueError(
-                f"this ensemble collected no {name!r} ({hint}); it has {sorted(self.mean)}"
+                f"this ensemble has no mean {name!r}: {self.left_out[name]} "
+                f"(each run's is in runs[r][{name!r}])"
             )
-        return self.mean[name]
+        if self.count == 0 and self.failures:
+            raise ValueError(
+                f"this ensemble collected no {name!r}: all {len(self.failures)} runs failed "
+                f"(see .failures; the first: {self.failures[0].error})"
+            )
+        raise ValueError(
+            f"this ensemble collected no {name!r} ({hint}); it has {sorted(self.mean)}"
+        )
 
     def msd(
         self, per_dimension: bool = False, particles: ArrayLike | None = None
@@ -179,7 +207,10 @@ class EnsembleResult:
         return values[_lag_indices(self.tamsd_lags, dt, lags, lag_samples)]
 
     def __repr__(self) -> str:
-        q = ", ".join(sorted(self.mean))
+        q = ", ".join(
+            k if self.counts.get(k, self.count) == self.count else f"{k} ({self.counts[k]} runs)"
+            for k in sorted(self.mean)
+        )
         return f"EnsembleResult({self.count} runs, {len(self.failures)} failed; {q})"
 
 
@@ -192,42 +223,61 @@ def _difference(v, mean):
 
 class _Accumulator:
     """Running mean and variance per quantity (Welford), so runs can be reduced as they
-    arrive without keeping them."""
+    arrive without keeping them.  Each quantity is the mean of the runs that returned it
+    (``counts``); one whose shape differs between runs, or that is not numbers, has no
+    mean and is named in ``left_out`` with the reason."""
 
     def __init__(self):
         self.count = 0
+        self.counts = {}
         self.mean = {}
         self.m2 = {}
-        self.ragged = set()
+        self.first = {}  # quantity -> (run, shape) of the first run that returned it
+        self.left_out = {}
 
-    def add(self, result):
+    def _leave_out(self, k, reason):
+        self.left_out[k] = reason
+        for d in (self.mean, self.m2, self.counts):
+            d.pop(k, None)
+
+    def add(self, result, run=None):
+        """Add one run's quantities; ``run`` (its index) names it in ``left_out``."""
         self.count += 1
+        run = self.count - 1 if run is None else run
         for k, v in result.items():
-            v = np.asarray(v, dtype=np.float64)
-            if k in self.ragged:
+            if k in self.left_out:
+                continue
+            try:
+                v = np.asarray(v, dtype=np.float64)
+            except (TypeError, ValueError) as exc:
+                self._leave_out(k, f"run {run}'s is not numbers ({exc})")
                 continue
             if k not in self.mean:
+                self.first[k] = (run, v.shape)
+                self.counts[k] = 1
                 self.mean[k] = v.copy()
                 self.m2[k] = np.zeros_like(v)
                 continue
-            if self.mean[k].shape != v.shape:  # runs that stopped at different samples
-                self.ragged.add(k)
-                del self.mean[k], self.m2[k]
+            if self.mean[k].shape != v.shape:
+                first_run, first_shape = self.first[k]
+                self._leave_out(
+                    k,
+                    f"its shape differs between runs ({first_shape} in run {first_run}, "
+                    f"{v.shape} in run {run})",
+                )
                 continue
+            self.counts[k] += 1
             # runs with inf in some entries and finite numbers in others: mean inf, error NaN
             with np.errstate(invalid="ignore"):
                 delta = _difference(v, self.mean[k])
-                self.mean[k] += delta / self.count
+                self.mean[k] += delta / self.counts[k]
                 self.m2[k] += delta * _difference(v, self.mean[k])
 
     def result(self):
         error = {}
         for k, m2 in self.m2.items():
-            error[k] = (
-                np.sqrt(m2 / (self.count - 1) / self.count)
-                if self.count > 1
-                else np.full_like(m2, np.nan)
-            )
+            n = self.counts[k]
+            error[k] = np.sqrt(m2 / (n - 1) / n) if n > 1 else np.full_like(m2, np.nan)
         return self.mean, error
 
 
@@ -301,12 +351,20 @@ class _Task:
 
 def _call_task(task, index, seed):
     """Run one realization in a worker; return ('ok', result) or ('error', failure info)
-    so that one failing run never loses the others."""
+    so that one failing run never loses the others.  The failure info ends with the
+    exception itself, without its traceback (which is formatted beside it), when it
+    pickles: if every run fails alike, ``ensemble`` raises it."""
     try:
         return index, "ok", task(seed)
     # any error of the task (user code) is caught: reported with its seed, the other runs go on
     except Exception as exc:  # noqa: BLE001
-        return index, "error", (repr(exc), exc.__class__.__name__, traceback.format_exc())
+        info = (repr(exc), exc.__class__.__name__, traceback.format_exc())
+        exc.__traceback__ = None  # its frames may hold the failed run's arrays
+        try:  # the round trip: an exception may pickle and not unpickle (required args)
+            pickle.loads(pickle.dumps(exc))
+        except Exception:  # noqa: BLE001 (an exception that does not pickle stays behind)
+            exc = None
+        return index, "error", (*info, exc)
 
 
 def _progress_bar(total, progress):
@@ -326,12 +384,46 @@ def _process_context():
     return mp.get_context("forkserver" if sys.platform.startswith("linux") else "spawn")
 
 
+def _exit_with_parent(lifeline):
+    """In a worker process: exit as soon as the ensemble's process dies.
+
+    ``lifeline`` is the read end of a pipe whose only write end the parent holds (forkserver
+    and spawn workers inherit no other descriptors), so reading it waits until the parent
+    closes it -- after its pool has shut down -- or dies, killed or not.  A worker that
+    outlives its parent would otherwise wait for tasks forever, and keep the forkserver
+    alive with it.  A daemon thread: it blocks without the GIL and ends with the worker."""
+
+    def watch():
+        try:
+            lifeline.recv_bytes()
+        except (EOFError, OSError):
+            pass
+        os._exit(1)
+
+    threading.Thread(target=watch, name="granular-exit-with-parent", daemon=True).start()
+
+
+@contextlib.contextmanager
 def _executor(backend, workers):
     import concurrent.futures as cf
 
     if backend == "threads":
-        return cf.ThreadPoolExecutor(max_workers=workers)
-    return cf.ProcessPoolExecutor(max_workers=workers, mp_context=_process_context())
+        with cf.ThreadPoolExecutor(max_workers=workers) as pool:
+            yield pool
+        return
+    context = _process_context()
+    lifeline, keep = context.Pipe(duplex=False)
+    try:
+        with cf.ProcessPoolExecutor(
+            max_workers=workers,
+            mp_context=context,
+            initializer=_exit_with_parent,
+            initargs=(lifeline,),
+        ) as pool:
+            yield pool
+    finally:  # the workers have exited (shutdown waits for them): let go of the pipe
+        keep.close()
+        lifeline.close()
 
 
 def _main_guard_lines(tree):
@@ -490,10 +582,11 @@ class _PointReducer:
         self.acc = _Accumulator()
         self.kept = [] if keep_runs else None
         self.failures = []
+        self.first_exception = None  # of the first failure, if it came back with it
 
     def add(self, run, status, payload):
         if status == "ok":
-            self.acc.add(payload)
+            self.acc.add(payload, run)
             if self.kept is not None:
                 self.kept.append(payload)
         else:
@@ -507,11 +600,15 @@ class _PointReducer:
                     payload[1],
                 )
             )
+            if len(self.failures) == 1 and len(payload) > 3:
+                self.first_exception = payload[3]
 
     def result(self):
         mean, error = self.acc.result()
+        counts = dict(self.acc.counts)
         times = mean.pop("times", None)
         error.pop("times", None)
+        counts.pop("times", None)
         return EnsembleResult(
             self.kept if self.kept is not None else [],
             mean,
@@ -519,7 +616,121 @@ class _PointReducer:
             self.acc.count,
             self.failures,
             times,
+            counts,
+            dict(self.acc.left_out),
         )
+
+
+def _check_run_options(run_kwargs, models):
+    """Refuse, before any run starts, EDMD run options with which every run would fail.
+
+    ``Simulation.run`` checks them again in every run (it has the last word, and checks
+    what needs the scene); this is the same check made once, so that a caller's mistake
+    is an exception here rather than K failed runs."""
+    unknown = sorted(set(run_kwargs) - set(RUN_OPTIONS))
+    if unknown:
+        raise TypeError(
+            f"ensemble got unknown keyword arguments {unknown}: besides its own, it takes "
+            f"{', '.join(RUN_OPTIONS)}, which each EDMD run passes to Simulation.run "
+            "(what a run stores follows from quantities=)"
+        )
+    t_stop = run_kwargs.get("t_stop")
+    t_end = math.inf
+    if t_stop is not None:
+        try:
+            t_end = float(t_stop)
+        except (TypeError, ValueError):
+            raise TypeError(f"t_stop must be a number (a time), got {t_stop!r}") from None
+        if not t_end >= 0:
+            raise ValueError(f"t_stop must be a time >= 0 (runs start at t = 0), got {t_end:g}")
+    stop_when = run_kwargs.get("stop_when")
+    if stop_when is not None:
+        if not isinstance(stop_when, dict):
+            raise TypeError(
+                f"stop_when must be a dict such as {{'collisions_per_particle': 10}}, "
+                f"got {type(stop_when).__name__}"
+            )
+        bad = sorted(set(stop_when) - set(_STOP_KEYS))
+        if bad:
+            raise ValueError(f"unknown stop_when keys {bad}; use {list(_STOP_KEYS)}")
+        for key, value in stop_when.items():
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+                raise TypeError(f"stop_when[{key!r}] must be a number, got {value!r}")
+            if math.isnan(value):
+                raise ValueError(f"stop_when[{key!r}] is NaN")
+    if (run_kwargs or any(isinstance(m, Scene) for m in models)) and (
+        t_end == math.inf and not stop_when
+    ):
+        raise ValueError(
+            "EDMD runs need a finite t_stop or a stop_when criterion, e.g. "
+            "ensemble(scene, runs, t_stop=10.0) (the options of Simulation.run)"
+        )
+    times = run_kwargs.get("sample_times")
+    if times is None:
+        return
+    try:
+        times = np.asarray(times, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(f"sample_times must be an array of times: {exc}") from None
+    if times.ndim != 1:
+        raise ValueError(f"sample_times must be one-dimensional, got shape {times.shape}")
+    if not np.all(np.isfinite(times)):
+        raise ValueError("sample_times must be finite")
+    if len(times) and times[0] < 0:
+        raise ValueError(f"sample_times start at {times[0]:g}, before t = 0 when runs start")
+    steps = np.diff(times)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0))
+        raise ValueError(
+            f"sample_times must be strictly increasing: entry {i + 1} is {times[i + 1]:g} "
+            f"after {times[i]:g} (np.sort them, or build them increasing)"
+        )
+    if len(times) and times[-1] > t_end + 1e-12 * max(1.0, abs(t_end)):  # as Simulation.run
+        raise ValueError(f"sample_times reach {times[-1]:g}, past t_stop = {t_end:g}")
+
+
+def _check_outcome(reducers, results):
+    """Raise when every run of the call failed alike -- the caller's mistake, most likely,
+    that no result can hide -- and warn about what a result cannot show: a point whose
+    runs all failed, quantities left out of the means."""
+    failed = [f for r in results for f in r.failures]
+    if failed and not any(r.count for r in results):
+        kinds = sorted({f.error_type for f in failed})
+        first = failed[0]
+        if len(kinds) == 1:
+            exc = next((r.first_exception for r in reducers if r.first_exception is not None), None)
+            note = (
+                f"every one of this ensemble's {len(failed)} runs failed with {kinds[0]} "
+                f"(the first, run {first.index}: {first.error}); run {first.index}'s "
+                f"traceback:\n{first.traceback}"
+            )
+            if exc is not None:
+                if hasattr(exc, "add_note"):
+                    exc.add_note(note)
+                raise exc
+            raise RuntimeError(note)
+        warnings.warn(
+            f"every one of this ensemble's {len(failed)} runs failed ({', '.join(kinds)}); "
+            "see .failures",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+    for p, r in enumerate(results):
+        where = f"point {p}: " if len(results) > 1 else ""
+        if r.count == 0 and any(x.count for x in results):
+            warnings.warn(
+                f"{where}every one of its {len(r.failures)} runs failed "
+                f"(the first: {r.failures[0].error}); see .failures",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+        for name, reason in r.left_out.items():
+            warnings.warn(
+                f"{where}{name!r} has no ensemble mean: {reason}; each run's is in "
+                f"runs[r][{name!r}]",
+                RuntimeWarning,
+                stacklevel=3,
+            )
 
 
 def _reduce_in_order(results, reducers, runs, bar, stored=None):
@@ -631,8 +842,15 @@ def ensemble(
         uninterrupted call gives.  Needs a ``seed`` and a model that pickles (a Scene, a
         module-level function or a partial of one: it is recognised by its pickle, not
         by its code).  Files are written atomically; failed runs are stored too (delete
-        a run's file to redo it).  A directory made by another model, other run options,
-        quantities, seed or granular version is refused (``CheckpointError``).
+        a run's file to redo it).  A call holds the directory locked until it returns: a
+        second call on it meanwhile is refused (the lock dies with its process, so a
+        killed ensemble resumes).  A directory, or a run file, made by another model,
+        other run options, quantities, seed or granular version is refused, and so is a
+        damaged run file (``CheckpointError`` naming the file).
+    **run_kwargs
+        For EDMD runs: ``t_stop``, ``sample_times`` and ``stop_when`` as in
+        ``Simulation.run`` (times from 0, the start of every run).  They are checked
+        before any run starts.
 
     Returns
     -------
@@ -640,10 +858,36 @@ def ensemble(
         One result, or for a sweep a list of them, one per point in order.  Failed runs
         (e.g. inelastic collapse) are listed in their point's ``.failures`` with their seeds
         and do not lose the others.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For arguments with which no run could succeed (e.g. ``sample_times`` not
+        increasing, an EDMD run without ``t_stop`` or ``stop_when``), before any run.
+    Exception
+        When every run of the call failed with one exception type: that exception (of
+        the first failed run), with a note saying so and giving the run's traceback (a
+        ``RuntimeError`` with its message when the exception is not at hand: runs read
+        back from ``save_to``, or an exception that does not pickle).
+        (Failures of several types give a ``RuntimeWarning`` and the result.)
+    CheckpointError
+        For a ``save_to`` directory in use, of another ensemble, or damaged.
+
+    Warns
+    -----
+    RuntimeWarning
+        For a quantity whose shape differs between runs (it gets no mean: see
+        ``EnsembleResult.left_out``), and for a point of a sweep whose runs all failed.
     """
+    if isinstance(runs, bool) or not isinstance(runs, (int, np.integer)):
+        raise TypeError(f"runs must be a whole number >= 1, got {runs!r}")
     runs = int(runs)
     if runs < 1:
         raise ValueError(f"runs must be >= 1, got {runs}")
+    if workers is not None and (
+        isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1
+    ):
+        raise ValueError(f"workers must be a whole number >= 1, got {workers!r}")
     if isinstance(model, (list, tuple)):
         sweep, models = True, list(model)
     else:
@@ -656,9 +900,12 @@ def ensemble(
                 "model must be a Scene, a function of seed or a list of these, "
                 f"got {type(m).__name__}"
             )
+    if isinstance(quantities, str):
+        raise TypeError(f"quantities must be a list of names, e.g. ({quantities!r},)")
     bad = set(quantities) - set(EDMD_QUANTITIES)
     if bad:
         raise ValueError(f"unknown quantities {sorted(bad)}; choose from {EDMD_QUANTITIES}")
+    _check_run_options(run_kwargs, models)
     if isinstance(backend, str) and backend == "processes":
         where = _unguarded_main_call(_process_context().get_start_method())
         if where is not None:
@@ -675,7 +922,32 @@ def ensemble(
     if save_to is not None:
         from .ensemble_store import RunStore, fingerprint
 
+        # locked until this call returns: no other ensemble writes there meanwhile
         store = RunStore(save_to, fingerprint(models, sweep, root, run_kwargs, quantities))
+    with store if store is not None else contextlib.nullcontext():
+        reducers = _run_all(
+            models,
+            runs,
+            root,
+            sweep,
+            run_kwargs,
+            quantities,
+            store,
+            keep_runs,
+            backend,
+            workers,
+            progress,
+        )
+    results = [r.result() for r in reducers]
+    _check_outcome(reducers, results)
+    return results if sweep else results[0]
+
+
+def _run_all(
+    models, runs, root, sweep, run_kwargs, quantities, store, keep_runs, backend, workers, progress
+):
+    """Every run of every point, from the store or the backend, fed to one reducer per
+    point in run order."""
     seeds = _seeds(root, runs, len(models) if sweep else None)
     tasks = [_Task(m, run_kwargs, tuple(quantities)) for m in models]
     # call index p * runs + r: run r of point p, the order in which runs are reduced
@@ -694,5 +966,4 @@ def ensemble(
         if store is not None:
             results = _saving(results, store, runs, seeds)
         _reduce_in_order(results, reducers, runs, bar, stored)
-    results = [r.result() for r in reducers]
-    return results if sweep else results[0]
+    return reducers

@@ -1,24 +1,41 @@
 """An ensemble's finished runs in a directory, so that an interrupted ensemble resumes.
 
 ``ensemble(..., save_to=directory)`` writes each run's result there as it finishes (one
-``.npz`` per run, read back with ``allow_pickle=False``) and, called again, takes the runs
-already there instead of repeating them.  Files are written to a temporary name and
-renamed, so a run killed mid-write leaves no file that passes for finished.  The
-directory's ``ensemble.json`` holds a fingerprint of what made it (models, run options,
-quantities, seed, granular version); a call that differs in any of them is refused.  A
-model function is recognised by its pickle (its qualified name and any partial arguments),
-not by its code: edit a function's body and keep its name, and the directory will not
-notice -- start a new directory when the model changes.  Runs are identified by (point,
-run index) and their seeds, so the runs count may grow between calls: ``runs=k`` then
-``runs=n`` computes only the n - k new ones.
+``.npz`` per run) and, called again, takes the runs already there instead of repeating
+them.  Files are written to a temporary name and renamed, so a run killed mid-write leaves
+no file that passes for finished.
+
+One ensemble at a time: a call holds an exclusive lock on the directory's ``.lock`` file
+(``flock``; ``msvcrt.locking`` on Windows) from before it reads anything until it
+returns, and a second call on the directory meanwhile is refused.  The operating system
+drops the lock when its process dies, so a killed ensemble leaves nothing stuck.
+
+The directory's ``ensemble.json`` holds a fingerprint of what made it (models, run
+options, quantities, seed, granular version), and every run file carries that
+fingerprint's digest: a call that differs in any of them is refused, and so is a run file
+that another ensemble wrote.  A model function is recognised by its pickle (its qualified
+name and any partial arguments), not by its code: edit a function's body and keep its
+name, and the directory will not notice -- start a new directory when the model changes.
+Runs are identified by (point, run index) and their seeds, so the runs count may grow
+between calls: ``runs=k`` then ``runs=n`` computes only the n - k new ones.
+
+Reading a run file trusts nothing in it: the file must be a regular file, its zip members
+stored uncompressed (as ``np.savez`` writes them) and together no larger than the file,
+each a ``.npy`` array of plain numbers or text whose header's size matches its member, with
+the zip's CRC checked; anything else is a ``CheckpointError`` naming the file.  So a
+damaged or crafted file costs at most its own size in memory, and runs no code.
 """
 
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import os
 import pickle
+import stat
+import sys
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +46,11 @@ from .errors import CheckpointError
 
 FINGERPRINT = "ensemble.json"
 _META = "__run__"  # the entry of a run's file that describes it; results use other names
+LOCK = ".lock"
+# ensemble.json is a few hundred bytes; anything far larger is not one
+_MAX_FINGERPRINT_BYTES = 1 << 20
+# dtype kinds a run file may hold: numbers, booleans and text (never objects)
+_KINDS = "biufcUS"
 
 
 def _digest(obj: Any, what: str) -> str:
@@ -64,18 +86,180 @@ def fingerprint(models, sweep, root, run_kwargs, quantities) -> dict[str, Any]:
     }
 
 
+def digest(print_: dict[str, Any]) -> str:
+    """SHA-256 of a fingerprint's canonical JSON: what every run file of it carries."""
+    return hashlib.sha256(json.dumps(print_, sort_keys=True).encode()).hexdigest()
+
+
+class _DirectoryLock:
+    """An exclusive lock on ``folder/.lock`` held through an open file: ``flock`` on POSIX
+    (its owner is the open file, so two calls in one process exclude each other too),
+    ``msvcrt.locking`` on Windows.  The kernel releases it when the process dies; the file
+    itself stays (deleting it would let two processes lock two different files)."""
+
+    def __init__(self, folder: Path) -> None:
+        path = folder / LOCK
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            if not self._try_lock(fd):
+                try:  # the holder's pid, for the message (Windows may refuse the read)
+                    os.lseek(fd, 0, os.SEEK_SET)
+                    holder = os.read(fd, 32).decode(errors="replace").strip()
+                except OSError:
+                    holder = ""
+                who = f"process {holder}" if holder.isdigit() else "another process"
+                raise CheckpointError(
+                    f"{folder} is in use by another ensemble ({who} holds {path}): "
+                    "two ensembles in one save_to directory would mix their runs.  Wait for "
+                    "it to finish (then call again to resume from its runs), or give this "
+                    "call another directory"
+                )
+            # the holder's pid, padded to a fixed width so no truncation is needed
+            os.lseek(fd, 0, os.SEEK_SET)
+            os.write(fd, f"{os.getpid():<20d}\n".encode())
+        except BaseException:
+            os.close(fd)
+            raise
+        self._fd = fd
+
+    @staticmethod
+    def _try_lock(fd: int) -> bool:
+        if sys.platform == "win32":
+            import msvcrt
+
+            try:
+                msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+            except OSError:
+                return False
+            return True
+        import fcntl
+
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            return False
+        return True
+
+    def release(self) -> None:
+        if self._fd is not None:
+            os.close(self._fd)  # closing the file drops the lock (flock and msvcrt alike)
+            self._fd = None
+
+
+def _read_regular(path: Path, limit: int | None = None) -> bytes:
+    """The bytes of ``path``, which must be a regular file (not a device, a FIFO or a
+    directory, which could be read forever), of at most ``limit`` bytes."""
+    # non-blocking, so that opening a FIFO does not wait for a writer
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
+    with open(fd, "rb") as f:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            raise ValueError("not a regular file")
+        if limit is not None and info.st_size > limit:
+            raise ValueError(f"{info.st_size} bytes, more than the {limit} it can be")
+        data = f.read(info.st_size + 1)
+    if len(data) != info.st_size:
+        raise ValueError("its size changed while it was read")
+    return data
+
+
+def _read_npy(member: zipfile.ZipExtFile, size: int) -> np.ndarray:
+    """One ``.npy`` member whose header must describe exactly its ``size`` bytes."""
+    version = np.lib.format.read_magic(member)
+    if version == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(member)
+    elif version == (2, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(member)
+    else:
+        raise ValueError(f"unsupported .npy version {version}")
+    if dtype.kind not in _KINDS or dtype.names is not None or dtype.subdtype is not None:
+        raise ValueError(f"an array of dtype {dtype}: a run file holds numbers and text only")
+    header = member.tell()
+    count = 1
+    for extent in shape:
+        count *= int(extent)
+    if count * dtype.itemsize != size - header:
+        raise ValueError(
+            f"a header for {shape} x {dtype.itemsize} bytes in a member of {size - header}"
+        )
+    data = member.read(size - header)
+    if len(data) != size - header or member.read(1):  # reading to the end checks the CRC
+        raise ValueError("a member shorter or longer than its header says")
+    return np.frombuffer(data, dtype=dtype).reshape(shape, order="F" if fortran else "C").copy()
+
+
+def _read_run_file(path: Path) -> dict[str, np.ndarray]:
+    """The arrays of a run file, read within the file's own size (see the module's
+    docstring); ValueError, OSError or zipfile's errors for anything else."""
+    data = _read_regular(path)
+    arrays = {}
+    with zipfile.ZipFile(io.BytesIO(data)) as zf:
+        members = zf.infolist()
+        if sum(m.file_size for m in members) > len(data):
+            raise ValueError("its members claim more bytes than the file has")
+        for m in members:
+            if m.compress_type != zipfile.ZIP_STORED or m.file_size != m.compress_size:
+                raise ValueError(f"member {m.filename!r} is compressed (run files are not)")
+            name = m.filename.removesuffix(".npy")
+            if name == m.filename or name in arrays:
+                raise ValueError(f"unexpected member {m.filename!r}")
+            with zf.open(m) as member:
+                arrays[name] = _read_npy(member, m.file_size)
+    return arrays
+
+
+def _check_meta(meta: Any) -> dict[str, Any]:
+    """A run file's description, checked for the fields and types ``load`` uses."""
+    ok = (
+        isinstance(meta, dict)
+        and meta.get("status") in ("ok", "error")
+        and isinstance(meta.get("seed"), dict)
+        and isinstance(meta.get("ensemble"), str)
+    )
+    if ok and meta["status"] == "ok":
+        names = [meta.get("scalars"), meta.get("arrays")]
+        ok = all(isinstance(n, list) and all(isinstance(k, str) for k in n) for n in names)
+    elif ok:
+        error = meta.get("error")
+        ok = isinstance(error, list) and len(error) == 3 and all(isinstance(e, str) for e in error)
+    if not ok:
+        raise ValueError("its description lacks fields or has wrong types")
+    return meta
+
+
 class RunStore:
-    """The directory of an ensemble's runs, checked against (or given) a fingerprint."""
+    """The directory of an ensemble's runs, locked for this call and checked against (or
+    given) a fingerprint.  Use as a context manager, or call ``close()``, to release the
+    lock."""
 
     def __init__(self, path: str | os.PathLike, print_: dict[str, Any]) -> None:
         self.path = Path(path)
         self.path.mkdir(parents=True, exist_ok=True)
+        self._lock = _DirectoryLock(self.path)
+        try:
+            self._check_or_write(print_)
+            # with the lock held no one else writes here: a temporary file is a dead
+            # writer's (write_atomic's, killed before its rename)
+            for stale in self.path.glob(".tmp-*"):
+                stale.unlink(missing_ok=True)
+        except BaseException:
+            self._lock.release()
+            raise
+        self.digest = digest(print_)
+
+    def _check_or_write(self, print_: dict[str, Any]) -> None:
         own = self.path / FINGERPRINT
         if own.exists():
             try:
-                theirs = json.loads(own.read_text())
-            except (OSError, ValueError) as exc:
-                raise CheckpointError(f"{own} is unreadable: {exc}") from exc
+                theirs = json.loads(_read_regular(own, _MAX_FINGERPRINT_BYTES))
+                if not isinstance(theirs, dict):
+                    raise ValueError("not a JSON object")
+            # any unreadable file (I/O, not JSON, nested too deep, too large) gets one error
+            except Exception as exc:
+                raise CheckpointError(
+                    f"{own} is unreadable ({exc.__class__.__name__}: {exc}): not made by "
+                    "ensemble(save_to=...), or damaged; use another directory"
+                ) from exc
             differ = sorted(k for k in set(print_) | set(theirs) if print_.get(k) != theirs.get(k))
             if differ:
                 raise CheckpointError(
@@ -89,7 +273,17 @@ class RunStore:
                     f"{self.path} holds run files but no {FINGERPRINT}: not made by "
                     "ensemble(save_to=...), or damaged; use another directory"
                 )
-            self._write_atomic(own, json.dumps(print_, indent=1).encode())
+            write_atomic(own, json.dumps(print_, indent=1).encode())
+
+    def close(self) -> None:
+        """Release the directory's lock (the files stay)."""
+        self._lock.release()
+
+    def __enter__(self) -> RunStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     def _file(self, point: int, run: int) -> Path:
         return self.path / f"p{point:04d}-r{run:06d}.npz"
@@ -97,52 +291,60 @@ class RunStore:
     def has(self, point: int, run: int) -> bool:
         return self._file(point, run).exists()
 
-    def _write_atomic(self, target: Path, data: bytes) -> None:
-        write_atomic(target, data)
-
     def write(self, point, run, seed, status, payload) -> None:
-        """Store one finished run: its arrays (status "ok") or its failure."""
-        meta = {"status": status, "seed": _seed_dict(seed)}
+        """Store one finished run: its arrays (status "ok") or its failure (the first
+        three entries of the payload: repr, type name, traceback)."""
+        meta = {"status": status, "seed": _seed_dict(seed), "ensemble": self.digest}
         arrays = {}
         if status == "ok":
             arrays = {k: np.asarray(v) for k, v in payload.items()}
             if _META in arrays:
                 raise ValueError(f"a run's result may not be named {_META!r}")
             meta["scalars"] = sorted(k for k, v in payload.items() if np.ndim(v) == 0)
+            # the names stored, so that a run missing one (a damaged zip directory can
+            # hide a member) is refused, not read as a run without that quantity
+            meta["arrays"] = sorted(arrays)
         else:
-            meta["error"] = list(payload)
-        import io
-
-        buf = io.BytesIO()
-        try:
-            np.savez(buf, **{_META: np.array(json.dumps(meta))}, **arrays)
-        except ValueError as exc:  # object arrays would need pickle to load
+            meta["error"] = [str(e) for e in payload[:3]]
+        bad = sorted(k for k, v in arrays.items() if v.dtype.kind not in _KINDS)
+        if bad:
             raise ValueError(
-                f"run {run} of point {point}: its result cannot be saved without pickle "
-                f"({exc}); save_to stores NumPy arrays of numbers only"
-            ) from exc
-        self._write_atomic(self._file(point, run), buf.getvalue())
+                f"run {run} of point {point}: its result {bad} are not arrays of numbers "
+                "or text; save_to stores NumPy arrays of numbers only"
+            )
+        buf = io.BytesIO()
+        np.savez(buf, **{_META: np.array(json.dumps(meta))}, **arrays)
+        write_atomic(self._file(point, run), buf.getvalue())
 
     def load(self, point, run, seed) -> tuple[str, Any]:
         """(status, payload) of a stored run, as ``_call_task`` returned it."""
         path = self._file(point, run)
         try:
-            with np.load(path, allow_pickle=False) as npz:
-                arrays = {k: npz[k] for k in npz.files}
-            meta = json.loads(str(arrays.pop(_META)[()]))
-        # any unreadable file (bad zip, missing entry, bad JSON) gets the same advice
+            arrays = _read_run_file(path)
+            meta = _check_meta(json.loads(str(arrays.pop(_META)[()])))
+            if meta["status"] == "ok" and sorted(arrays) != meta["arrays"]:
+                raise ValueError(f"it holds {sorted(arrays)}, not the {meta['arrays']} written")
+        # any unreadable file (I/O, bad zip, crafted header, missing entry, bad or deeply
+        # nested JSON) gets the same error and advice
         except Exception as exc:
             raise CheckpointError(
                 f"{path} is unreadable ({exc.__class__.__name__}: {exc}); delete it and "
                 "call again to redo that run"
             ) from exc
-        if meta.get("seed") != _seed_dict(seed):
+        if meta["ensemble"] != self.digest:
             raise CheckpointError(
-                f"{path} was made with seed {meta.get('seed')}, but this call gives that run "
+                f"{path} was written by another ensemble than the one {self.path / FINGERPRINT}"
+                " describes (another model, run options, quantities, seed or granular "
+                "version): its runs cannot be mixed with this one's.  Delete that file to "
+                "redo the run, or use another directory"
+            )
+        if meta["seed"] != _seed_dict(seed):
+            raise CheckpointError(
+                f"{path} was made with seed {meta['seed']}, but this call gives that run "
                 f"{_seed_dict(seed)} (a SeedSequence that has spawned before gives new seeds: "
                 "pass an int or a fresh SeedSequence)"
             )
         if meta["status"] != "ok":
             return meta["status"], tuple(meta["error"])
-        scalars = set(meta.get("scalars", ()))
+        scalars = set(meta["scalars"])
         return "ok", {k: (v[()] if k in scalars else v) for k, v in arrays.items()}

@@ -3,6 +3,11 @@ failures reported without losing the other runs, sweeps in one call, bounded mem
 
 import functools
 import math
+import os
+import signal
+import subprocess
+import sys
+import time
 import weakref
 
 import numpy as np
@@ -172,8 +177,12 @@ def test_bad_arguments():
         granular.ensemble(ensemble_tasks.small_gas, 2, quantities=("colour",), **RUN)
     with pytest.raises(ValueError, match="backend must be"):
         granular.ensemble(ensemble_tasks.gaussian, 2, backend="gpu")
-    res = granular.ensemble(ensemble_tasks.gaussian, 2, backend="serial", t_stop=1.0)
-    assert res.count == 0 and "apply to EDMD scenes only" in res.failures[0].error
+    # run options for a model that returns no Scene fail every run alike: that error
+    with pytest.raises(TypeError, match="apply to EDMD scenes only") as info:
+        granular.ensemble(ensemble_tasks.gaussian, 2, backend="serial", t_stop=1.0)
+    assert "every one of this ensemble's 2 runs failed with TypeError" in "".join(
+        getattr(info.value, "__notes__", [])
+    )
 
 
 def test_finished_runs_are_not_kept_when_only_means_are_asked_for():
@@ -343,3 +352,173 @@ def test_a_dead_worker_gets_the_same_advice():
         granular.ensemble(_kills_its_worker, 2, seed=1, workers=2)
     assert GUARD_TO_WRITE in str(info.value) and 'backend="serial"' in str(info.value)
     assert isinstance(info.value, granular.GranularError)
+
+
+# A caller's mistake is an exception before any run starts, not K failed runs.
+
+CALLED = []
+
+
+def _counting_gas(seed):
+    CALLED.append(seed)
+    return Scene.random(20, 0.02, dim=2, seed=seed)
+
+
+SCENE = Scene.random(20, 0.02, dim=2, seed=1)
+
+
+@pytest.mark.parametrize(
+    "kwargs, error, match",
+    [
+        (dict(t_stop=1.0, sample_times=np.linspace(1, 0, 5)), ValueError, "strictly increasing"),
+        (dict(sample_times=np.linspace(0, 1, 5)), ValueError, "finite t_stop or a stop_when"),
+        (dict(t_stop=1.0, sample_times=np.linspace(0, 2, 5)), ValueError, "past t_stop = 1"),
+        (dict(t_stop=1.0, sample_times=[-1.0, 0.5]), ValueError, "before t = 0"),
+        (dict(t_stop=1.0, sample_times=[[0.0, 0.5]]), ValueError, "one-dimensional"),
+        (dict(t_stop=1.0, sample_times=[0.0, np.nan]), ValueError, "finite"),
+        (dict(t_stop=float("nan")), ValueError, "t_stop must be a time >= 0"),
+        (dict(t_stop=-1.0), ValueError, "t_stop must be a time >= 0"),
+        (dict(t_stop="soon"), TypeError, "t_stop must be a number"),
+        (dict(t_stop=1.0, stop_when={"energy": 1.0}), ValueError, "unknown stop_when keys"),
+        (dict(stop_when={"collisions_per_particle": "ten"}), TypeError, "must be a number"),
+        (dict(stop_when=10), TypeError, "stop_when must be a dict"),
+        (
+            dict(t_stop=1.0, store=("positions",)),
+            TypeError,
+            r"unknown keyword arguments \['store'\]",
+        ),
+        (dict(t_stop=1.0, tstop=2.0), TypeError, r"unknown keyword arguments \['tstop'\]"),
+    ],
+)
+def test_a_callers_mistake_raises_before_any_run(kwargs, error, match):
+    CALLED.clear()
+    with pytest.raises(error, match=match):
+        granular.ensemble(_counting_gas, 3, seed=1, backend="serial", **kwargs)
+    assert CALLED == [], "no run started"
+
+
+def test_a_scene_without_t_stop_and_other_argument_mistakes_raise_at_once():
+    with pytest.raises(ValueError, match="finite t_stop or a stop_when"):
+        granular.ensemble(SCENE, 3, seed=1, backend="serial")
+    with pytest.raises(TypeError, match="runs must be a whole number"):
+        granular.ensemble(SCENE, 2.5, seed=1, backend="serial", t_stop=1.0)
+    with pytest.raises(ValueError, match="workers must be"):
+        granular.ensemble(SCENE, 2, seed=1, workers=0, t_stop=1.0)
+    with pytest.raises(TypeError, match=r"list of names, e.g. \('msd',\)"):
+        granular.ensemble(SCENE, 2, seed=1, backend="serial", t_stop=1.0, quantities="msd")
+
+
+@pytest.mark.parametrize("backend", ["serial", "processes"])
+def test_every_run_failing_alike_raises_that_error(backend):
+    """Every run raises the same error type: that error is raised (unpickled from a worker
+    with its attributes), noting how many runs failed and the first run's traceback."""
+    with pytest.raises(granular.InelasticCollapseError, match="collapse in run 0") as info:
+        granular.ensemble(ensemble_tasks.always_collapses, 3, seed=1, backend=backend, workers=2)
+    assert info.value.time == 0.5 and info.value.particles == (1, 2)
+    note = "".join(getattr(info.value, "__notes__", []))
+    assert "every one of this ensemble's 3 runs failed with InelasticCollapseError" in note
+    assert "always_collapses" in note, "the worker's traceback"
+    # a model function returning a Scene, called without t_stop: each run refuses
+    with pytest.raises(ValueError, match="finite t_stop or a stop_when criterion"):
+        granular.ensemble(ensemble_tasks.scene_without_run_options, 2, seed=1, backend="serial")
+
+
+def test_a_sweep_point_whose_runs_all_fail_is_warned_about():
+    with pytest.warns(RuntimeWarning, match=r"point 1: every one of its 2 runs failed"):
+        ok, failed = granular.ensemble(
+            [ensemble_tasks.gaussian, ensemble_tasks.always_collapses],
+            2,
+            seed=1,
+            backend="serial",
+        )
+    assert ok.count == 2 and failed.count == 0 and len(failed.failures) == 2
+    with pytest.raises(ValueError, match="all 2 runs failed"):
+        failed.msd()
+
+
+# Means over the runs that have a quantity; a quantity whose shape differs is named.
+
+
+def test_a_quantity_missing_from_some_runs_is_the_mean_of_the_runs_that_have_it():
+    """Runs 0, 2, 3 carry y = 0, 2, 3: mean 5/3 over 3 runs (not 5/4), error
+    std(ddof=1)/sqrt(3)."""
+    res = granular.ensemble(ensemble_tasks.y_missing_from_run_1, 4, seed=1, backend="serial")
+    y = np.array([0.0, 2.0, 3.0])
+    assert res.count == 4 and res.counts == {"x": 4, "y": 3}
+    np.testing.assert_allclose(res.mean["y"], 5 / 3, rtol=1e-15)
+    np.testing.assert_allclose(res.error["y"], y.std(ddof=1) / math.sqrt(3), rtol=1e-14)
+    np.testing.assert_allclose(res.mean["x"], 1.5, rtol=1e-15)
+    assert "y (3 runs)" in repr(res)
+
+
+def test_a_quantity_whose_shape_differs_between_runs_is_warned_about_and_named():
+    with pytest.warns(
+        RuntimeWarning,
+        match=r"'z' has no ensemble mean: its shape differs between runs "
+        r"\(\(3,\) in run 0, \(2,\) in run 1\)",
+    ):
+        res = granular.ensemble(ensemble_tasks.z_shorter_in_run_1, 3, seed=1, backend="serial")
+    assert "z" not in res.mean and "z" in res.left_out and res.counts == {"x": 3}
+    assert [r["z"].shape for r in res.runs] == [(3,), (2,), (3,)]
+    with pytest.raises(ValueError, match="no mean 'z': its shape differs"):
+        res._quantity("z", "")
+
+
+# Workers of the process backend do not outlive the ensemble's process.
+
+ORPHAN_SCRIPT = """import os, sys, time
+import granular
+
+def model(seed):
+    # tell the test this worker's pid and its parent's (the forkserver), then wait
+    with open(os.path.join(sys.argv[1], str(os.getpid())), "w") as f:
+        f.write(str(os.getppid()))
+    time.sleep(300)
+
+if __name__ == "__main__":
+    granular.ensemble(model, 4, seed=1, workers=2, progress=False)
+"""
+
+
+def _alive(pid):
+    """True while ``pid`` runs (a zombie, dead but not yet reaped, counts as gone)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rpartition(")")[2].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_workers_exit_when_the_ensemble_process_is_killed(tmp_path):
+    """SIGKILL the process running ensemble(backend="processes") while its workers run:
+    the workers and their forkserver are gone within 5 s (they used to wait for tasks
+    forever, and kept the forkserver alive)."""
+    script = tmp_path / "script.py"
+    script.write_text(ORPHAN_SCRIPT)
+    pids_dir = tmp_path / "pids"
+    pids_dir.mkdir()
+    parent = subprocess.Popen([sys.executable, str(script), str(pids_dir)], cwd=tmp_path)
+    others = []
+    try:
+        deadline = time.monotonic() + 60
+        while len(list(pids_dir.iterdir())) < 2 and time.monotonic() < deadline:
+            assert parent.poll() is None, "the ensemble's process ended early"
+            time.sleep(0.05)
+        time.sleep(0.2)  # both files written in full
+        workers = [int(p.name) for p in pids_dir.iterdir()]
+        forkservers = {int(p.read_text()) for p in pids_dir.iterdir()}
+        others = workers + sorted(forkservers)
+        assert len(workers) == 2 and all(_alive(p) for p in others)
+        parent.send_signal(signal.SIGKILL)
+        parent.wait(10)
+        deadline = time.monotonic() + 5
+        while any(_alive(p) for p in others) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not [p for p in others if _alive(p)], "processes outlived the ensemble's"
+    finally:
+        if parent.poll() is None:
+            parent.kill()
+        for p in others:  # only the processes this test started
+            if _alive(p):
+                os.kill(p, signal.SIGKILL)

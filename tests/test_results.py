@@ -191,11 +191,11 @@ def test_results_are_frozen_dataclasses(sde, ens):
 
 
 def test_a_failed_run_names_its_error_type():
-    res = granular.ensemble(
-        functools.partial(langevin.run, 1, gamma0=1.0, D0=1.0, dt=-1.0, t_stop=1.0),
-        1,
-        backend="serial",
-        progress=False,
-    )
+    # a sweep whose other point succeeds: a call whose every run fails raises instead
+    good = functools.partial(langevin.run, 1, gamma0=1.0, D0=1.0, dt=0.5, t_stop=1.0)
+    with pytest.warns(RuntimeWarning, match="point 1: every one of its 1 runs failed"):
+        _, res = granular.ensemble(
+            [good, functools.partial(good, dt=-1.0)], 1, backend="serial", progress=False
+        )
     (failure,) = res.failures
     assert failure.error_type == "ValueError" and "dt must be positive" in failure.error

@@ -50,3 +50,39 @@ def tracked_result(seed):
         live_results += 1
         peak_live_results = max(peak_live_results, live_results)
     return {"x": x}
+
+
+def y_missing_from_run_1(seed):
+    """Run r returns x = r and, except run 1, y = r: the mean of y is over 3 runs of 4."""
+    index = seed.spawn_key[-1]
+    out = {"x": np.float64(index)}
+    if index != 1:
+        out["y"] = np.float64(index)
+    return out
+
+
+def z_shorter_in_run_1(seed):
+    """z has 3 entries, but 2 in run 1 (as a run stopped early would sample)."""
+    index = seed.spawn_key[-1]
+    return {"x": np.float64(index), "z": np.zeros(2 if index == 1 else 3)}
+
+
+def always_collapses(seed):
+    raise granular.InelasticCollapseError(
+        f"collapse in run {seed.spawn_key[-1]}", particles=(1, 2), time=0.5
+    )
+
+
+def scene_without_run_options(seed):
+    """A model returning a Scene: with no t_stop given, every EDMD run refuses to start."""
+    return granular.Scene.random(20, 0.02, dim=2, seed=seed)
+
+
+def slow_draws(seed, delay=0.02):
+    """Arrays drawn from the run's seed, after a pause that varies from run to run (so
+    that a process killed at a random moment is caught in a run, between runs or mid-write)."""
+    import time
+
+    rng = np.random.default_rng(seed)
+    time.sleep(delay * rng.random())
+    return {"times": np.arange(4.0), "msd": rng.random(4), "energy": np.float64(rng.random())}
