@@ -18,10 +18,10 @@
 #include "common.h"
 
 /* Cell heads beyond this many bytes are taken as out of cache, and scans ask for the
- * occupied cells' heads ahead.  In cache the extra loop only costs (cachegrind, 2D
- * N = 1e4 with 196 kB of heads: 0.4 fewer mispredicted branches per event without it);
- * at 3D N = 1e5 (3.2 MB) it saves time.  The event loop then also prefetches events
- * ahead (edmd.c). */
+ * occupied cells' heads ahead.  In cache the extra loop only costs: its length, the number
+ * of occupied cells, is as good as random, so its branch mispredicts; out of cache the
+ * heads it asks for save more than that (both counted in docs/performance.md).  The event
+ * loop then also prefetches events ahead (edmd.c). */
 #define GR_HEADS_CACHED ((size_t)1 << 20)
 
 typedef struct {
@@ -175,8 +175,8 @@ static GR_ALWAYS_INLINE int cell_neighbours_in(const gr_cells *g, int dim, const
     return m;
 }
 
-/* Compiled apart for periodic boxes, where no neighbour lies beyond a wall (3D,
- * N = 1e3, where 27 % of the cells are at the edge: 1287 -> 1204 instructions an event). */
+/* Compiled apart for periodic boxes, where no neighbour lies beyond a wall: a small box
+ * has many edge cells, and the wall tests cost them instructions (docs/performance.md). */
 static inline int cell_neighbours(const gr_cells *g, int dim, const int32_t *c, int axis,
                                   int dir, gr_nbr *out)
 {

@@ -15,10 +15,12 @@
  * (Schwager & Poeschel 1998, Phys. Rev. E 57, 650, the series and C1, C2; Brilliantov &
  * Poeschel, Kinetic Theory of Granular Gases, OUP 2004, ch. 6, the same in this notation;
  * equation numbers not given: the papers' text was not at hand, so the convention was
- * fixed by integrating the contact numerically, see tests/test_restitution.py).  Series of order 2 in delta = A kappa^(2/5) v^(1/5):
- * the next term is about -0.5 delta^3 (measured against a numerical integration of the
- * contact, tests/test_restitution.py), so it is evaluated for delta <= GR_VISCO_DELTA_MAX
- * only, where the error is below 0.008 (eps >= 0.76); faster impacts are given eps at
+ * fixed by integrating the contact numerically, see tests/test_restitution.py).  Series
+ * of order 2 in delta = A kappa^(2/5) v^(1/5): for a contact that ends where the force
+ * vanishes (Schwager & Poeschel 2008, Phys. Rev. E 78, 051304) the next term is
+ * +(4/15) delta^(5/2) (checked against a numerical integration of the contact,
+ * tests/test_restitution.py), so it is evaluated for delta <= GR_VISCO_DELTA_MAX only,
+ * where the error is at most 0.0015 (eps >= 0.76); faster impacts are given eps at
  * delta max and counted (gr_edmd_counters.law_clamped), because the truncated series
  * turns up again past delta = C1 / (2 C2) = 0.72 and means nothing there.  In 2D the same
  * law is a model choice: there is no Hertz law for disks. */

@@ -199,11 +199,10 @@ static GR_AVX512 inline __m512i lookup128(const __m512i *t, __m512i iz, __mmask1
 /* Why permutes and not gathers: the tables are 512 B (k) and 1 KB (w), 24 vectors, loaded
  * once a call; w is held as its low and its high 32-bit halves, so each of the three
  * look-ups is 4 vpermt2d and 3 blends for 16 draws (and 2 vpermt2d put w's halves back
- * together), against gathers that stall (the batch took 100 ns a call with gathers, 67
- * with permutes of w as doubles, 49 as here; m = 6, a C loop of calls alone). The draw
- * counter is a vector add and z a moving pointer, not (k + 1) golden and z + k B: with
- * -fwrapv (in Python's CFLAGS, which the extension inherits) GCC 12 compiled the indexed
- * form into a loop 12 M steps/s slower. */
+ * together), against gathers that stall (and against permutes of w as doubles; timings in
+ * docs/performance.md). The draw counter is a vector add and z a moving pointer, not
+ * (k + 1) golden and z + k B: with -fwrapv (in Python's CFLAGS, which the extension
+ * inherits) GCC 12 compiled the indexed form into a slower loop. */
 static GR_AVX512 uint32_t batch_avx512(uint64_t key, uint64_t step0, uint64_t particle, int m,
                                        double *restrict z, uint64_t *restrict seed,
                                        uint32_t *restrict miss)

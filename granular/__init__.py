@@ -38,8 +38,9 @@ __version__ = "0.1.0"
 _LAZY = ("plot", "interop")
 
 
-# the applications moved to granular.cli (issue 14); the old names work for one more
-# release, with a DeprecationWarning
+# the applications moved to granular.cli; the old names work, with a DeprecationWarning,
+# for the one release after the move, and go in this one
+_MOVED_REMOVED_IN = "0.3.0"
 _MOVED = ("demo", "reproduce", "speed_accuracy", "bench", "bench_langevin")
 
 
@@ -52,7 +53,8 @@ def __getattr__(name):
         import warnings
 
         warnings.warn(
-            f"granular.{name} moved to granular.cli.{name}; the old name goes in the next release",
+            f"granular.{name} moved to granular.cli.{name}; the old name is removed in "
+            f"granular {_MOVED_REMOVED_IN}",
             DeprecationWarning,
             stacklevel=2,
         )

@@ -75,12 +75,18 @@ INITIAL = ("thermal", "udsbm", "fixed")
 _CHUNK_PARTICLE_STEPS = 10_000_000
 
 
+# the array use of LangevinResult.msd / .tamsd works, with a DeprecationWarning, for the
+# one release after the change, and goes in this one
+_ARRAY_USE_REMOVED_IN = "0.3.0"
+
+
 class _ArrayAndMethod(np.ndarray):
     """The transition from an array attribute to a method of the same name:
     ``result.msd`` used to be the (T,) array and is now the method ``result.msd()``.
     This object is both -- called, it runs the method; used as an array (indexing,
     arithmetic, NumPy functions), it is the old array and warns that this use is
-    deprecated.  Results of array use are plain arrays."""
+    deprecated; the array use is removed in granular 0.3.0 (``_ARRAY_USE_REMOVED_IN``).
+    Results of array use are plain arrays."""
 
     _method: Any  # the bound method (None only on views made by NumPy itself)
     _name: str
@@ -101,8 +107,8 @@ class _ArrayAndMethod(np.ndarray):
 
     def _deprecated(self) -> None:
         warnings.warn(
-            f"using result.{self._name} as an array is deprecated; call "
-            f"result.{self._name}() (the same numbers)",
+            f"using result.{self._name} as an array is deprecated and removed in granular "
+            f"{_ARRAY_USE_REMOVED_IN}; call result.{self._name}() (the same numbers)",
             DeprecationWarning,
             stacklevel=3,
         )

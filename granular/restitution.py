@@ -33,9 +33,10 @@ _KIND_TABLE = 2
 # ch. 6): C1 = Gamma(3/5) sqrt(pi) / (2^(1/5) 5^(2/5) Gamma(21/10)), C2 = (3/5) C1^2.
 C1: float = math.gamma(3 / 5) * math.sqrt(math.pi) / (2**0.2 * 5**0.4 * math.gamma(21 / 10))
 C2: float = 0.6 * C1**2
-# The series is used up to this delta (csrc/restitution.h GR_VISCO_DELTA_MAX): the next,
-# dropped term is about -0.5 delta^3 (tests/test_restitution.py integrates the contact),
-# below 0.008 here; past delta = C1 / (2 C2) = 0.72 the truncated series rises again.
+# The series is used up to this delta (csrc/restitution.h GR_VISCO_DELTA_MAX): for a
+# contact that ends where the force vanishes (Schwager & Poeschel 2008) the first dropped
+# term is +(4/15) delta^(5/2) and the error 0.0015 here (tests/test_restitution.py
+# integrates the contact); past delta = C1 / (2 C2) = 0.72 the truncated series rises again.
 DELTA_MAX: float = 0.25
 # A table of at most this many points (csrc/restitution.h GR_LAW_TABLE_MAX).
 TABLE_MAX = 1_000_000
@@ -145,9 +146,11 @@ class Viscoelastic(RestitutionLaw):
     viscoelastic functions); ``characteristic_speed`` ``(A kappa^(2/5))^-5`` is the speed
     at which delta = 1.
 
-    The series is of order 2 in delta.  Its next term is about -0.5 delta^3 (found by
-    integrating the contact numerically, tests/test_restitution.py), so it is used for
-    delta <= 0.25 only (eps >= 0.76, error < 0.008), i.e. speeds up to ``max_speed``.  A
+    The series is of order 2 in delta.  For a contact that ends where the force vanishes
+    (the spheres separate before the overlap returns to zero; Schwager & Poeschel 2008) its
+    next term is +(4/15) delta^(5/2) (checked by integrating the contact numerically,
+    tests/test_restitution.py); it is used for delta <= 0.25 only (eps >= 0.76, error at
+    most 0.0015, 0.2 %), i.e. speeds up to ``max_speed``.  A
     faster collision gets eps(max_speed), and the engine counts it
     (``Simulation.stats['law_clamped_collisions']``; ``Simulation.run`` warns): a gas
     whose collisions often exceed ``max_speed`` is outside this law.
@@ -173,6 +176,8 @@ class Viscoelastic(RestitutionLaw):
     N. V. Brilliantov, F. Spahn, J.-M. Hertzsch, T. Poeschel, Phys. Rev. E 53, 5382 (1996).
 
     T. Schwager, T. Poeschel, Phys. Rev. E 57, 650 (1998).
+
+    T. Schwager, T. Poeschel, Phys. Rev. E 78, 051304 (2008).
 
     N. V. Brilliantov, T. Poeschel, Kinetic Theory of Granular Gases, OUP (2004), ch. 6.
     """

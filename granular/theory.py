@@ -388,7 +388,7 @@ def _check_dim(dim):
         raise ValueError(f"dim must be 2 or 3, got {dim}")
 
 
-# -- the end of homogeneous cooling: the shear instability (issue 15) ----------------------
+# -- the end of homogeneous cooling: the shear instability ---------------------------------
 #
 # Sources: Goldhirsch & Zanetti 1993, Phys. Rev. Lett. 70, 1619 (the instability); Brey,
 # Ruiz-Montero & Cubero 1999, Phys. Rev. E 60, 3150 and Garzo 2005, Phys. Rev. E 72, 021106
@@ -541,7 +541,7 @@ def shear_mode_level(box: FloatOrArray, critical: FloatOrArray) -> FloatOrArray:
     return level[()] if level.ndim == 0 else level
 
 
-# == Viscoelastic granular gases and UDSBM with power-law coefficients (issue 15) ============
+# == Viscoelastic granular gases and UDSBM with power-law coefficients =====================
 #
 # Two parts.  (1) The homogeneous cooling of a gas of viscoelastic spheres, whose restitution
 # depends on the normal impact speed g (Brilliantov, Spahn, Hertzsch & Poeschel, PRE 53, 5382

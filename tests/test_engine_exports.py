@@ -1,5 +1,5 @@
-"""The engine's rules are owned by the C core and read from it by the Python side
-(issue 14): the big-particle rule and its default, the bytes per particle, and the
+"""The engine's rules are owned by the C core and read from it by the Python side:
+the big-particle rule and its default, the bytes per particle, and the
 checks of a configuration without building an engine."""
 
 import math

@@ -214,7 +214,7 @@ def test_dask_submission_is_windowed(dask_client):
         np.testing.assert_array_equal(a.error["x"], b.error["x"])
 
 
-# Runs constant across the ensemble keep their value, inf included (issue 13, item 16).
+# Runs constant across the ensemble keep their value, inf included.
 
 
 def test_langevin_ensemble_keeps_infinite_tau0():
@@ -263,7 +263,7 @@ def test_reducer_with_infinite_and_varying_entries():
     assert math.isnan(one.result()[1]["tau0"]) and one.result()[0]["tau0"] == math.inf
 
 
-# A script without `if __name__ == "__main__":` (issue 13, item 10).  The process backend
+# A script without `if __name__ == "__main__":`.  The process backend
 # starts its workers with forkserver (Linux) or spawn, which re-run the main script: an
 # unguarded ensemble call there broke the pool (BrokenProcessPool).  These tests run real
 # scripts in a fresh interpreter, as a user would.

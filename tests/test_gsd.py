@@ -1,4 +1,4 @@
-"""GSD files (issue 17): Trajectory.write, granular.read and Scene.from_gsd round trip
+"""GSD files: Trajectory.write, granular.read and Scene.from_gsd round trip
 exactly; the file is a valid HOOMD GSD file for gsd itself and for MDAnalysis."""
 
 import os

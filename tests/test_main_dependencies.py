@@ -1,4 +1,4 @@
-"""The command line checks its optional dependencies before any work (issue 13, item 11):
+"""The command line checks its optional dependencies before any work:
 after ``pip install .`` without extras, ``python -m granular demo`` used to compute for a
 minute and then die on ``import matplotlib``, losing the results.
 
@@ -70,7 +70,7 @@ def test_demo_without_matplotlib_stops_before_any_work(tmp_path):
 
 @pytest.mark.parametrize("name", ["demo", "reproduce", "speed_accuracy", "bench", "bench_langevin"])
 def test_old_application_names_still_work_with_a_warning(name):
-    """granular.<app> moved to granular.cli.<app> (issue 14); the old name is the same module
+    """granular.<app> moved to granular.cli.<app>; the old name is the same module
     for one more release, and says where it went."""
     import importlib
 

@@ -15,7 +15,7 @@ import granular
 
 ROOT = Path(__file__).resolve().parent.parent
 
-# "A few hundred lines at most" (issue 14); today's README is about 250 lines, 14 KB. Engine
+# "A few hundred lines at most"; today's README is about 250 lines, 14 KB. Engine
 # design belongs in docs/engine.md, measurements in docs/performance.md.
 README_MAX_LINES = 300
 README_MAX_BYTES = 16_000
@@ -156,3 +156,26 @@ def test_every_equation_number_cites_the_thesis():
             )
             assert definition, f"{name} cites [G20] but never gives its full reference"
             assert definition.group(1) == THESIS_TITLE
+
+
+# -- comments say why, not when or which ticket ---------------------------------------------
+
+# "issue 16", "#16", or a date: the history belongs in git and CHANGELOG.md, measurements in
+# docs/performance.md with their dates
+TICKET_OR_DATE = re.compile(r"\bissues?\s+\d+|(?<![\w&])#\d{1,4}\b|\b20\d\d-\d\d-\d\d\b", re.I)
+
+
+def test_code_carries_no_issue_numbers_or_dates():
+    _source_file("pyproject.toml")
+    files = [
+        *sorted((ROOT / "granular").rglob("*.py")),
+        *sorted((ROOT / "csrc").glob("*.[ch]")),
+        *sorted((ROOT / "tests").rglob("*.py")),
+    ]
+    found = [
+        f"{path.relative_to(ROOT)}:{number}: {line.strip()}"
+        for path in files
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+        if TICKET_OR_DATE.search(line) and path.name != "test_repo_habits.py"
+    ]
+    assert not found, "\n".join(found)

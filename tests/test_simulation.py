@@ -495,7 +495,7 @@ def test_large_tracer_long_run_conserves_and_never_overlaps(dim):
     assert min(coarse.stats["cells"][:dim]) < min(sim.stats["cells"][:dim])
 
 
-# -- issue 13: unreachable energy targets, rounding past t_stop, heated walls, threads ------
+# -- unreachable energy targets, rounding past t_stop, heated walls, threads ---------------
 
 
 def test_energy_target_without_a_dissipative_channel_is_refused():

@@ -58,8 +58,8 @@ def edmd_workload(
         before = sim.stats
         target += collisions / windows
         # CPU time of this thread, where the engine runs: the process's would add NumPy's
-        # BLAS threads, which spin for a while after a call (9 % of a window's wall time
-        # at packing 0.45, measured 2026-11-27) without slowing the engine
+        # BLAS threads, which spin for a while after a call without slowing the engine
+        # (measured in docs/performance.md)
         t0, c0 = time.perf_counter(), time.thread_time()
         sim.run(stop_when={"collisions_per_particle": target}, store=())
         seconds, cpu = time.perf_counter() - t0, time.thread_time() - c0

@@ -160,7 +160,7 @@ def workloads(quick=False, rounds=1):
                     cpu_rates,
                 )
             )
-    # the memory case: N = 1000, t = 1000, dt = 0.01, MSD and 30 TAMSD lags, each
+    # the memory case: N = 1000, t = 1000, dt = 0.01, MSD and 30 TAMSD lags, each
     # TAMSD estimator beside the same run without lags (the "plain" rate it is a share of)
     n, t_stop = (1_000, 1000.0) if not quick else (200, 20.0)
     lags = log_lags(30, t_stop / 2, 0.01)

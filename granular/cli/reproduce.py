@@ -632,7 +632,7 @@ def _tools():
 
 
 def _fig_clustering(cfg, out):
-    """Where homogeneous cooling ends (issue 15): see ``reproduce_clustering``."""
+    """Where homogeneous cooling ends: see ``reproduce_clustering``."""
     from . import reproduce_clustering
 
     # its big box lies beyond L_c on purpose: silence the warning, which needs the runs in
@@ -644,7 +644,7 @@ def _fig_clustering(cfg, out):
 
 
 def _fig_visco(cfg, out):
-    """Viscoelastic gases (issue 15): see ``reproduce_visco``."""
+    """Viscoelastic gases: see ``reproduce_visco``."""
     from . import reproduce_visco
 
     return reproduce_visco._fig_visco(cfg, out, **_tools())

@@ -1,4 +1,4 @@
-"""The reproduction's viscoelastic experiment (issue 15): the thesis' "further work" gas whose
+"""The reproduction's viscoelastic experiment: the thesis' "further work" gas whose
 restitution grows towards 1 as collisions slow down (``granular.Viscoelastic``).
 
 Three parts, each against ``granular.theory``:

@@ -44,8 +44,8 @@ EXTREME = [
     1e300,
     1.7976931348623157e308,
 ]
-# An elastic run may drift by rounding only: ~1e-16 relative per collision (the issue measured
-# <= 2e-15 over 1e7 collisions); these runs have < 1e5 events, so 1e-10 is far above rounding
+# An elastic run may drift by rounding only: ~1e-16 relative per collision (<= 2e-15 over
+# 1e7 collisions measured); these runs have < 1e5 events, so 1e-10 is far above rounding
 # and far below any real loss (a lost or doubled impulse changes E by O(1/N)).
 ENERGY_RTOL = 1e-10
 EVENTS = 20_000  # the event budget that keeps a case's run short
