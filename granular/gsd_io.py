@@ -38,6 +38,8 @@ from typing import Any
 
 import numpy as np
 
+from ._files import check_kind
+
 FORMAT = 1  # the version of the log layout above
 _COUNTERS = (
     "kinetic_energy",
@@ -178,6 +180,7 @@ def write(traj: Any, path: str | os.PathLike) -> None:
 
 
 def _open(path):
+    check_kind(path, "gsd")  # a checkpoint or another .npz: say what reads it
     path = _check_suffix(path)
     if not path.is_file():
         raise FileNotFoundError(f"no GSD file at {str(path)!r}")

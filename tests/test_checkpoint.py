@@ -568,3 +568,143 @@ def test_a_state_that_cannot_continue_is_not_saved(tmp_path):
     with pytest.raises(CheckpointError, match="cannot continue"):
         sim.save(tmp_path / "inf")
     assert not list(tmp_path.iterdir())
+
+
+# -- files get the permissions a plain open() gives ---------------------------------------
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o077])
+def test_files_get_the_permissions_a_plain_open_gives(umask, tmp_path):
+    """Checkpoints and an ensemble's run files (both written by _files.write_atomic) are
+    readable by whom the user's umask lets read a file: 0o666 less the umask for a new
+    file, as open() makes it; a file replaced keeps its own mode, as open() keeps it."""
+    from granular._files import write_atomic
+
+    sim = Simulation(Scene.random(20, 0.02, dim=2, seed=31))
+    old = os.umask(umask)
+    try:
+        with open(tmp_path / "plain", "wb") as f:
+            f.write(b"x")
+        sim.save(tmp_path / "ck.npz")
+        write_atomic(tmp_path / "run.npz", b"data")
+    finally:
+        os.umask(old)
+    want = 0o666 & ~umask
+    assert os.stat(tmp_path / "plain").st_mode & 0o777 == want
+    for name in ("ck.npz", "run.npz"):
+        assert os.stat(tmp_path / name).st_mode & 0o777 == want, name
+    os.chmod(tmp_path / "ck.npz", 0o640)
+    sim.save(tmp_path / "ck.npz")
+    assert os.stat(tmp_path / "ck.npz").st_mode & 0o777 == 0o640
+    assert sorted(os.listdir(tmp_path)) == ["ck.npz", "plain", "run.npz"]
+
+
+# -- another kind of file: say what it is and what reads it ---------------------------------
+
+
+def test_a_gsd_file_given_to_load_and_a_checkpoint_given_to_read_are_named(saved, tmp_path):
+    """Simulation.load of a GSD file says it is one and names granular.read (not NumPy's
+    advice to load with allow_pickle); granular.read of a checkpoint names
+    Simulation.load; a lone .npy names numpy.load."""
+    gsd = tmp_path / "run.gsd"
+    gsd.write_bytes(b"\xdf\x65\xdf\x65\xdf\x65\xdf\x65" + bytes(200))  # GSD's magic number
+    with pytest.raises(CheckpointError, match=r"GSD trajectory file .*granular\.read") as exc:
+        Simulation.load(gsd)
+    assert "pickle" not in str(exc.value)
+    npy = tmp_path / "a.npy"
+    np.save(npy, np.arange(3))
+    with pytest.raises(CheckpointError, match=r"\.npy array \(read it with numpy\.load"):
+        Simulation.load(npy)
+    ck_file = tmp_path / "ck.npz"
+    ck_file.write_bytes(saved)
+    with pytest.raises(ValueError, match=r"not a GSD .*Simulation\.load"):
+        granular.read(ck_file)
+
+
+# -- damaged and crafted archives: CheckpointError, and no more read than the state needs --
+
+
+def _zip_members(data):
+    with zipfile.ZipFile(__import__("io").BytesIO(data)) as zf:
+        return {i.filename: zf.read(i) for i in zf.infolist()}
+
+
+def _zip(members, compress=zipfile.ZIP_STORED):
+    buf = __import__("io").BytesIO()
+    with zipfile.ZipFile(buf, "w", compress) as zf:
+        for name, data in members.items():
+            zf.writestr(name, data)
+    return buf.getvalue()
+
+
+def _npy(array_or_header, data=b""):
+    buf = __import__("io").BytesIO()
+    if isinstance(array_or_header, dict):  # a header alone, then the given data
+        np.lib.format.write_array_header_1_0(buf, array_or_header)
+        buf.write(data)
+    else:
+        np.save(buf, array_or_header)
+    return buf.getvalue()
+
+
+def test_damaged_archives_raise_checkpoint_error_only(saved, tmp_path):
+    """A compression method zipfile does not know (NotImplementedError), an encrypted
+    member (RuntimeError), JSON nested 10^5 deep (RecursionError), a .npy header claiming
+    2^40 elements (MemoryError) and a device that never ends (/dev/zero) are each refused
+    with CheckpointError."""
+    members = _zip_members(saved)
+    path = tmp_path / "bad.npz"
+
+    def refused(data, match=None):
+        path.write_bytes(data)
+        with pytest.raises(CheckpointError, match=match):
+            Simulation.load(path)
+        with pytest.raises(CheckpointError, match=match):
+            ck.loads(data)
+
+    # the method and flag bits in the local and central headers of the first member
+    method = bytearray(saved)
+    for sig, at in ((b"PK\x03\x04", 8), (b"PK\x01\x02", 10)):
+        k = method.find(sig)
+        method[k + at : k + at + 2] = (99).to_bytes(2, "little")
+    refused(bytes(method), "compressed or encrypted")
+    encrypted = bytearray(saved)
+    for sig, at in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):
+        k = encrypted.find(sig)
+        encrypted[k + at] |= 1
+    refused(bytes(encrypted), "compressed or encrypted")
+    refused(_zip(dict(members, **{"meta.npy": _npy(np.array("[" * 100_000))})))
+    for name, dtype, shape in (
+        ("scene_radii.npy", "<f8", (2**40,)),
+        ("scene_positions.npy", "<f8", (2**40, 2)),
+        ("engine_state.npy", "|u1", (2**40,)),
+    ):
+        header = {"descr": dtype, "fortran_order": False, "shape": shape}
+        bad = _zip(dict(members, **{name: _npy(header, bytes(800))}))
+        refused(bad, r"an array of shape|800 bytes of data for an array of \d{13,} bytes")
+    with pytest.raises(CheckpointError, match="not a regular file"):
+        Simulation.load("/dev/zero")
+    refused(_zip(dict(members, extra=b"x")), "a checkpoint holds exactly")
+
+
+def test_an_extra_deflated_member_is_refused_unread(saved, tmp_path):
+    """A checkpoint with one more member of 256 MiB of zeros, deflated to 256 kB: refused
+    before anything of it is inflated (Python's allocations peak far below its size)."""
+    import tracemalloc
+
+    path = tmp_path / "bomb.npz"
+    path.write_bytes(saved)
+    with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
+        with zf.open("extra.npy", "w", force_zip64=True) as member:
+            chunk = bytes(1 << 20)
+            for _ in range(256):
+                member.write(chunk)
+    assert path.stat().st_size < 2 * len(saved) + (1 << 20)
+    tracemalloc.start()
+    try:
+        with pytest.raises(CheckpointError, match="compressed"):
+            Simulation.load(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 16 * len(saved) + (4 << 20), peak
