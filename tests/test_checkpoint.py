@@ -708,3 +708,118 @@ def test_an_extra_deflated_member_is_refused_unread(saved, tmp_path):
     finally:
         tracemalloc.stop()
     assert peak < 16 * len(saved) + (4 << 20), peak
+
+
+# -- a loaded state must be one its scene could reach, and can go on from -----------------
+
+
+def _small(boundary="periodic", restitution=1.0, **kw):
+    """Nine disks on a grid with distinct masses (found by them in the engine state)."""
+    g = (np.arange(3) + 0.5) / 3
+    pos = np.array([[x, y] for x in g for y in g])
+    vel = np.random.default_rng(41).normal(size=pos.shape)
+    masses = np.linspace(0.6, 1.0, 9)
+    return Scene(pos, vel, 0.05, masses, boundary=boundary, restitution=restitution, **kw)
+
+
+def _edit_records(data, scene, change):
+    """The checkpoint with change(P, image) applied to the engine state's particle records
+    (n x stride doubles: x, v, clock, radius) and image counters (n x d int64), which lie
+    either side of the masses; no renumbering below 4096 particles: scene order."""
+
+    def edit(state):
+        at = bytes(state).find(scene.masses.tobytes())
+        assert at > 0 and bytes(state).count(scene.masses.tobytes()) == 1
+        n, d = scene.n, scene.dim
+        p0, i0 = at - 8 * n * (2 * d + 2), at + 8 * n
+        records = np.frombuffer(state[p0:at], np.float64).reshape(n, 2 * d + 2).copy()
+        image = np.frombuffer(state[i0 : i0 + 8 * n * d], np.int64).reshape(n, d).copy()
+        change(records, image)
+        state[p0:at] = records.tobytes()
+        state[i0 : i0 + 8 * n * d] = image.tobytes()
+
+    return _rewrite_state(data, edit)
+
+
+def _set(**columns):
+    """A change of records: {"x0": (particle, value), "v0": ...} (x0 = first coordinate)."""
+
+    def change(records, image):
+        for name, (i, value) in columns.items():
+            records[i, {"x": 0, "v": 2}[name[0]] + int(name[1])] = value
+
+    return change
+
+
+def test_a_state_that_breaks_the_rules_of_a_scene_is_refused(tmp_path):
+    """States crafted past the checksum at t = 0 (so that positions are those at the
+    clocks): two particles at one place, a particle through a wall, a speed of 1e140
+    (within the scale limits in a unit box with masses <= 1, but 1e280 times the initial
+    energy) are refused as a new scene would be; the unaltered file loads."""
+    path = tmp_path / "state.npz"
+    walls = _small("walls")
+    data = ck.dumps(Simulation(walls))
+    ck.loads(data)
+    cases = (
+        (_set(x0=(1, walls.positions[0, 0]), x1=(1, walls.positions[0, 1])), "overlap"),
+        (_set(x0=(0, 1.1)), "crosses a wall"),
+        (_set(v0=(0, 1e140)), "kinetic energy .* exceeds the initial scene's"),
+    )
+    for change, why in cases:
+        path.write_bytes(_edit_records(data, walls, change))
+        with pytest.raises(CheckpointError, match=f"is corrupt: .*{why}"):
+            Simulation.load(path)
+
+
+def test_a_state_its_initial_scene_cannot_reach_is_refused(tmp_path):
+    """The stored initial scene bounds the state: collisions without heated walls never
+    add kinetic energy, elastic ones keep it, and a periodic box keeps the momentum (to a
+    relative 1e-6: rounding drifts them by ~1e-15 in 5e5 collisions)."""
+    path = tmp_path / "state.npz"
+
+    def scaled(factor, shift=0.0):
+        def change(records, image):
+            records[:, 2:4] = records[:, 2:4] * factor + shift
+
+        return change
+
+    for scene, change, why in (
+        (_small(), scaled(0.5), "below the initial scene's .* elastic"),
+        (_small(restitution=0.5), scaled(1.01), "exceeds the initial scene's"),
+        (_small(restitution=0.5), scaled(0.5, 0.1), "momentum differs"),
+        (_small("walls", wall_restitution=0.9), scaled(1.01), "exceeds"),
+    ):
+        data = ck.dumps(Simulation(scene))
+        path.write_bytes(_edit_records(data, scene, change))
+        with pytest.raises(CheckpointError, match=why):
+            Simulation.load(path)
+    heated = _small("walls", wall_restitution=1.5)  # heated walls may add energy
+    data = ck.dumps(Simulation(heated))
+    path.write_bytes(_edit_records(data, heated, scaled(1.01)))
+    Simulation.load(path)
+
+
+def test_an_image_counter_no_crossing_could_make_is_refused(tmp_path):
+    """Each change of an image counter is a cell crossing or a shell exit, so none is
+    larger than their count: INT64_MIN (whose decrement overflowed, and whose unwrapped
+    position flipped sign) or one more than the crossings is refused; as many loads."""
+    scene = _small()
+    sim = Simulation(scene)
+    sim.run(3.0)
+    moves = sim.stats["cell_crossings"] + sim.stats["shell_exits"]
+    assert np.any(sim._engine.state()[2] != 0) and moves > 0
+    data = ck.dumps(sim)
+    path = tmp_path / "image.npz"
+
+    def image(value):
+        def change(records, image):
+            image[4, 1] = value
+
+        return change
+
+    path.write_bytes(_edit_records(data, scene, image(-moves)))
+    assert Simulation.load(path).unwrapped_positions[4, 1] < -moves + 1
+    for value in (-(2**63), 2**63 - 1, moves + 1):
+        path.write_bytes(_edit_records(data, scene, image(value)))
+        with pytest.raises(CheckpointError, match="image counter is larger than the cell"):
+            Simulation.load(path)
