@@ -13,11 +13,15 @@ no code) holding
   queue as it stands, cell and neighbour lists, the renumbering, the time and every
   counter.
 
-Loading builds an engine from the stored scene and knobs (which rebuilds what follows
-from them: cell sizes, neighbour tables) and restores the saved state into it; the
-C core checks every size, index and link it reads.  A file from another format version,
-granular version or engine layout is refused, as is a truncated or corrupt one, with a
-``CheckpointError`` saying which.
+Reading takes only what the state needs: exactly these members, stored (np.savez does not
+compress), each of the shape and size the scene's N and d give it, so that nothing is
+inflated or allocated beyond the file's own size.  Loading builds an engine from the stored
+scene and knobs (which rebuilds what follows from them: cell sizes, neighbour tables) and
+restores the saved state into it; the C core checks every size, index, link and counter it
+reads.  The state must then be one the run can be in (``_fault``): a valid Scene as it is
+now, and its energy and momentum those its initial scene allows.  A file from another format
+version, granular version or engine layout is refused, as is a truncated, corrupt or
+crafted one, with a ``CheckpointError`` saying which.
 """
 
 from __future__ import annotations
