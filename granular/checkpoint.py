@@ -357,7 +357,7 @@ def _build(meta: dict[str, Any], arrays: dict[str, np.ndarray], where: str) -> S
         )
         sim = Simulation(scene, **knobs)
         sim._engine.restore_state(state)
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise CheckpointError(f"{where} is corrupt: {exc}") from exc
     fault = _fault(sim)
     if fault:

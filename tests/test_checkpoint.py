@@ -823,3 +823,22 @@ def test_an_image_counter_no_crossing_could_make_is_refused(tmp_path):
         path.write_bytes(_edit_records(data, scene, image(value)))
         with pytest.raises(CheckpointError, match="image counter is larger than the cell"):
             Simulation.load(path)
+
+
+def test_a_stored_scene_that_is_no_scene_is_refused(saved, tmp_path):
+    """The stored initial scene is checked as Scene(...) checks one, and what that raises
+    (ValueError; OverflowError for a number of 400 digits in the JSON) comes out as
+    CheckpointError."""
+    members = _zip_members(saved)
+    path = tmp_path / "scene.npz"
+    meta, _ = ck._read_npz(saved, "x")
+    for name in ("contact_duration", "restitution"):
+        path.write_bytes(_rewrite_meta(saved, scene=dict(meta["scene"], **{name: 10**400})))
+        with pytest.raises(CheckpointError, match="is corrupt"):
+            Simulation.load(path)
+    for name, value in (("positions", np.nan), ("radii", -1.0), ("masses", np.inf)):
+        arr = np.load(__import__("io").BytesIO(members[f"scene_{name}.npy"])).copy()
+        arr.flat[0] = value
+        path.write_bytes(_zip(dict(members, **{f"scene_{name}.npy": _npy(arr)})))
+        with pytest.raises(CheckpointError, match="is corrupt"):
+            Simulation.load(path)
