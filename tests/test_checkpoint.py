@@ -1,6 +1,9 @@
 """Checkpoints: Simulation.save / Simulation.load and pickling continue a run bit for bit,
-in every engine mode; bad files are refused with CheckpointError; corrupted engine states
-never crash the C core (tests/helpers/checkpoint_fuzz.py, in a subprocess).
+in every engine mode; files get the permissions open() gives; bad files (damaged archives,
+other kinds of file, states crafted past the checksum that break a scene's rules or its
+initial scene's conservation laws) are refused with CheckpointError, reading no more than
+the state needs; corrupted engine states never crash the C core
+(tests/helpers/checkpoint_fuzz.py, in a subprocess).
 
 "Bit for bit" is tested as exact equality (np.array_equal, ==) of positions, velocities,
 every statistic and every Trajectory array between a Simulation that ran on and one that
