@@ -803,9 +803,10 @@ def test_a_state_its_initial_scene_cannot_reach_is_refused(tmp_path):
 
 
 def test_an_image_counter_no_crossing_could_make_is_refused(tmp_path):
-    """Each change of an image counter is a cell crossing or a shell exit, so none is
-    larger than their count: INT64_MIN (whose decrement overflowed, and whose unwrapped
-    position flipped sign) or one more than the crossings is refused; as many loads."""
+    """Each change of an image counter is a cell crossing or a shell exit through a periodic
+    box's face, so none is larger than their count: INT64_MIN (whose decrement overflowed,
+    and whose unwrapped position flipped sign) or one more than the crossings is refused; as
+    many loads.  Between walls every counter is 0."""
     scene = _small()
     sim = Simulation(scene)
     sim.run(3.0)
@@ -826,6 +827,14 @@ def test_an_image_counter_no_crossing_could_make_is_refused(tmp_path):
         path.write_bytes(_edit_records(data, scene, image(value)))
         with pytest.raises(CheckpointError, match="image counter is larger than the cell"):
             Simulation.load(path)
+    # between walls nothing wraps: every counter is 0, however many cells were crossed
+    walls = _small("walls")
+    sim = Simulation(walls)
+    sim.run(3.0)
+    assert sim.stats["cell_crossings"] > 0
+    path.write_bytes(_edit_records(ck.dumps(sim), walls, image(1)))
+    with pytest.raises(CheckpointError, match="image counter is larger than the cell"):
+        Simulation.load(path)
 
 
 def test_a_stored_scene_that_is_no_scene_is_refused(saved, tmp_path):

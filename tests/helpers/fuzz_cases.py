@@ -518,8 +518,9 @@ TABLE_MUTATIONS = [
 
 
 def _checkpoint_params(rng):
-    """A small gas run for up to 400 events, to be saved and loaded."""
-    return dict(scene=_random_params(rng, max_n=20), events=int(rng.integers(0, 400)), edits=[])
+    """A small gas (a valid scene of _scene_params) run for up to 400 events, to be saved and
+    loaded."""
+    return dict(scene=_scene_params(rng), events=int(rng.integers(0, 400)), edits=[])
 
 
 def _edit(make):
@@ -815,7 +816,7 @@ def _run_checkpoint(p, mutated):
 
     from helpers.checkpoint_fuzz import apply_edits
 
-    scene = Scene.random(**p["scene"])
+    scene = Scene(**p["scene"])
     sim = Simulation(scene)
     if p["events"]:
         sim.run(stop_when={"events": p["events"]})
