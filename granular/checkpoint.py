@@ -206,7 +206,7 @@ def _member_array(zf, info, dtype, shape, max_bytes, check_head=None):
     nbytes)``, if given, checks the data's first 64 bytes before the rest is read."""
     with zf.open(info) as fp:
         got_shape, got = _npy_header(fp, info.filename)
-        if (got.kind != "U" or got.byteorder == ">") if dtype == "U" else got != dtype:
+        if (got.kind != "U" or not got.isnative) if dtype == "U" else got != dtype:
             raise ValueError(f"{info.filename}: an array of {got}, not of {dtype}")
         if shape is None and len(got_shape) == 1:
             shape = got_shape
@@ -288,7 +288,7 @@ def _read_members(zf, f, where):
     if len(n_d) != 2 or n_d[1] not in (2, 3) or n_d[0] < 1:
         raise ValueError(f"its scene positions have shape {n_d}, not (N, 2) or (N, 3)")
     n, d = n_d
-    f8 = np.dtype("<f8")
+    f8 = np.dtype(np.float64)  # native, as np.savez wrote the Scene's arrays
     shapes = {
         "positions": (n, d),
         "velocities": (n, d),
@@ -307,7 +307,7 @@ def _read_members(zf, f, where):
         # the total size (uint64), n (int64) and dim (int32)
         if len(head) < 44:
             raise ValueError("its engine state is truncated")
-        total, n_state, d_state = struct.unpack_from("<Qqi", head, 24)
+        total, n_state, d_state = struct.unpack_from("=Qqi", head, 24)
         if (total, n_state, d_state) != (nbytes, n, d):
             raise ValueError(
                 f"its engine state's header says {total} bytes, N = {n_state}, d = "
