@@ -1,7 +1,7 @@
 """Checkpoints: a Simulation's whole state in a file, continued bit for bit after loading.
 
-A checkpoint is a NumPy ``.npz`` file (read with ``allow_pickle=False``: loading one runs
-no code) holding
+A checkpoint is a NumPy ``.npz`` file (read without pickle: only arrays of numbers and one
+string are accepted, so loading one runs no code) holding
 
 - ``meta``: JSON with the format name and version, the granular version, the engine's
   state layout (``_core.CHECKPOINT_LAYOUT``), the engine knobs (``cell_factor``,
