@@ -383,6 +383,17 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
             return "a particle's collision counter (count or pcount) is negative or past "
                    "INT64_MAX / 2";
 
+    /* image counters: each change of one is a cell crossing or a shell exit through a
+     * periodic box's face (edmd.c), so none exceeds their count in size, and between walls
+     * all are 0.  Bounded so, a counter cannot overflow in a run before those two
+     * counters pass INT64_MAX / 2 more (the bound above), and the unwrapped positions
+     * (pos + image L) stay those the run made. */
+    const int64_t moves = b->periodic ? t->crossings + t->shell_exits : 0; /* <= INT64_MAX */
+    for (size_t k = 0; k < (size_t)n * d; k++)
+        if (t->image[k] < -moves || t->image[k] > moves)
+            return "a particle's image counter is larger than the cell crossings and shell "
+                   "exits that could have made it";
+
     /* the renumbering is a permutation; through it each particle has the radius, mass
      * and bigness the scene gives it (skel: the scene's index -> s's internal index) */
     for (int32_t i = 0; i < n; i++) {

@@ -1,7 +1,7 @@
 """Checkpoints: a Simulation's whole state in a file, continued bit for bit after loading.
 
-A checkpoint is a NumPy ``.npz`` file (read with ``allow_pickle=False``: loading one runs
-no code) holding
+A checkpoint is a NumPy ``.npz`` file (read without pickle: only arrays of numbers and one
+string are accepted, so loading one runs no code) holding
 
 - ``meta``: JSON with the format name and version, the granular version, the engine's
   state layout (``_core.CHECKPOINT_LAYOUT``), the engine knobs (``cell_factor``,
@@ -13,11 +13,15 @@ no code) holding
   queue as it stands, cell and neighbour lists, the renumbering, the time and every
   counter.
 
-Loading builds an engine from the stored scene and knobs (which rebuilds what follows
-from them: cell sizes, neighbour tables) and restores the saved state into it; the
-C core checks every size, index and link it reads.  A file from another format version,
-granular version or engine layout is refused, as is a truncated or corrupt one, with a
-``CheckpointError`` saying which.
+Reading takes only what the state needs: exactly these members, stored (np.savez does not
+compress), each of the shape and size the scene's N and d give it, so that nothing is
+inflated or allocated beyond the file's own size.  Loading builds an engine from the stored
+scene and knobs (which rebuilds what follows from them: cell sizes, neighbour tables) and
+restores the saved state into it; the C core checks every size, index, link and counter it
+reads.  The state must then be one the run can be in (``_fault``): a valid Scene as it is
+now, and its energy and momentum those its initial scene allows.  A file from another format
+version, granular version or engine layout is refused, as is a truncated, corrupt or
+crafted one, with a ``CheckpointError`` saying which.
 """
 
 from __future__ import annotations
@@ -25,16 +29,19 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import math
 import os
-import tempfile
+import stat
+import struct
 import zipfile
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from . import _core
-from .errors import CheckpointError
-from .restitution import describe, from_description
+from ._files import WHAT_READS, kind_of, write_atomic
+from .errors import CheckpointError, GranularError
+from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
 from .scene import Scene
 
 if TYPE_CHECKING:
@@ -50,8 +57,13 @@ _SCENE_ARRAYS = ("positions", "velocities", "radii", "masses", "lower", "upper")
 _SCENE_PARAMS = ("boundary", "wall_restitution", "restitution", "contact_duration")
 
 
-# The largest speed the C restore accepts (csrc/checkpoint.c; granular/scene.py's limit).
-_MAX_SPEED = 1e140
+# Collisions without heated walls never add kinetic energy, elastic ones keep it, and
+# pair collisions keep the momentum -- up to rounding: about 1e-16 of the energy
+# (momentum) per collision, of either sign, which drifted them by 2e-15 (1e-16 of the
+# largest momentum) in 5e5 collisions of 500 particles.  At that rate 1e-6 is out of
+# reach (even 1e10 collisions all rounding one way would only just reach it).  A state
+# off by more than this relative tolerance is not one its initial scene could reach.
+_CONSERVED_RTOL = 1e-6
 
 
 def _version() -> str:
@@ -60,13 +72,51 @@ def _version() -> str:
     return __version__
 
 
+def _fault(sim: Simulation) -> str | None:
+    """What makes ``sim``'s current state one its run cannot have reached or cannot go on
+    from, or None: its positions and velocities must make a valid Scene (the scale limits,
+    inside the walls, no overlaps: the checks of a new scene, scene.py and
+    csrc/validate.c), and its energy and momentum must be those its initial scene allows."""
+    try:
+        now = sim.scene
+    except (GranularError, ValueError) as exc:
+        return f"its particles now are not a valid scene ({exc})"
+    start = sim._initial
+    e0, e = start.kinetic_energy, now.kinetic_energy
+    periodic = start.boundary == "periodic"
+    if periodic or not heats(start.wall_restitution):
+        if e > e0 * (1.0 + _CONSERVED_RTOL):
+            return (
+                f"its kinetic energy {e:.6g} exceeds the initial scene's {e0:.6g}, which "
+                "collisions without heated walls cannot do"
+            )
+        elastic = not loses_energy(start.restitution) and (
+            periodic or not loses_energy(start.wall_restitution)
+        )
+        if elastic and e < e0 * (1.0 - _CONSERVED_RTOL):
+            return (
+                f"its kinetic energy {e:.6g} is below the initial scene's {e0:.6g}, which "
+                "elastic collisions keep"
+            )
+    if periodic:
+        p0, p = (np.sum(x.masses[:, None] * x.velocities, axis=0) for x in (start, now))
+        scale = math.sqrt(2.0 * e0 * float(np.sum(start.masses)))  # |P| <= this
+        drift = float(np.max(np.abs(p - p0)))
+        if not drift <= _CONSERVED_RTOL * scale:
+            return (
+                f"its momentum differs from the initial scene's by {drift:.6g} (of a largest "
+                f"possible {scale:.6g}), which collisions in a periodic box keep"
+            )
+    return None
+
+
 def dumps(sim: Simulation) -> bytes:
     """The checkpoint of ``sim`` as the bytes of an ``.npz`` file (see ``Simulation.save``)."""
-    _, vel, _ = sim._engine.state()
-    if not np.all(np.abs(vel) <= _MAX_SPEED):
+    fault = _fault(sim)
+    if fault:
         raise CheckpointError(
-            "this Simulation's velocities are not finite or beyond 1e140 (as a NonFiniteError "
-            "or HeatedWallsError leaves them): the state cannot continue, so it is not saved"
+            f"this Simulation's state cannot continue, so it is not saved: {fault} (as a "
+            "NonFiniteError or HeatedWallsError leaves it)"
         )
     state = np.frombuffer(sim._engine.save_state(), dtype=np.uint8)
     scene = sim._initial
@@ -86,69 +136,190 @@ def dumps(sim: Simulation) -> bytes:
 
 
 def save(sim: Simulation, path: str | os.PathLike) -> None:
-    """Write ``sim``'s checkpoint to ``path`` atomically (``write_atomic``): an older
+    """Write ``sim``'s checkpoint to ``path`` atomically (``_files.write_atomic``): an older
     checkpoint at ``path`` survives until the new one is complete."""
     write_atomic(path, dumps(sim), suffix=".npz")
 
 
-def write_atomic(path: str | os.PathLike, data: bytes, suffix: str = ".part") -> None:
-    """Write ``data`` to ``path`` so that a crash mid-way never leaves a half file: into a
-    temporary file (``.tmp-*``) in the same directory, flushed to disk, then renamed over
-    ``path`` (a rename within a file system is atomic)."""
-    path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=suffix, dir=folder)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def load(path: str | os.PathLike) -> Simulation:
     """The Simulation saved in ``path`` (see ``Simulation.load``)."""
+    where = repr(os.fspath(path))
     try:
-        with open(path, "rb") as f:
-            data = f.read()
+        f = open(path, "rb")  # closed by the with below, after the checks on it
     except OSError as exc:
-        raise CheckpointError(f"cannot read the checkpoint {os.fspath(path)!r}: {exc}") from exc
-    return loads(data, where=repr(os.fspath(path)))
+        raise CheckpointError(f"cannot read the checkpoint {where}: {exc}") from exc
+    with f:
+        try:
+            regular = stat.S_ISREG(os.fstat(f.fileno()).st_mode)
+        except OSError as exc:
+            raise CheckpointError(f"cannot read the checkpoint {where}: {exc}") from exc
+        if not regular:  # a device (/dev/zero), a pipe: no size to check, no end
+            raise CheckpointError(
+                f"{where} is not a regular file (a device, a pipe or a socket): a checkpoint "
+                "is a file written by Simulation.save"
+            )
+        meta, arrays = _read_npz(f, where)
+    return _build(meta, arrays, where)
 
 
-def _read_npz(data: bytes, where: str) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+# The members of a checkpoint's zip archive, each an .npy array.
+_MEMBERS = ("meta", "engine_state", *(f"scene_{name}" for name in _SCENE_ARRAYS))
+# The meta JSON, stored as a NumPy unicode string (4 bytes a character): at most two
+# restitution tables of TABLE_MAX points, each number at most 24 characters and a
+# separator, and a few kB besides.
+_META_MAX_BYTES = 4 * (2 * 2 * TABLE_MAX * 26 + (1 << 16))
+# What a damaged or crafted archive makes NumPy's and zipfile's readers raise.
+_READ_ERRORS = (
+    OSError,
+    ValueError,
+    EOFError,
+    KeyError,
+    TypeError,
+    IndexError,
+    OverflowError,
+    NotImplementedError,  # an unknown compression method
+    RuntimeError,  # an encrypted member; RecursionError (deeply nested JSON) is one too
+    struct.error,
+    zipfile.BadZipFile,
+)
+
+
+def _npy_header(fp, name):
+    """(shape, dtype) from the .npy header at the start of ``fp``."""
+    version = np.lib.format.read_magic(fp)
+    if version == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(fp)
+    elif version in ((2, 0), (3, 0)):
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(fp)
+    else:
+        raise ValueError(f"{name}: unknown .npy version {version}")
+    if fortran or dtype.hasobject:
+        raise ValueError(f"{name}: not a C-ordered array of numbers")
+    return shape, dtype
+
+
+def _member_array(zf, info, dtype, shape, max_bytes, check_head=None):
+    """The .npy member ``info`` of ``zf``, refused unless it holds an array of ``dtype``
+    ("U": a unicode string of any length) and ``shape`` (None: one-dimensional), its data
+    fills the rest of the member exactly, and that is at most ``max_bytes``.  Nothing
+    beyond the header is read before its size is known to be right; ``check_head(head,
+    nbytes)``, if given, checks the data's first 64 bytes before the rest is read."""
+    with zf.open(info) as fp:
+        got_shape, got = _npy_header(fp, info.filename)
+        if (got.kind != "U" or not got.isnative) if dtype == "U" else got != dtype:
+            raise ValueError(f"{info.filename}: an array of {got}, not of {dtype}")
+        if shape is None and len(got_shape) == 1:
+            shape = got_shape
+        if got_shape != shape:
+            raise ValueError(f"{info.filename}: an array of shape {got_shape}, not {shape}")
+        nbytes = got.itemsize * math.prod(shape)
+        left = info.file_size - fp.tell()
+        if nbytes > max_bytes or left != nbytes:
+            raise ValueError(
+                f"{info.filename}: {left} bytes of data for an array of {nbytes} bytes "
+                f"(at most {max_bytes})"
+            )
+        data = fp.read(min(nbytes, 64))
+        if check_head is not None:
+            check_head(data, nbytes)
+        data += fp.read(nbytes - len(data))
+        if len(data) != nbytes:
+            raise EOFError(f"{info.filename} is truncated")
+        fp.read(1)  # at the member's end: zipfile checks its CRC-32 on the way
+    return np.frombuffer(data, dtype=got).reshape(shape)
+
+
+def _read_npz(f, where: str) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+    """(meta, arrays) from the checkpoint in the binary file ``f`` (or bytes); what is
+    read is bounded by the file's size and the sizes the state's arrays must have."""
+    if isinstance(f, (bytes, bytearray, memoryview)):
+        f = io.BytesIO(f)
+    head = f.read(8)
+    f.seek(0)
+    kind = kind_of(head)
+    if kind != "npz":
+        what = WHAT_READS[kind] if kind else "neither a zip archive nor a GSD file"
+        raise CheckpointError(
+            f"{where} is not a granular checkpoint: it is {what}.  Simulation.load reads "
+            "the checkpoints Simulation.save writes"
+        )
     try:
-        with np.load(io.BytesIO(data), allow_pickle=False) as npz:
-            arrays = {name: npz[name] for name in npz.files}
-        meta = json.loads(str(arrays.pop("meta")[()]))
-    except (
-        OSError,
-        ValueError,
-        EOFError,
-        KeyError,
-        TypeError,
-        IndexError,
-        zipfile.BadZipFile,
-        json.JSONDecodeError,
-    ) as exc:
+        with zipfile.ZipFile(f) as zf:
+            return _read_members(zf, f, where)
+    except CheckpointError:
+        raise
+    except _READ_ERRORS as exc:
         raise CheckpointError(
             f"{where} is not a granular checkpoint, or it is truncated or corrupt "
             f"({exc.__class__.__name__}: {exc})"
         ) from exc
+
+
+def _read_members(zf, f, where):
+    size = f.seek(0, os.SEEK_END)
+    infos = zf.infolist()
+    names = {info.filename: info for info in infos}
+    if len(names) != len(infos):
+        raise ValueError("a member is named twice")
+    for info in infos:
+        # np.savez stores its members: a compressed one could decompress to any size
+        if info.compress_type != zipfile.ZIP_STORED or info.flag_bits & 0x1:
+            raise ValueError(
+                f"its member {info.filename!r} is compressed or encrypted, which "
+                "Simulation.save never writes"
+            )
+        if info.compress_size != info.file_size or info.header_offset + info.file_size > size:
+            raise ValueError(f"its member {info.filename!r} claims more bytes than the file has")
+    if "meta.npy" not in names:
+        raise CheckpointError(f"{where} is not a granular checkpoint (no {FORMAT!r} header)")
+    meta = json.loads(str(_member_array(zf, names["meta.npy"], "U", (), _META_MAX_BYTES)[()]))
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise CheckpointError(f"{where} is not a granular checkpoint (no {FORMAT!r} header)")
+    _check_version(meta, where)
+    want = {f"{name}.npy" for name in _MEMBERS}
+    if set(names) != want:
+        raise ValueError(
+            f"its members are {sorted(names)}; a checkpoint holds exactly {sorted(want)}"
+        )
+    # the sizes of the scene's arrays follow from its positions' (N, d); the engine
+    # state's size from its own header, which must agree with them
+    with zf.open(names["scene_positions.npy"]) as fp:
+        n_d, _ = _npy_header(fp, "scene_positions.npy")
+    if len(n_d) != 2 or n_d[1] not in (2, 3) or n_d[0] < 1:
+        raise ValueError(f"its scene positions have shape {n_d}, not (N, 2) or (N, 3)")
+    n, d = n_d
+    f8 = np.dtype(np.float64)  # native, as np.savez wrote the Scene's arrays
+    shapes = {
+        "positions": (n, d),
+        "velocities": (n, d),
+        "radii": (n,),
+        "masses": (n,),
+        "lower": (d,),
+        "upper": (d,),
+    }
+    arrays = {
+        f"scene_{name}": _member_array(zf, names[f"scene_{name}.npy"], f8, shape, size)
+        for name, shape in shapes.items()
+    }
+
+    def check_head(head, nbytes):
+        # csrc/checkpoint.c's header: magic 8, version 4, byte order 4, layout 8, then
+        # the total size (uint64), n (int64) and dim (int32)
+        if len(head) < 44:
+            raise ValueError("its engine state is truncated")
+        total, n_state, d_state = struct.unpack_from("=Qqi", head, 24)
+        if (total, n_state, d_state) != (nbytes, n, d):
+            raise ValueError(
+                f"its engine state's header says {total} bytes, N = {n_state}, d = "
+                f"{d_state}; the state has {nbytes} bytes and the scene N = {n}, d = {d}"
+            )
+
+    state = names["engine_state.npy"]
+    arrays["engine_state"] = _member_array(zf, state, np.dtype("u1"), None, size, check_head)
     return meta, arrays
 
 
-def loads(data: bytes, where: str = "the checkpoint") -> Simulation:
-    """The Simulation in checkpoint bytes made by ``dumps`` (also what unpickling calls)."""
-    from .simulation import Simulation
-
-    meta, arrays = _read_npz(bytes(data), where)
+def _check_version(meta: dict, where: str) -> None:
     mine = (FORMAT_VERSION, _version(), str(_core.CHECKPOINT_LAYOUT))
     theirs = (meta.get("format_version"), meta.get("granular_version"), meta.get("layout"))
     if theirs != mine:
@@ -158,10 +329,20 @@ def loads(data: bytes, where: str = "the checkpoint") -> Simulation:
             f"layout {mine[2]}).  A run continues bit for bit only in the version that saved "
             "it: load it there, or start afresh here from its scene (Simulation(old.scene))"
         )
+
+
+def loads(data: bytes, where: str = "the checkpoint") -> Simulation:
+    """The Simulation in checkpoint bytes made by ``dumps`` (also what unpickling calls)."""
+    meta, arrays = _read_npz(bytes(data), where)
+    return _build(meta, arrays, where)
+
+
+def _build(meta: dict[str, Any], arrays: dict[str, np.ndarray], where: str) -> Simulation:
+    """The Simulation of a checkpoint's parts, read and checked for their sizes."""
+    from .simulation import Simulation
+
     try:
         state = arrays["engine_state"]
-        if state.dtype != np.uint8 or state.ndim != 1:
-            raise ValueError("engine_state is not a byte array")
         if hashlib.sha256(state).hexdigest() != meta["engine_state_sha256"]:
             raise ValueError("the engine state does not match its checksum")
         fields = {name: arrays[f"scene_{name}"] for name in _SCENE_ARRAYS}
@@ -177,6 +358,9 @@ def loads(data: bytes, where: str = "the checkpoint") -> Simulation:
         )
         sim = Simulation(scene, **knobs)
         sim._engine.restore_state(state)
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise CheckpointError(f"{where} is corrupt: {exc}") from exc
+    fault = _fault(sim)
+    if fault:
+        raise CheckpointError(f"{where} is corrupt: {fault}")
     return sim

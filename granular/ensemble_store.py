@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .checkpoint import write_atomic
+from ._files import write_atomic
 from .errors import CheckpointError
 
 FINGERPRINT = "ensemble.json"

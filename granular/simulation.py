@@ -97,8 +97,9 @@ class Simulation:
         lists, the renumbering, the time and the statistics so far, the scene the
         Simulation was built from and the knobs (``cell_factor``, ``big_ratio``,
         ``shell``).  The file is written to a temporary name and renamed, so a crash
-        never leaves a half-written checkpoint: about 270 (2D) to 370 (3D, neighbour
-        lists) bytes per particle.
+        never leaves a half-written checkpoint, with the permissions ``open()`` would
+        give it (0o666 less the umask): about 270 (2D) to 370 (3D, neighbour lists)
+        bytes per particle.
 
         Parameters
         ----------
@@ -111,7 +112,8 @@ class Simulation:
             If another thread is running this Simulation.
         CheckpointError
             If the state cannot continue (non-finite or overflowing velocities, as a
-            ``NonFiniteError`` leaves them): nothing is written.
+            ``NonFiniteError`` leaves them, or anything else ``load`` would refuse):
+            nothing is written.
         """
         from . import checkpoint
 
@@ -126,6 +128,7 @@ class Simulation:
         Parameters
         ----------
         path : str or os.PathLike
+            A file written by ``save`` (a regular file: not a device or a pipe).
 
         Returns
         -------
@@ -134,9 +137,11 @@ class Simulation:
         Raises
         ------
         CheckpointError
-            If the file is not a checkpoint, is truncated or corrupt, or was written by
-            another granular version or engine layout (a run continues bit for bit only
-            in the version that saved it).
+            If the file is not a checkpoint (a GSD file is named as one: read it with
+            ``granular.read``), is truncated, corrupt or crafted (every part is checked,
+            the state also as a Scene and against its initial scene's energy and
+            momentum), or was written by another granular version or engine layout (a
+            run continues bit for bit only in the version that saved it).
         """
         from . import checkpoint
 

@@ -1,6 +1,9 @@
 """Checkpoints: Simulation.save / Simulation.load and pickling continue a run bit for bit,
-in every engine mode; bad files are refused with CheckpointError; corrupted engine states
-never crash the C core (tests/helpers/checkpoint_fuzz.py, in a subprocess).
+in every engine mode; files get the permissions open() gives; bad files (damaged archives,
+other kinds of file, states crafted past the checksum that break a scene's rules or its
+initial scene's conservation laws) are refused with CheckpointError, reading no more than
+the state needs; corrupted engine states never crash the C core
+(tests/helpers/checkpoint_fuzz.py, in a subprocess).
 
 "Bit for bit" is tested as exact equality (np.array_equal, ==) of positions, velocities,
 every statistic and every Trajectory array between a Simulation that ran on and one that
@@ -568,3 +571,286 @@ def test_a_state_that_cannot_continue_is_not_saved(tmp_path):
     with pytest.raises(CheckpointError, match="cannot continue"):
         sim.save(tmp_path / "inf")
     assert not list(tmp_path.iterdir())
+
+
+# -- files get the permissions a plain open() gives ---------------------------------------
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o077])
+def test_files_get_the_permissions_a_plain_open_gives(umask, tmp_path):
+    """Checkpoints and an ensemble's run files (both written by _files.write_atomic) are
+    readable by whom the user's umask lets read a file: 0o666 less the umask for a new
+    file, as open() makes it; a file replaced keeps its own mode, as open() keeps it."""
+    from granular._files import write_atomic
+
+    sim = Simulation(Scene.random(20, 0.02, dim=2, seed=31))
+    old = os.umask(umask)
+    try:
+        with open(tmp_path / "plain", "wb") as f:
+            f.write(b"x")
+        sim.save(tmp_path / "ck.npz")
+        write_atomic(tmp_path / "run.npz", b"data")
+    finally:
+        os.umask(old)
+    want = 0o666 & ~umask
+    assert os.stat(tmp_path / "plain").st_mode & 0o777 == want
+    for name in ("ck.npz", "run.npz"):
+        assert os.stat(tmp_path / name).st_mode & 0o777 == want, name
+    os.chmod(tmp_path / "ck.npz", 0o640)
+    sim.save(tmp_path / "ck.npz")
+    assert os.stat(tmp_path / "ck.npz").st_mode & 0o777 == 0o640
+    assert sorted(os.listdir(tmp_path)) == ["ck.npz", "plain", "run.npz"]
+
+
+# -- another kind of file: say what it is and what reads it ---------------------------------
+
+
+def test_a_gsd_file_given_to_load_and_a_checkpoint_given_to_read_are_named(saved, tmp_path):
+    """Simulation.load of a GSD file says it is one and names granular.read (not NumPy's
+    advice to load with allow_pickle); granular.read of a checkpoint names
+    Simulation.load; a lone .npy names numpy.load."""
+    gsd = tmp_path / "run.gsd"
+    gsd.write_bytes(b"\xdf\x65\xdf\x65\xdf\x65\xdf\x65" + bytes(200))  # GSD's magic number
+    with pytest.raises(CheckpointError, match=r"GSD trajectory file .*granular\.read") as exc:
+        Simulation.load(gsd)
+    assert "pickle" not in str(exc.value)
+    npy = tmp_path / "a.npy"
+    np.save(npy, np.arange(3))
+    with pytest.raises(CheckpointError, match=r"\.npy array \(read it with numpy\.load"):
+        Simulation.load(npy)
+    ck_file = tmp_path / "ck.npz"
+    ck_file.write_bytes(saved)
+    with pytest.raises(ValueError, match=r"not a GSD .*Simulation\.load"):
+        granular.read(ck_file)
+
+
+# -- damaged and crafted archives: CheckpointError, and no more read than the state needs --
+
+
+def _zip_members(data):
+    with zipfile.ZipFile(__import__("io").BytesIO(data)) as zf:
+        return {i.filename: zf.read(i) for i in zf.infolist()}
+
+
+def _zip(members, compress=zipfile.ZIP_STORED):
+    buf = __import__("io").BytesIO()
+    with zipfile.ZipFile(buf, "w", compress) as zf:
+        for name, data in members.items():
+            zf.writestr(name, data)
+    return buf.getvalue()
+
+
+def _npy(array_or_header, data=b""):
+    buf = __import__("io").BytesIO()
+    if isinstance(array_or_header, dict):  # a header alone, then the given data
+        np.lib.format.write_array_header_1_0(buf, array_or_header)
+        buf.write(data)
+    else:
+        np.save(buf, array_or_header)
+    return buf.getvalue()
+
+
+def test_damaged_archives_raise_checkpoint_error_only(saved, tmp_path):
+    """A compression method zipfile does not know (NotImplementedError), an encrypted
+    member (RuntimeError), JSON nested 10^5 deep (RecursionError), a .npy header claiming
+    2^40 elements (MemoryError) and a device that never ends (/dev/zero) are each refused
+    with CheckpointError."""
+    members = _zip_members(saved)
+    path = tmp_path / "bad.npz"
+
+    def refused(data, match=None):
+        path.write_bytes(data)
+        with pytest.raises(CheckpointError, match=match):
+            Simulation.load(path)
+        with pytest.raises(CheckpointError, match=match):
+            ck.loads(data)
+
+    # the method and flag bits in the local and central headers of the first member
+    method = bytearray(saved)
+    for sig, at in ((b"PK\x03\x04", 8), (b"PK\x01\x02", 10)):
+        k = method.find(sig)
+        method[k + at : k + at + 2] = (99).to_bytes(2, "little")
+    refused(bytes(method), "compressed or encrypted")
+    encrypted = bytearray(saved)
+    for sig, at in ((b"PK\x03\x04", 6), (b"PK\x01\x02", 8)):
+        k = encrypted.find(sig)
+        encrypted[k + at] |= 1
+    refused(bytes(encrypted), "compressed or encrypted")
+    refused(_zip(dict(members, **{"meta.npy": _npy(np.array("[" * 100_000))})))
+    for name, dtype, shape in (
+        ("scene_radii.npy", "<f8", (2**40,)),
+        ("scene_positions.npy", "<f8", (2**40, 2)),
+        ("engine_state.npy", "|u1", (2**40,)),
+    ):
+        header = {"descr": dtype, "fortran_order": False, "shape": shape}
+        bad = _zip(dict(members, **{name: _npy(header, bytes(800))}))
+        refused(bad, r"an array of shape|800 bytes of data for an array of \d{13,} bytes")
+    with pytest.raises(CheckpointError, match="not a regular file"):
+        Simulation.load("/dev/zero")
+    refused(_zip(dict(members, extra=b"x")), "a checkpoint holds exactly")
+
+
+def test_an_extra_deflated_member_is_refused_unread(saved, tmp_path):
+    """A checkpoint with one more member of 256 MiB of zeros, deflated to 256 kB: refused
+    before anything of it is inflated (Python's allocations peak far below its size)."""
+    import tracemalloc
+
+    path = tmp_path / "bomb.npz"
+    path.write_bytes(saved)
+    with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as zf:
+        with zf.open("extra.npy", "w", force_zip64=True) as member:
+            chunk = bytes(1 << 20)
+            for _ in range(256):
+                member.write(chunk)
+    assert path.stat().st_size < 2 * len(saved) + (1 << 20)
+    tracemalloc.start()
+    try:
+        with pytest.raises(CheckpointError, match="compressed"):
+            Simulation.load(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 16 * len(saved) + (4 << 20), peak
+
+
+# -- a loaded state must be one its scene could reach, and can go on from -----------------
+
+
+def _small(boundary="periodic", restitution=1.0, **kw):
+    """Nine disks on a grid with distinct masses (found by them in the engine state)."""
+    g = (np.arange(3) + 0.5) / 3
+    pos = np.array([[x, y] for x in g for y in g])
+    vel = np.random.default_rng(41).normal(size=pos.shape)
+    masses = np.linspace(0.6, 1.0, 9)
+    return Scene(pos, vel, 0.05, masses, boundary=boundary, restitution=restitution, **kw)
+
+
+def _edit_records(data, scene, change):
+    """The checkpoint with change(P, image) applied to the engine state's particle records
+    (n x stride doubles: x, v, clock, radius) and image counters (n x d int64), which lie
+    either side of the masses; no renumbering below 4096 particles: scene order."""
+
+    def edit(state):
+        at = bytes(state).find(scene.masses.tobytes())
+        assert at > 0 and bytes(state).count(scene.masses.tobytes()) == 1
+        n, d = scene.n, scene.dim
+        p0, i0 = at - 8 * n * (2 * d + 2), at + 8 * n
+        records = np.frombuffer(state[p0:at], np.float64).reshape(n, 2 * d + 2).copy()
+        image = np.frombuffer(state[i0 : i0 + 8 * n * d], np.int64).reshape(n, d).copy()
+        change(records, image)
+        state[p0:at] = records.tobytes()
+        state[i0 : i0 + 8 * n * d] = image.tobytes()
+
+    return _rewrite_state(data, edit)
+
+
+def _set(**columns):
+    """A change of records: {"x0": (particle, value), "v0": ...} (x0 = first coordinate)."""
+
+    def change(records, image):
+        for name, (i, value) in columns.items():
+            records[i, {"x": 0, "v": 2}[name[0]] + int(name[1])] = value
+
+    return change
+
+
+def test_a_state_that_breaks_the_rules_of_a_scene_is_refused(tmp_path):
+    """States crafted past the checksum at t = 0 (so that positions are those at the
+    clocks): two particles at one place, a particle through a wall, a speed of 1e140
+    (within the scale limits in a unit box with masses <= 1, but 1e280 times the initial
+    energy) are refused as a new scene would be; the unaltered file loads."""
+    path = tmp_path / "state.npz"
+    walls = _small("walls")
+    data = ck.dumps(Simulation(walls))
+    ck.loads(data)
+    cases = (
+        (_set(x0=(1, walls.positions[0, 0]), x1=(1, walls.positions[0, 1])), "overlap"),
+        (_set(x0=(0, 1.1)), "crosses a wall"),
+        (_set(v0=(0, 1e140)), "kinetic energy .* exceeds the initial scene's"),
+    )
+    for change, why in cases:
+        path.write_bytes(_edit_records(data, walls, change))
+        with pytest.raises(CheckpointError, match=f"is corrupt: .*{why}"):
+            Simulation.load(path)
+
+
+def test_a_state_its_initial_scene_cannot_reach_is_refused(tmp_path):
+    """The stored initial scene bounds the state: collisions without heated walls never
+    add kinetic energy, elastic ones keep it, and a periodic box keeps the momentum (to a
+    relative 1e-6: rounding drifts them by ~1e-15 in 5e5 collisions)."""
+    path = tmp_path / "state.npz"
+
+    def scaled(factor, shift=0.0):
+        def change(records, image):
+            records[:, 2:4] = records[:, 2:4] * factor + shift
+
+        return change
+
+    for scene, change, why in (
+        (_small(), scaled(0.5), "below the initial scene's .* elastic"),
+        (_small(restitution=0.5), scaled(1.01), "exceeds the initial scene's"),
+        (_small(restitution=0.5), scaled(0.5, 0.1), "momentum differs"),
+        (_small("walls", wall_restitution=0.9), scaled(1.01), "exceeds"),
+    ):
+        data = ck.dumps(Simulation(scene))
+        path.write_bytes(_edit_records(data, scene, change))
+        with pytest.raises(CheckpointError, match=why):
+            Simulation.load(path)
+    heated = _small("walls", wall_restitution=1.5)  # heated walls may add energy
+    data = ck.dumps(Simulation(heated))
+    path.write_bytes(_edit_records(data, heated, scaled(1.01)))
+    Simulation.load(path)
+
+
+def test_an_image_counter_no_crossing_could_make_is_refused(tmp_path):
+    """Each change of an image counter is a cell crossing or a shell exit through a periodic
+    box's face, so none is larger than their count: INT64_MIN (whose decrement overflowed,
+    and whose unwrapped position flipped sign) or one more than the crossings is refused; as
+    many loads.  Between walls every counter is 0."""
+    scene = _small()
+    sim = Simulation(scene)
+    sim.run(3.0)
+    moves = sim.stats["cell_crossings"] + sim.stats["shell_exits"]
+    assert np.any(sim._engine.state()[2] != 0) and moves > 0
+    data = ck.dumps(sim)
+    path = tmp_path / "image.npz"
+
+    def image(value):
+        def change(records, image):
+            image[4, 1] = value
+
+        return change
+
+    path.write_bytes(_edit_records(data, scene, image(-moves)))
+    assert Simulation.load(path).unwrapped_positions[4, 1] < -moves + 1
+    for value in (-(2**63), 2**63 - 1, moves + 1):
+        path.write_bytes(_edit_records(data, scene, image(value)))
+        with pytest.raises(CheckpointError, match="image counter is larger than the cell"):
+            Simulation.load(path)
+    # between walls nothing wraps: every counter is 0, however many cells were crossed
+    walls = _small("walls")
+    sim = Simulation(walls)
+    sim.run(3.0)
+    assert sim.stats["cell_crossings"] > 0
+    path.write_bytes(_edit_records(ck.dumps(sim), walls, image(1)))
+    with pytest.raises(CheckpointError, match="image counter is larger than the cell"):
+        Simulation.load(path)
+
+
+def test_a_stored_scene_that_is_no_scene_is_refused(saved, tmp_path):
+    """The stored initial scene is checked as Scene(...) checks one, and what that raises
+    (ValueError; OverflowError for a number of 400 digits in the JSON) comes out as
+    CheckpointError."""
+    members = _zip_members(saved)
+    path = tmp_path / "scene.npz"
+    meta, _ = ck._read_npz(saved, "x")
+    for name in ("contact_duration", "restitution"):
+        path.write_bytes(_rewrite_meta(saved, scene=dict(meta["scene"], **{name: 10**400})))
+        with pytest.raises(CheckpointError, match="is corrupt"):
+            Simulation.load(path)
+    for name, value in (("positions", np.nan), ("radii", -1.0), ("masses", np.inf)):
+        arr = np.load(__import__("io").BytesIO(members[f"scene_{name}.npy"])).copy()
+        arr.flat[0] = value
+        path.write_bytes(_zip(dict(members, **{f"scene_{name}.npy": _npy(arr)})))
+        with pytest.raises(CheckpointError, match="is corrupt"):
+            Simulation.load(path)

@@ -1,18 +1,23 @@
 """Random bad and edge inputs for tests/test_fuzz.py, and the worker process that runs them.
 
-A case is one call -- ``Scene(...)``, ``Scene.random(...)``, ``Simulation(scene).run(...)`` or
-``langevin.run(...)`` -- drawn by a seeded generator: a valid baseline with none, one or two of
-its arguments replaced by something wrong or extreme (wrong shapes and types, NaN/inf, zero and
-negative values, scales at the ends of float64, overlapping particles, far-away boxes, odd
-sample times and stop criteria). ``make_cases(seed, count)`` gives the same list in every
-process, so the worker and the test only exchange case numbers.
+A case is one call -- ``Scene(...)``, ``Scene.random(...)``, ``Simulation(scene).run(...)``,
+``langevin.run(...)`` (its ``threads=`` too), a scene with a ``TabulatedRestitution`` table, or
+``Simulation.load`` of a checkpoint -- drawn by a seeded generator: a valid baseline with none,
+one or two of its arguments replaced by something wrong or extreme (wrong shapes and types,
+NaN/inf, zero and negative values, scales at the ends of float64, overlapping particles,
+far-away boxes, odd sample times and stop criteria, tables out of order or range, checkpoints
+truncated, bit-flipped or crafted: tests/helpers/checkpoint_fuzz.py). ``make_cases(seed,
+count)`` gives the same list in every process, so the worker and the test only exchange case
+numbers.
 
 A case passes when the call raises GranularError, ValueError or TypeError with a message
-(MemoryError too where the input asks for more memory than a machine has), or returns a result
-that passes the invariants: every number finite, no two particles overlapping at any sample,
-the kinetic energy conserved when pair collisions and walls are elastic, every requested
-sample returned when the run reaches its t_stop, Scene.random's radii where they were asked
-for. An unmutated baseline must not raise at all (but for an inelastic collapse, which is
+(MemoryError too where the input asks for more memory than a machine has; a checkpoint only
+CheckpointError), or returns a result that passes the invariants: every number finite, no two
+particles overlapping at any sample, the kinetic energy conserved when pair collisions and
+walls are elastic and never gained without heated walls, every requested sample returned when
+the run reaches its t_stop, Scene.random's radii where they were asked for, a Langevin run's
+results the same to the bit for any number of threads, an unaltered checkpoint continuing bit
+for bit. An unmutated baseline must not raise at all (but for an inelastic collapse, which is
 physics).
 """
 
@@ -456,23 +461,221 @@ LANGEVIN_MUTATIONS = [
     _set("store_positions", ["yes", None]),
 ]
 
+
+def _in_scene(mutate):
+    """A scene mutation applied to the scene of a case that holds one (p["scene"])."""
+
+    def wrapped(rng, p):
+        return "scene: " + mutate(rng, p["scene"])
+
+    return wrapped
+
+
+def _table_params(rng):
+    """A scene whose pair or wall restitution is a table of 1-6 points, decreasing in speed."""
+    k = int(rng.integers(1, 7))
+    speeds = np.sort(rng.uniform(0.0, 4.0, k))
+    if rng.random() < 0.5:
+        speeds[0] = 0.0
+    scene = _scene_params(rng)
+    side = str(rng.choice(["restitution", "wall_restitution"]))
+    return dict(scene=scene, side=side, speeds=speeds, values=np.sort(rng.uniform(0.3, 1, k))[::-1])
+
+
+def _table_order(rng, p):
+    speeds = np.array(p["speeds"], dtype=float)
+    if len(speeds) < 2:
+        speeds = np.append(speeds, speeds[-1] + 1.0)
+        p["values"] = np.append(p["values"], 0.5)
+    how = int(rng.integers(3))
+    speeds = [speeds[::-1], np.concatenate([speeds[:1], speeds[:-1]]), -speeds][how]
+    p["speeds"] = speeds
+    return ["speeds decreasing", "a speed repeated", "speeds negated"][how]
+
+
+def _table_long(rng, p):
+    from granular.restitution import TABLE_MAX
+
+    k = int(rng.choice([TABLE_MAX + 1, 10**5]))
+    p["speeds"] = np.linspace(0.0, 10.0, k)
+    p["values"] = np.linspace(1.0, 0.5, k)
+    return f"a table of {k} points"
+
+
+TABLE_MUTATIONS = [
+    _entry("speeds", [NAN, INF, -INF, -1.0, -0.0, 1e308, 5e-324]),
+    _entry("values", [NAN, INF, -1e-300, 1.0 + 1e-15, 2.0, 0.0, 1.0]),
+    _shape("speeds"),
+    _shape("values"),
+    _set("speeds", [*WRONG_TYPES, [], [[0.0, 1.0], [2.0, 3.0]], 1.0]),
+    _set("values", [*WRONG_TYPES, [], 0.5]),
+    _table_order,
+    _table_long,
+    _in_scene(_scale(1e-150)),
+    _in_scene(_scale(1e150)),
+    _in_scene(_set("wall_restitution", [1.5])),  # heated walls with a table between particles
+]
+
+
+def _checkpoint_params(rng):
+    """A small gas (a valid scene of _scene_params) run for up to 400 events, to be saved and
+    loaded."""
+    return dict(scene=_scene_params(rng), events=int(rng.integers(0, 400)), edits=[])
+
+
+def _edit(make):
+    """A mutation appending an edit of the checkpoint's bytes (checkpoint_fuzz.apply_edits)."""
+
+    def mutate(rng, p):
+        edit = make(rng)
+        p["edits"].append(edit)
+        return f"{edit[0]} {edit[1:]}"
+
+    return mutate
+
+
+def _pick(rng, values):
+    return values[int(rng.integers(len(values)))]
+
+
+_META_PATHS = [
+    ("format",),
+    ("format_version",),
+    ("granular_version",),
+    ("layout",),
+    ("knobs",),
+    ("knobs", "cell_factor"),
+    ("knobs", "shell"),
+    ("knobs", "bogus"),
+    ("scene",),
+    ("scene", "boundary"),
+    ("scene", "restitution"),
+    ("scene", "wall_restitution"),
+    ("scene", "contact_duration"),
+    ("engine_state_sha256",),
+]
+_META_VALUES = [
+    None,
+    -1,
+    0,
+    0.5,
+    1e308,
+    10**400,
+    "x",
+    "auto",
+    True,
+    [],
+    {},
+    [[[[[]]]]],
+    {"law": "TabulatedRestitution", "speeds": [1.0, 0.0], "values": [2.0]},
+    {"law": "Viscoelastic", "damping": -1.0, "kappa": 1.0},
+    {"law": "os.system", "command": "true"},
+]
+_RECORD_VALUES = [NAN, INF, -INF, 1e140, -1e140, 1e300, 2.0, -1.0, 0.5, 0.0, 5e-324]
+_IMAGE_VALUES = [-(2**63), 2**63 - 1, 2**62, -1, 1, 10**12]
+
+
+def _state_int(rng):
+    from helpers.checkpoint_fuzz import STATE_HEADER
+
+    if rng.random() < 0.5:  # a header field
+        _, at, width = _pick(rng, STATE_HEADER)
+        value = _pick(rng, [-1, 0, 1, 2, 3, 4, 64, 2**31 - 1, -(2**31)])
+        return ("state_int", at, width, value)
+    width = int(rng.choice([4, 8]))
+    values = [-1, 0, 1, 2**31 - 1, -(2**31)] + ([2**62, -(2**63)] if width == 8 else [])
+    return ("state_int", float(rng.random()), width, _pick(rng, values))
+
+
+CHECKPOINT_MUTATIONS = [
+    _edit(lambda r: ("rezip",)),  # the same members in a new archive: loads
+    _edit(lambda r: ("truncate", float(r.random()))),
+    _edit(lambda r: ("flip", float(r.random()), int(r.integers(1, 256)))),
+    _edit(
+        lambda r: (
+            "zip_field",
+            _pick(r, ["flags", "method", "size", "offset"]),
+            _pick(r, [0, 1, 8, 12, 99, 0xFFFF, 2**31, 0xFFFFFFFF]),
+        )
+    ),
+    _edit(lambda r: ("compress",)),
+    _edit(
+        lambda r: (
+            "extra_member",
+            _pick(r, ["extra.npy", "meta.npy", "../x"]),
+            _pick(r, [1, 1 << 20, 16 << 20]),
+        )
+    ),
+    _edit(lambda r: ("drop_member", int(r.integers(8)))),
+    _edit(
+        lambda r: (
+            "npy_header",
+            int(r.integers(8)),
+            *_pick(
+                r,
+                [
+                    ("shape", (2**40,)),
+                    ("shape", (2**20, 2**20)),
+                    ("shape", (0,)),
+                    ("shape", ()),
+                    ("shape", (1,)),
+                    ("descr", "<f4"),
+                    ("descr", "|O"),
+                    ("descr", ">f8"),
+                    ("descr", "<U3"),
+                    ("descr", "|u1"),
+                    ("fortran_order", True),
+                ],
+            ),
+        )
+    ),
+    _edit(lambda r: ("meta", _pick(r, _META_PATHS), _pick(r, _META_VALUES))),
+    _edit(
+        lambda r: (
+            "meta_raw",
+            *_pick(
+                r,
+                [("[", 100_000), ("{}", 1), ("", 1), ("null", 1), ("1e999999", 1), ("[1, 2", 1)],
+            ),
+        )
+    ),
+    _edit(_state_int),
+    _edit(lambda r: ("state_double", float(r.random()), _pick(r, _RECORD_VALUES))),
+    _edit(lambda r: ("record", int(r.integers(20)), int(r.integers(8)), _pick(r, _RECORD_VALUES))),
+    _edit(lambda r: ("image", int(r.integers(20)), int(r.integers(3)), _pick(r, _IMAGE_VALUES))),
+]
+
+THREADS_MUTATIONS = [
+    _set("threads", [0, -1, 1.5, True, "2", NAN, None, 1, 2, 3, 7, 1024, 10**6, np.int64(2)]),
+]
+
 KINDS = {
     "scene": (_scene_params, SCENE_MUTATIONS),
     "random": (_random_params, RANDOM_MUTATIONS),
     "run": (_run_params, RUN_MUTATIONS),
     "langevin": (_langevin_params, LANGEVIN_MUTATIONS),
 }
+# Kinds added later draw from a stream of their own, so that adding one leaves the cases of
+# the others as they were: restitution tables, checkpoints, langevin.run's threads= (a
+# Langevin baseline whose threads are always set, so that its result is compared with one
+# thread's).
+LATER_KINDS = {
+    "table": (_table_params, TABLE_MUTATIONS),
+    "checkpoint": (_checkpoint_params, CHECKPOINT_MUTATIONS),
+    "threads": (_langevin_params, THREADS_MUTATIONS),
+}
+LATER_SHARE = 0.2  # of the cases
 
 
-def make_cases(seed, count):
-    """``count`` cases as dicts {kind, params, labels}, the same for the same seed."""
-    rng = np.random.default_rng(seed)
+def _draw(rng, kinds, count, at_least_one=()):
     cases = []
     for i in range(count):
-        kind = list(KINDS)[i % len(KINDS)]
-        baseline, mutations = KINDS[kind]
+        kind = list(kinds)[i % len(kinds)]
+        baseline, mutations = kinds[kind]
         params = baseline(rng)
         n_mut = int(rng.choice([0, 1, 1, 1, 1, 1, 2, 2, 2, 2]))
+        if kind in at_least_one:
+            n_mut = max(n_mut, 1)
         labels = []
         for _ in range(n_mut):
             mutate = mutations[int(rng.integers(len(mutations)))]
@@ -482,6 +685,13 @@ def make_cases(seed, count):
                 pass
         cases.append(dict(kind=kind, params=params, labels=labels))
     return cases
+
+
+def make_cases(seed, count):
+    """``count`` cases as dicts {kind, params, labels}, the same for the same seed."""
+    later = int(LATER_SHARE * count)
+    first = _draw(np.random.default_rng(seed), KINDS, count - later)
+    return first + _draw(np.random.default_rng([seed, 1]), LATER_KINDS, later, ("threads",))
 
 
 def describe(case):
@@ -530,6 +740,7 @@ def _verified(check):
 @_verified
 def _check_trajectory(scene, traj, sim, sample_times=None):
     from granular import Scene
+    from granular.restitution import heats
 
     if sample_times is not None and traj.stop_reason == "time":  # every sample or an error
         want = len(np.asarray(sample_times, dtype=float))
@@ -564,10 +775,13 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
     elastic = scene.restitution == 1 and (
         scene.boundary == "periodic" or scene.wall_restitution == 1
     )
-    if elastic and len(traj.kinetic_energy):
-        e = np.asarray(traj.kinetic_energy, dtype=float)
+    e = np.asarray(traj.kinetic_energy, dtype=float)
+    if elastic and len(e):
         drift = np.max(np.abs(e - e[0])) / e[0] if e[0] > 0 else np.max(np.abs(e))
         _check(drift <= ENERGY_RTOL, f"elastic run: kinetic energy drifted by {drift:.3g}")
+    if len(e) and (scene.boundary == "periodic" or not heats(scene.wall_restitution)):
+        rise = (np.max(e) - e[0]) / e[0] if e[0] > 0 else np.max(e)
+        _check(rise <= ENERGY_RTOL, f"no heated walls, yet the kinetic energy rose by {rise:.3g}")
 
 
 @_verified
@@ -589,6 +803,57 @@ def _run_scene(scene):
     sim = Simulation(scene)
     traj = sim.run(t_stop, sample_times=np.linspace(0, t_stop, 5), stop_when={"events": EVENTS})
     _check_trajectory(scene, traj, sim)
+
+
+def _run_checkpoint(p, mutated):
+    """Save a short run, damage the file (p["edits"]), load it: CheckpointError, or a
+    Simulation that runs on within the invariants and bit for bit as the original (when the
+    file is unaltered, or only its packaging changed).  A state crafted past its checksum
+    that passes every check must be a valid scene, and need only end cleanly after (its
+    predictions cannot be checked)."""
+    from granular import CheckpointError, GranularError, Scene, Simulation
+    from granular import checkpoint as ck
+
+    from helpers.checkpoint_fuzz import apply_edits
+
+    scene = Scene(**p["scene"])
+    sim = Simulation(scene)
+    if p["events"]:
+        sim.run(stop_when={"events": p["events"]})
+    data = ck.dumps(sim)
+    bad = apply_edits(data, p["edits"], sim._engine.state()[1])
+    try:
+        loaded = ck.loads(bad)
+    except CheckpointError as exc:
+        if bad == data:
+            return "FAIL", f"an unaltered checkpoint was refused: {exc}"
+        return "error", f"CheckpointError: {exc}"[:300]
+    except Exception as exc:  # noqa: BLE001 -- anything else is the failure
+        tb = traceback.extract_tb(exc.__traceback__)[-1]
+        where = f"{os.path.basename(tb.filename)}:{tb.lineno}"
+        return "FAIL", f"{type(exc).__name__} (not CheckpointError): {exc} (at {where})"
+    more = dict(stop_when={"events": 1000}, t_stop=loaded.time + 1.0)
+    crafted = any(e[0].startswith(("state", "record", "image")) for e in p["edits"])
+    if crafted and bad != data:
+        try:
+            _ = loaded.scene  # what a load accepts is a valid scene (no overlaps, inside, scales)
+        except Exception as exc:  # noqa: BLE001
+            return "FAIL", f"a loaded state is not a valid scene: {type(exc).__name__}: {exc}"
+        try:
+            traj = loaded.run(**more)
+        except GranularError as exc:
+            return "error", f"{type(exc).__name__} in the run: {exc}"[:300]
+        _check(np.all(np.isfinite(traj.kinetic_energy)), "non-finite energy after a load")
+        return "ok", ""
+    t0 = loaded.time
+    times = np.linspace(t0, t0 + 1.0, 4)
+    traj = loaded.run(**more, sample_times=times)
+    _check_trajectory(scene, traj, loaded)
+    # what the checks accept of a file whose state was not crafted is the saved state
+    again = sim.run(**more, sample_times=times)
+    same = np.array_equal(traj.positions, again.positions) and loaded.stats == sim.stats
+    _check(same, "an accepted checkpoint did not continue bit for bit")
+    return "ok", ""
 
 
 def run_case(case):
@@ -619,8 +884,19 @@ def run_case(case):
             if "again" in p:
                 traj = sim.run(**p["again"], stop_when={"events": EVENTS})
                 _check_trajectory(scene, traj, sim)
-        else:
-            _check_langevin(langevin.run(**p))
+        elif kind == "table":
+            law = granular.TabulatedRestitution(p["speeds"], p["values"])
+            _run_scene(Scene(**dict(p["scene"], **{p["side"]: law})))
+        elif kind == "checkpoint":
+            return _run_checkpoint(p, mutated)
+        else:  # langevin, threads
+            r = langevin.run(**p)
+            _check_langevin(r)
+            if "threads" in p and p["threads"] != 1:  # the same bits on one thread
+                one = langevin.run(**dict(p, threads=1))
+                for name in ("msd_total", "v2", "tamsd_mean", "final_positions"):
+                    a, b = getattr(r, name), getattr(one, name)
+                    _check(np.array_equal(a, b), f"threads={p['threads']!r}: {name} differs")
         return "ok", ""
     except InvariantError as exc:
         return "FAIL", f"invariant: {exc}"

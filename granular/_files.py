@@ -1,0 +1,116 @@
+"""Writing files atomically, and telling granular's files apart by their first bytes.
+
+``write_atomic`` is used for checkpoints (granular/checkpoint.py) and an ensemble's run
+files (granular/ensemble_store.py); ``kind_of`` lets a reader that was handed the wrong
+kind of file say what the file is and which function reads it.
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+
+# The first bytes of each kind of file: a zip archive (an .npz, and so a checkpoint or an
+# ensemble's run file), a single .npy array, a GSD file (its magic number 0x65DF65DF65DF65DF,
+# little-endian).
+_MAGIC = (
+    (b"PK\x03\x04", "npz"),
+    (b"PK\x05\x06", "npz"),  # a zip archive with no members
+    (b"\x93NUMPY", "npy"),
+    (b"\xdf\x65\xdf\x65\xdf\x65\xdf\x65", "gsd"),
+)
+# What each kind is, and what reads it, for the messages of a reader given another kind.
+WHAT_READS = {
+    "npz": "a NumPy .npz archive (a checkpoint written by Simulation.save is one: read it "
+    "with granular.Simulation.load)",
+    "npy": "a single NumPy .npy array (read it with numpy.load)",
+    "gsd": "a GSD trajectory file (read it with granular.read, or take one frame as a scene "
+    "with granular.Scene.from_gsd)",
+}
+
+
+def kind_of(head: bytes) -> str | None:
+    """The kind of file whose first bytes are ``head`` ("npz", "npy", "gsd"), or None.
+
+    Parameters
+    ----------
+    head : bytes
+        The file's first 8 bytes (or more).
+    """
+    for magic, kind in _MAGIC:
+        if head.startswith(magic):
+            return kind
+    return None
+
+
+def check_kind(path: str | os.PathLike, want: str) -> None:
+    """Raise ValueError if the file at ``path`` starts as another kind of file than
+    ``want`` ("npz", "gsd"), saying what it is and which function reads it; a file that
+    cannot be read, or is of no kind known here, is left to the reader's own checks.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file a reader was given.
+    want : str
+        The kind that reader reads.
+    """
+    try:
+        with open(path, "rb") as f:
+            head = f.read(8)
+    except OSError:
+        return
+    kind = kind_of(head)
+    if kind is not None and kind != want:
+        raise ValueError(
+            f"{os.fspath(path)!r} is not {WHAT_READS[want].split(' (')[0]}: it is "
+            f"{WHAT_READS[kind]}"
+        )
+
+
+def write_atomic(path: str | os.PathLike, data: bytes, suffix: str = ".part") -> None:
+    """Write ``data`` to ``path`` so that a crash mid-way never leaves a half file: into a
+    temporary file (``.tmp-*``) in the same directory, flushed to disk, then renamed over
+    ``path`` (a rename within a file system is atomic).
+
+    The file gets the permissions a plain ``open(path, "wb")`` would give it: those of the
+    file it replaces, or for a new file 0o666 less the process' umask (the temporary file
+    is created with mode 0o666 and the kernel applies the umask and any default ACL).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Where to write.
+    data : bytes
+        The whole content.
+    suffix : str
+        The temporary file's suffix.
+    """
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    try:
+        mode = os.stat(path).st_mode & 0o777
+    except FileNotFoundError:
+        mode = None
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
+    for _ in range(100):  # a random name taken already: draw another
+        tmp = os.path.join(folder, f".tmp-{secrets.token_hex(8)}{suffix}")
+        try:
+            fd = os.open(tmp, flags, 0o666)
+            break
+        except FileExistsError:
+            continue
+    else:
+        raise FileExistsError(f"no free temporary name in {folder!r}")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            if mode is not None and hasattr(os, "fchmod"):
+                os.fchmod(f.fileno(), mode)
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
