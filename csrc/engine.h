@@ -51,7 +51,8 @@ struct gr_edmd {
     int64_t events, pair, wall, invalid, elastic_tc;
     int64_t crossings;    /* cell crossings */
     int64_t shell_exits;  /* list mode: shell exits, each rebuilding one list */
-    double virial, wall_impulse, kinetic;
+    double virial, wall_impulse;
+    double kinetic;       /* total kinetic energy, updated by differences at each collision */
     double kinetic_time;  /* integral of the total kinetic energy over time, for the pressure */
     int64_t law_clamped;  /* collisions past a viscoelastic law's range (restitution.h) */
 };
@@ -129,6 +130,9 @@ int gr_renumber(gr_edmd *s);
  * GR_RENUMBER_MIN_N) fit in the cache anyway and never do. */
 #define GR_RENUMBER_MIN_N 4096
 #define GR_RENUMBER_EVENTS_PER_N 16
+
+/* The total kinetic energy summed from the velocities (sample.c). */
+double gr_kinetic_total(const gr_edmd *s);
 
 /* Write sample smp->next, the state at time ts, and advance smp->next (sample.c). */
 void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts);

@@ -285,6 +285,48 @@ def test_stop_criteria():
         sim.run()
 
 
+def _bouncing_energy_integral(speed, mass, t_end):
+    """The integral over [0, t_end] of the kinetic energy of a disk of radius 0.05 that
+    starts at the centre of the unit box moving along x at `speed`, between walls of
+    restitution 1/2: each bounce halves the speed (exactly, in binary)."""
+    t, gap, total, v = 0.0, 0.45, 0.0, speed
+    while t + gap / v < t_end:
+        total += 0.5 * mass * v * v * (gap / v)
+        t, gap, v = t + gap / v, 0.9, 0.5 * v
+    return total + 0.5 * mass * v * v * (t_end - t)
+
+
+@pytest.mark.parametrize("speed", [1e15, 7e15, 1e17, 1e20])
+def test_a_fast_disk_cooled_by_walls_keeps_a_true_energy_count(speed):
+    """A disk at 1e15 between walls of restitution 1/2 loses 30 orders of magnitude of
+    energy by t = 1; the engine's running energy total (updated by differences) carried
+    rounding of 1e-16 of the first energy, which then exceeded the energy itself: below
+    the "no criterion" sentinel it stopped the run at t = 1.2e-7 with stop_reason
+    'kinetic_energy' (1e15, 1e20), above it the time integral of the energy, hence the
+    pressure, came out 32 % or 3x too large (7e15, 1e17).  The run must go to t_stop and
+    the integral match the bounce-by-bounce sum: each energy summed from the velocities is
+    exact to 1e-16 relative, the integral a sum of positive terms of such, so 1e-12 is a
+    wide bound."""
+    s = Scene([[0.5, 0.5]], [[speed, 0.0]], 0.05, boundary="walls", wall_restitution=0.5)
+    sim = Simulation(s)
+    tr = sim.run(1.0)
+    assert tr.stop_reason == "time" and tr.times[-1] == 1.0
+    exact = _bouncing_energy_integral(speed, s.masses[0], 1.0)
+    assert sim.stats["kinetic_time_integral"] == pytest.approx(exact, rel=1e-12)
+
+
+def test_an_energy_target_stops_at_the_bounce_that_reaches_it():
+    """The same disk asked to stop at an energy 4**-30.5 of its start: each bounce
+    quarters the energy, so the 31st is the first at or below the target -- not the
+    27th, where the drifting running total had fallen to the target."""
+    s = Scene([[0.5, 0.5]], [[1e15, 0.0]], 0.05, boundary="walls", wall_restitution=0.5)
+    sim = Simulation(s)
+    tr = sim.run(stop_when={"kinetic_energy": s.kinetic_energy * 4.0**-30.5})
+    assert tr.stop_reason == "kinetic_energy"
+    assert sim.stats["wall_collisions"] == 31
+    assert tr.kinetic_energy[-1] == pytest.approx(s.kinetic_energy * 4.0**-31, rel=1e-15)
+
+
 def test_log_spaced_samples_and_counters():
     s = Scene.random(500, 0.025, seed=1)
     times = np.concatenate([[0.0], np.logspace(-3, 1, 30)])
