@@ -257,6 +257,10 @@ class Simulation:
         HeatedWallsError
             If heated walls (``wall_restitution > 1``) pumped the energy up beyond what
             float64 event times can resolve.
+        GranularError, KeyboardInterrupt
+            Every error of the run, and Ctrl-C (seen between chunks of events, the state
+            intact), carry ``.trajectory``: the samples taken so far, with ``stop_reason``
+            ``"error"`` or ``"interrupted"``.
 
         Warns
         -----
@@ -370,7 +374,8 @@ class Simulation:
         except (GranularError, KeyboardInterrupt) as exc:
             # keep what was sampled: every sample time up to the engine's clock is written
             k = int(np.searchsorted(times, self.time, side="right"))
-            trajectory = self._trajectory(times[:k], buf, k, "error")
+            why = "interrupted" if isinstance(exc, KeyboardInterrupt) else "error"
+            trajectory = self._trajectory(times[:k], buf, k, why)
             heated = self._heated_walls_error(exc, energy0)
             if heated is not None:
                 heated.trajectory = trajectory

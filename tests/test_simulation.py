@@ -391,6 +391,36 @@ def test_ctrl_c_leaves_a_consistent_state():
     assert tr.kinetic_energy[-1] == pytest.approx(s.kinetic_energy, rel=1e-13)
 
 
+class _InterruptedEngine:
+    """The real engine, whose second advance() is cut short by Ctrl-C."""
+
+    def __init__(self, engine):
+        self.engine, self.calls = engine, 0
+
+    def advance(self, *args, **kwargs):
+        self.calls += 1
+        if self.calls == 2:
+            raise KeyboardInterrupt
+        return self.engine.advance(*args, **kwargs)
+
+    def __getattr__(self, name):
+        return getattr(self.engine, name)
+
+
+def test_ctrl_c_says_interrupted_and_keeps_the_samples():
+    """Ctrl-C between chunks: the partial trajectory says "interrupted", not "error", and
+    holds every sample up to the engine's clock."""
+    sim = Simulation(Scene.random(200, 0.02, seed=12))
+    sim._engine = _InterruptedEngine(sim._engine)
+    times = np.linspace(0.0, 1e4, 10001)
+    with pytest.raises(KeyboardInterrupt) as info:
+        sim.run(t_stop=1e4, sample_times=times)
+    tr = info.value.trajectory
+    assert tr.stop_reason == "interrupted"
+    assert 0 < sim.time < 1e4
+    np.testing.assert_array_equal(tr.times, times[times <= sim.time])
+
+
 def test_progress_bar_and_memory_guard(capsys):
     s = Scene.random(200, 0.03, seed=13)
     Simulation(s).run(t_stop=0.5, progress=True)
