@@ -151,12 +151,11 @@ class Simulation:
             return (checkpoint.loads, (checkpoint.dumps(self),))
 
     @contextlib.contextmanager
-    def _exclusive(self):
-        """Hold the run lock, or raise RuntimeError if a run holds it."""
+    def _exclusive(self, instead: str = "save or copy it between runs"):
+        """Hold the run lock, or raise RuntimeError if a run holds it, saying what to do
+        ``instead``."""
         if not self._running.acquire(blocking=False):
-            raise RuntimeError(
-                "another thread is running this Simulation; save or copy it between runs"
-            )
+            raise RuntimeError(f"another thread is running this Simulation; {instead}")
         try:
             yield
         finally:
@@ -272,15 +271,11 @@ class Simulation:
         """
         if not getattr(self, "_clustering_checked", False):  # also for restored Simulations
             self._warn_clustering(t_stop, stop_when)
-        if not self._running.acquire(blocking=False):
-            raise RuntimeError(
-                "another thread is running this Simulation; a Simulation runs one run at a "
-                "time (wait for it, or give each thread its own Simulation(scene))"
-            )
-        try:
+        with self._exclusive(
+            "a Simulation runs one run at a time (wait for it, or give each thread its own "
+            "Simulation(scene))"
+        ):
             return self._run(t_stop, sample_times, stop_when, store, progress)
-        finally:
-            self._running.release()
 
     def _run(self, t_stop, sample_times, stop_when, store, progress):
         crit = dict(stop_when or {})
