@@ -267,7 +267,10 @@ class Simulation:
             On the first run of a granular gas (constant xi < 1) in a periodic box beyond
             the critical size of the shear instability (``granular.clustering``) that can
             reach the instability's onset t* (by ``t_stop`` or the collisions per particle
-            asked for; a run to an energy or an event count may).
+            asked for; a run to an energy or an event count may); for a ``Viscoelastic``
+            law, on the first run if the box is beyond the critical size at the law's
+            effective restitution at the present temperature
+            (``granular.clustering.effective_restitution``).
         """
         if not getattr(self, "_clustering_checked", False):  # also for restored Simulations
             self._warn_clustering(t_stop, stop_when)
