@@ -517,8 +517,9 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     as it cools, and L_c with it: the message gives linear theory's outlook with xi_eff(T)
     along the cooling (when the slowest shear modes reach 5%, or else when L_c outgrows
     the box and how far they have grown by then), and t* and the collisions returned are
-    0, so that every run is warned: linear theory's onset is no bound here (a box about
-    twice L_c, whose modes peak short of 5% in linear theory, clusters).
+    0, so that every run is warned: linear theory's onset is no bound here (a gas whose
+    slowest modes peak short of 5% in linear theory still runs measurably warmer than
+    the cooling law: docs/clustering.md).
 
     Parameters
     ----------
