@@ -73,12 +73,13 @@ static double next_sample(const gr_edmd_samples *smp);
 
 /* The collision count 2 * pair + wall at which s->kinetic is next summed anew: the next
  * multiple of GR_KINETIC_RESUM * n above the present count. */
-#define GR_KINETIC_RESUM 8
+#define GR_KINETIC_RESUM 16
 static double next_resum(const gr_edmd *s)
 {
     const int64_t every = GR_KINETIC_RESUM * (int64_t)s->n;
     return (double)((2 * s->pair + s->wall) / every + 1) * (double)every;
 }
+
 /* The events are inlined into each of the four loops (as GCC did by itself for the two
  * loops before laws came): each loop then holds its own copy, compiled for its dim and
  * laws, and the constant-restitution loops execute exactly the instructions they did. */
@@ -107,8 +108,8 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
      * velocities: in a gas cooled by many orders of magnitude (a fast particle between
      * absorbing walls) that error exceeds the energy itself.  So it is summed anew
      * every GR_KINETIC_RESUM collisions a particle (at fixed collision counts: the
-     * same whatever the calls and checkpoints; one particle's energy a collision over
-     * GR_KINETIC_RESUM), and whenever it reaches the energy test's gate -- the target,
+     * same whatever the calls and checkpoints; one particle's energy summed per
+     * GR_KINETIC_RESUM collisions), and whenever it reaches the energy test's gate -- the target,
      * or 0 without one -- where the run then stops on the fresh sum alone. */
     const double kinetic = stop->energy ? stop->kinetic_energy * (double)n : 0.0;
     double resum = fmin(collisions, next_resum(s));
@@ -186,13 +187,11 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
         if (status != GR_OK) return status;
         if (check) {
             check = 0;
-            if ((double)(2 * s->pair + s->wall) >= resum) {
-                if ((double)(2 * s->pair + s->wall) >= collisions) return GR_STOP_COLLISIONS;
-                s->kinetic = gr_kinetic_total(s);
-                resum = fmin(collisions, next_resum(s));
-            }
-            if (s->kinetic <= kinetic) {
-                s->kinetic = gr_kinetic_total(s);
+            const double count = (double)(2 * s->pair + s->wall);
+            if (count >= resum || s->kinetic <= kinetic) { /* rarely: resum <= collisions */
+                if (count >= collisions) return GR_STOP_COLLISIONS;
+                s->kinetic = kinetic_total(s, dim);
+                if (count >= resum) resum = fmin(collisions, next_resum(s));
                 if (stop->energy && s->kinetic <= kinetic) return GR_STOP_ENERGY;
             }
         }
