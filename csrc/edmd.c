@@ -107,11 +107,13 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
      * 1e-16 of the largest energy it has held since it was last summed from the
      * velocities: in a gas cooled by many orders of magnitude (a fast particle between
      * absorbing walls) that error exceeds the energy itself.  So it is summed anew
-     * every GR_KINETIC_RESUM collisions a particle (at fixed collision counts: the
-     * same whatever the calls and checkpoints; one particle's energy summed per
-     * GR_KINETIC_RESUM collisions), and whenever it reaches the energy test's gate -- the target,
-     * or 0 without one -- where the run then stops on the fresh sum alone. */
-    const double kinetic = stop->energy ? stop->kinetic_energy * (double)n : 0.0;
+     * every GR_KINETIC_RESUM collisions a particle (at fixed collision counts: the same
+     * whatever the calls and checkpoints; one particle's energy summed per
+     * GR_KINETIC_RESUM collisions), and whenever it reaches the energy test's gate: the
+     * target, where the run then stops on the fresh sum alone, or without one any
+     * negative value (not 0: a gas at rest would sum itself at every collision). */
+    const double kinetic =
+        stop->energy ? stop->kinetic_energy * (double)n : nextafter(0.0, -1.0);
     double resum = fmin(collisions, next_resum(s));
     /* events at one instant beyond this are a pile-up (every particle crossing a cell
      * wall at once, as a moving lattice does, is still well below it) */

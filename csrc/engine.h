@@ -146,7 +146,6 @@ int gr_renumber(gr_edmd *s);
 #define GR_RENUMBER_MIN_N 4096
 #define GR_RENUMBER_EVENTS_PER_N 16
 
-
 /* Write sample smp->next, the state at time ts, and advance smp->next (sample.c). */
 void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts);
 
