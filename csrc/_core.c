@@ -400,10 +400,11 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         PyErr_SetString(PyExc_ValueError, "max_events must be positive");
         return NULL;
     }
-    if (stop.t_stop != stop.t_stop) {
-        PyErr_SetString(PyExc_ValueError, "t_stop must not be NaN");
+    if (stop.t_stop != stop.t_stop || stop.kinetic_energy != stop.kinetic_energy) {
+        PyErr_SetString(PyExc_ValueError, "t_stop and kinetic_energy must not be NaN");
         return NULL;
     }
+    stop.energy = stop.kinetic_energy >= 0.0; /* negative: no energy criterion */
     stop.max_events = max_events;
     npy_intp any1[1] = {-1};
     PyArrayObject *times = as_f64(otimes, "sample_times", 1, any1);
@@ -526,7 +527,8 @@ static PyMethodDef EDMD_methods[] = {
     {"advance", (PyCFunction)(void (*)(void))EDMD_advance, METH_VARARGS | METH_KEYWORDS,
      "advance(t_stop, collisions_per_particle, kinetic_energy, max_events, sample_times, next,"
      " positions, velocities, kinetic, momentum, pair, wall, virial, wall_impulse)"
-     " -> (reason, next).  Process events, writing samples into the given arrays."},
+     " -> (reason, next).  Process events, writing samples into the given arrays"
+     " (kinetic_energy: the mean to stop at, negative for none)."},
     {"state", (PyCFunction)EDMD_state, METH_NOARGS,
      "state() -> (positions wrapped in the box, velocities, image counters) at the current time"},
     {"counters", (PyCFunction)EDMD_counters, METH_NOARGS, "counters() -> dict"},

@@ -57,7 +57,9 @@ typedef struct {
 typedef struct {
     double t_stop;                 /* absolute time; +inf for none */
     double collisions_per_particle;/* stop when (2*pair + wall)/N >= this; +inf for none */
-    double kinetic_energy;         /* stop when mean kinetic energy <= this; -1 for none */
+    int energy;                    /* 1: stop when the mean kinetic energy <= kinetic_energy
+                                    * (> 0); 0: no energy criterion */
+    double kinetic_energy;
     int64_t max_events;            /* events this call may process (> 0) */
 } gr_edmd_stop;
 

@@ -69,14 +69,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->virial = s->virial;
     c->wall_impulse = s->wall_impulse;
     c->kinetic_time = s->kinetic_time;
-    double k = 0.0;
-    for (int32_t i = 0; i < s->n; i++) {
-        const double *p = rec(s, s->dim, i);
-        double v2 = 0.0;
-        for (int a = 0; a < s->dim; a++) v2 += VEL(p, s->dim)[a] * VEL(p, s->dim)[a];
-        k += 0.5 * s->mass[i] * v2;
-    }
-    c->kinetic = k;
+    c->kinetic = kinetic_total(s, s->dim);
     for (int a = 0; a < 3; a++) c->ncell[a] = s->cells.nc[a];
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;
 }

@@ -19,7 +19,9 @@ independent of each other and of the positions) gives a known value:
     The kinetic energy of the coarse-grained flow field (the momentum per cell of an m^d
     grid) against the thermal energy, with the level that pure noise gives subtracted.
 
-Which theory says where the instability sets in: ``granular.theory.critical_box_size``.
+Which theory says where the instability sets in: ``granular.theory.critical_box_size``;
+for a viscoelastic gas at the restitution ``effective_restitution`` gives it at its
+temperature.  ``unstable_box`` is the text of ``Simulation.run``'s ClusteringWarning.
 """
 
 from __future__ import annotations
@@ -394,6 +396,100 @@ def onset(times: ArrayLike, excess: ArrayLike, threshold: float) -> float:
 # the share of the thermal energy at which the warning's t* counts homogeneous cooling as over
 _ONSET_SHARE = 0.05
 
+# Gauss-Legendre nodes on [0, 1] for effective_restitution's thermal mean, taken in y =
+# x^(1/10), x = m g^2 / 4T, over [0, 60^(1/10)] (e^-60 ends the Maxwellian): a viscoelastic
+# eps is a polynomial in g^(1/5), hence in y, so the integrand is smooth there except where
+# the law is clamped at max_speed, where the range is split
+_Y_END = 60.0**0.1
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(64)
+_NODES, _WEIGHTS = 0.5 * (_NODES + 1.0), 0.5 * _WEIGHTS
+
+
+def effective_restitution(restitution, temperature: ArrayLike, mass: float = 1.0):
+    """The constant restitution xi_eff that cools a gas at temperature T as fast as a
+    restitution law does: the thermal mean over the collisions of a Maxwellian gas,
+    weighted by the energy each loses,
+
+        1 - xi_eff^2 = <(1 - eps(g)^2) g^2> / <g^2>,
+
+    g the normal impact speed (its density over collisions is (g/s^2) exp(-g^2 / 2 s^2),
+    s^2 = 2T/m, as in ``theory``'s viscoelastic cooling).  With xi_eff, Haff's cooling rate
+    (1 - xi^2) omega(T) / d is the law's at T; for ``Viscoelastic`` it is 1 - xi_eff^2 =
+    2 C1 Gamma(21/10) delta(T) + O(delta^2), ``theory.viscoelastic_cooling_rate``.  The law
+    is evaluated as the engine applies it (past ``max_speed``, eps(max_speed)), by
+    quadrature exact to about 1e-12 for ``Viscoelastic`` (a tabulated law's kinks cost
+    digits).
+
+    Parameters
+    ----------
+    restitution : float or granular.RestitutionLaw
+        A number is returned as it is.
+    temperature : float or array_like
+        T (k_B = 1), > 0.
+    mass : float
+        The particle mass (equal masses: the relative velocity's variance is 2T/m).
+
+    Returns
+    -------
+    float or ndarray
+        xi_eff at each temperature.
+    """
+    from .restitution import RestitutionLaw
+
+    if not isinstance(restitution, RestitutionLaw):
+        return float(restitution)
+    T = np.asarray(temperature, dtype=np.float64)
+    if not (np.all(T > 0) and np.all(np.isfinite(T)) and mass > 0 and math.isfinite(mass)):
+        raise ValueError(
+            f"effective_restitution needs temperatures > 0 and a mass > 0, got T = "
+            f"{T.tolist()} and mass = {mass}"
+        )
+    scale = 4.0 * T[..., None] / mass  # g^2 = scale x = scale y^10
+    kink = getattr(restitution, "max_speed", math.inf)
+    y_kink = np.minimum((kink**2 / scale) ** 0.1, _Y_END)
+    loss = 0.0
+    for lo, hi in ((0.0, y_kink), (y_kink, _Y_END)):
+        y = lo + (hi - lo) * _NODES
+        eps = np.asarray(restitution(np.sqrt(scale * y**10)), dtype=np.float64)
+        density = 10.0 * y**19 * np.exp(-(y**10))  # x e^-x dx in y
+        loss = loss + np.sum((1.0 - eps**2) * density * (hi - lo) * _WEIGHTS, axis=-1)
+    xi = np.sqrt(np.clip(1.0 - loss, 0.0, None))
+    return float(xi) if xi.ndim == 0 else xi
+
+
+def _law_outlook(restitution, scene, big, radius, density, growth):
+    """Linear theory for a restitution law, whose gas grows more elastic as it cools: the
+    slowest shear mode's energy relative to the thermal one grows at the rate zeta(T) (1 -
+    (L_c(T)/L)^2), L_c(T) at xi_eff(T) (``effective_restitution``).  In u = ln(T0/T):
+    d ln(growth) = (1 - (L_c/L)^2) du, dt = du / zeta, d(collisions) = omega dt, zeta =
+    (1 - xi_eff^2) omega / d.  Returns (u, t, collisions, log growth) at the onset (the
+    growth reached) if it comes, else at the peak, where L_c(T) overtakes L."""
+    from . import theory
+
+    d, eta = scene.dim, scene.packing_fraction
+    T0, mass = float(scene.temperature), float(np.mean(scene.masses))
+    u = np.linspace(0.0, 60.0, 1501)  # the trapezoids' relative error ~1e-4
+    T = T0 * np.exp(-u)
+    xi = effective_restitution(restitution, T, mass)
+    lc = np.asarray(theory.critical_box_size(density, radius, xi, d, eta=eta))
+    omega = np.asarray(theory.collision_frequency(density, radius, T, mass, d, eta))
+
+    def integral(f):
+        return np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(u))])
+
+    log_growth = integral(1.0 - (lc / big) ** 2)
+    with np.errstate(divide="ignore"):
+        dt_du = d / ((1.0 - xi**2) * omega)  # inf once xi_eff rounds to 1: never reached
+    t, collisions = integral(dt_du), integral(omega * dt_du)
+    past = np.nonzero(log_growth >= math.log(growth))[0]
+    if past.size:
+        k = int(past[0])
+        u_at = float(np.interp(math.log(growth), log_growth[k - 1 : k + 1], u[k - 1 : k + 1]))
+    else:
+        u_at = float(u[np.argmax(log_growth)])
+    at = [float(np.interp(u_at, u, f)) for f in (t, collisions, log_growth)]
+    return u_at, at[0], at[1], at[2]
+
 
 def unstable_box_message(scene) -> str | None:
     """Why a scene's homogeneous cooling will end, or None when theory expects it to last:
@@ -408,14 +504,24 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     state (inf where linear theory gives no finite onset), or None when theory expects the
     homogeneous cooling to last.
 
-    None unless the box is periodic, the restitution a plain number xi < 1 (a restitution
-    law object is left alone) and the longest side above ``theory.critical_box_size``.
-    The message gives L, L_c, xi and the packing fraction, and t*: the time at which, in
-    linear theory, the slowest shear modes (k = 2 pi / L) grow from their equipartition
-    share of the kinetic energy, M / (d N) with M = 2 d (d - 1) real components, to 5% of it
-    (``theory.shear_mode_growth``), in time and in collisions per particle,
-    ``omega0 tau0 ln(1 + t*/tau0)``.  For mixtures the median radius (the bulk, which a big
-    tracer does not move) stands in for the radius (the theory is for equal spheres).
+    None unless the box is periodic, the restitution a plain number xi < 1 or a
+    ``Viscoelastic`` law (another law object is left alone) and the longest side above
+    ``theory.critical_box_size``.  The message gives L, L_c, xi and the packing fraction,
+    and t*: the time at which, in linear theory, the slowest shear modes (k = 2 pi / L) grow
+    from their equipartition share of the kinetic energy, M / (d N) with M = 2 d (d - 1)
+    real components, to 5% of it (``theory.shear_mode_growth``), in time and in collisions
+    per particle, ``omega0 tau0 ln(1 + t*/tau0)``.  For mixtures the median radius (the
+    bulk, which a big tracer does not move) stands in for the radius (the theory is for
+    equal spheres).
+
+    A viscoelastic gas is judged at its effective restitution at the present temperature
+    (``effective_restitution``: the constant xi that cools as fast).  It grows more elastic
+    as it cools, and L_c with it: the message gives linear theory's outlook with xi_eff(T)
+    along the cooling (when the slowest shear modes reach 5%, or else when L_c outgrows
+    the box and how far they have grown by then), and t* and the collisions returned are
+    0, so that every run is warned: linear theory's onset is no bound here (a gas whose
+    slowest modes peak short of 5% in linear theory still runs measurably warmer than
+    the cooling law: docs/clustering.md).
 
     Parameters
     ----------
@@ -424,7 +530,8 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     Returns
     -------
     tuple of (str, float, float) or None
-        The warning's text, t* and the collisions per particle until t*; or None.
+        The warning's text, t* and the collisions per particle until t* (0 and 0 for a
+        viscoelastic gas); or None.
 
     References
     ----------
@@ -434,35 +541,77 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     import numbers
 
     from . import theory
+    from .restitution import Viscoelastic
 
     xi = scene.restitution
-    if scene.boundary != "periodic" or not isinstance(xi, numbers.Real) or not xi < 1:
+    law = isinstance(xi, Viscoelastic)
+    if scene.boundary != "periodic" or not (law or (isinstance(xi, numbers.Real) and xi < 1)):
         return None
     lengths = scene.upper - scene.lower
     big = float(np.max(lengths))
     radius = float(np.median(scene.radii))
     density = scene.n / scene.volume
     eta = scene.packing_fraction
-    if not 0 < eta < 1:
+    temperature = float(scene.temperature)
+    mass = float(np.mean(scene.masses))
+    if not 0 < eta < 1 or (law and not 0 < temperature < math.inf):
         return None
+    if law:
+        xi = effective_restitution(xi, temperature, mass)
+        at = (
+            f"the effective restitution xi = {xi:.4g} of the viscoelastic law at the present "
+            f"temperature T = {temperature:.4g} (the constant xi that cools as fast: "
+            "granular.clustering.effective_restitution)"
+        )
+    else:
+        at = f"restitution xi = {float(xi):g}"
     lc = float(theory.critical_box_size(density, radius, float(xi), scene.dim, eta=eta))
     if not big > lc:
         return None
     d, n = scene.dim, scene.n
     text = (
         f"the periodic box (longest side L = {big:.4g}) exceeds the critical size "
-        f"L_c = {lc:.4g} of the shear instability at restitution xi = {float(xi):g} and "
+        f"L_c = {lc:.4g} of the shear instability at {at} and "
         f"packing fraction {eta:.4g} (granular.theory.critical_box_size: Enskog, Navier-Stokes "
         "order).  Its homogeneous cooling state is unstable: vortices, then density clusters, "
-        "grow from the longest wavelengths, and Haff's law stops describing the cooling"
+        "grow from the longest wavelengths, and "
     )
-    temperature = float(scene.temperature)
-    mass = float(np.mean(scene.masses))
+    growth = _ONSET_SHARE * d * n / (2 * d * (d - 1))
+    if law:
+        text += (
+            "the viscoelastic cooling law stops describing the cooling.  The gas grows more "
+            "elastic as it cools, and L_c with it"
+        )
+        u, t, cpp, log_growth = _law_outlook(scene.restitution, scene, big, radius, density, growth)
+        tau0 = theory.viscoelastic_tau0(
+            a_kappa=scene.restitution,
+            density=density,
+            radius=radius,
+            temperature0=temperature,
+            mass=mass,
+            dim=d,
+            eta=eta,
+        )
+        when = f"t = {t:.3g} (t/tau0' = {t / tau0:.3g}, {cpp:.3g} collisions per particle)"
+        if log_growth >= math.log(growth) * (1 - 1e-9):
+            text += (
+                f"; in linear theory the slowest shear modes reach {_ONSET_SHARE:.0%} of the "
+                f"kinetic energy at about {when}"
+            )
+        else:
+            share = _ONSET_SHARE * math.exp(log_growth) / growth
+            text += (
+                f"; in linear theory L_c outgrows the box at about {when}, T = "
+                f"{temperature * math.exp(-u):.3g}, when the slowest shear modes peak at "
+                f"{100 * share:.2g}% of the kinetic energy"
+            )
+        # every run is warned: linear theory's onset is no bound for a law's gas (above)
+        return text + _ADVICE, 0.0, 0.0
+    text += "Haff's law stops describing the cooling"
     t_star = cpp = math.inf
     if xi > 0 and temperature > 0:
         tau0 = float(theory.haff_tau0(density, radius, float(xi), temperature, mass, d, eta))
         omega0 = float(theory.collision_frequency(density, radius, temperature, mass, d, eta))
-        growth = _ONSET_SHARE * d * n / (2 * d * (d - 1))
         exponent = 2 * (1 - (lc / big) ** 2)
         if growth > 1:
             t_star = tau0 * (growth ** (1 / exponent) - 1)
@@ -472,8 +621,10 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
                 f"{cpp:.3g} collisions per particle; linear theory: the slowest shear modes "
                 f"reach {_ONSET_SHARE:.0%} of the kinetic energy)"
             )
-    text += (
-        ".  Use a box below L_c (fewer particles at the same density) for homogeneous "
-        "cooling, or measure the flow with granular.clustering.flow_energy."
-    )
-    return text, t_star, cpp
+    return text + _ADVICE, t_star, cpp
+
+
+_ADVICE = (
+    ".  Use a box below L_c (fewer particles at the same density) for homogeneous "
+    "cooling, or measure the flow with granular.clustering.flow_energy."
+)

@@ -80,7 +80,8 @@ class ClusteringWarning(UserWarning):
     """A granular gas in a periodic box beyond the critical size of the shear instability
     (``granular.theory.critical_box_size``): its homogeneous cooling will end (vortices,
     then clusters) and Haff's law will fail.  Issued once per Simulation, by the first
-    ``run`` that can reach the onset t* (``granular.clustering.unstable_box``)."""
+    ``run`` that can reach the onset t* (``granular.clustering.unstable_box``); for a
+    ``Viscoelastic`` law, judged at its effective restitution, by the first run."""
 
 
 class CheckpointError(GranularError, ValueError):

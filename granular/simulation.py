@@ -156,12 +156,11 @@ class Simulation:
             return (checkpoint.loads, (checkpoint.dumps(self),))
 
     @contextlib.contextmanager
-    def _exclusive(self):
-        """Hold the run lock, or raise RuntimeError if a run holds it."""
+    def _exclusive(self, instead: str = "save or copy it between runs"):
+        """Hold the run lock, or raise RuntimeError if a run holds it, saying what to do
+        ``instead``."""
         if not self._running.acquire(blocking=False):
-            raise RuntimeError(
-                "another thread is running this Simulation; save or copy it between runs"
-            )
+            raise RuntimeError(f"another thread is running this Simulation; {instead}")
         try:
             yield
         finally:
@@ -262,6 +261,10 @@ class Simulation:
         HeatedWallsError
             If heated walls (``wall_restitution > 1``) pumped the energy up beyond what
             float64 event times can resolve.
+        GranularError, KeyboardInterrupt
+            Every error of the run, and Ctrl-C (seen between chunks of events, the state
+            intact), carry ``.trajectory``: the samples taken so far, with ``stop_reason``
+            ``"error"`` or ``"interrupted"``.
 
         Warns
         -----
@@ -269,19 +272,18 @@ class Simulation:
             On the first run of a granular gas (constant xi < 1) in a periodic box beyond
             the critical size of the shear instability (``granular.clustering``) that can
             reach the instability's onset t* (by ``t_stop`` or the collisions per particle
-            asked for; a run to an energy or an event count may).
+            asked for; a run to an energy or an event count may); for a ``Viscoelastic``
+            law, on the first run if the box is beyond the critical size at the law's
+            effective restitution at the present temperature
+            (``granular.clustering.effective_restitution``).
         """
         if not getattr(self, "_clustering_checked", False):  # also for restored Simulations
             self._warn_clustering(t_stop, stop_when)
-        if not self._running.acquire(blocking=False):
-            raise RuntimeError(
-                "another thread is running this Simulation; a Simulation runs one run at a "
-                "time (wait for it, or give each thread its own Simulation(scene))"
-            )
-        try:
+        with self._exclusive(
+            "a Simulation runs one run at a time (wait for it, or give each thread its own "
+            "Simulation(scene))"
+        ):
             return self._run(t_stop, sample_times, stop_when, store, progress)
-        finally:
-            self._running.release()
 
     def _run(self, t_stop, sample_times, stop_when, store, progress):
         crit = dict(stop_when or {})
@@ -383,7 +385,8 @@ class Simulation:
         except (GranularError, KeyboardInterrupt) as exc:
             # keep what was sampled: every sample time up to the engine's clock is written
             k = int(np.searchsorted(times, self.time, side="right"))
-            trajectory = self._trajectory(times[:k], buf, k, "error")
+            why = "interrupted" if isinstance(exc, KeyboardInterrupt) else "error"
+            trajectory = self._trajectory(times[:k], buf, k, why)
             heated = self._heated_walls_error(exc, energy0)
             if heated is not None:
                 heated.trajectory = trajectory

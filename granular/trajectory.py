@@ -31,8 +31,9 @@ class Trajectory:
     pair_collisions, wall_collisions : (T,) cumulative counts since the simulation began
     virial : (T,) cumulative sum over pair collisions of r_ij . dp_j
     wall_impulse : (T,) cumulative normal momentum given to the walls
-    stop_reason : why the run ended: "time", "collisions", "kinetic_energy", "events"
-        or "idle" (no event will ever happen)
+    stop_reason : why the run ended: "time", "collisions", "kinetic_energy", "events",
+        "idle" (no event will ever happen); a run cut short carries the samples so far in
+        its exception's ``.trajectory``, with "error" or, after Ctrl-C, "interrupted"
     masses, radii, lower, upper, boundary : copied from the scene
     """
 

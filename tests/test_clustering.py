@@ -320,8 +320,83 @@ def test_no_clustering_warning(n, restitution, boundary):
         granular.Simulation(_gas(n, restitution, boundary)).run(t_stop=1e-3)
 
 
+def _viscoelastic_disks(n, radius, delta0=0.1):
+    """2D disks in the unit box with the viscoelastic law of delta(T0) = delta0."""
+    gas = granular.Scene.random(n, radius, dim=2, seed=1)
+    law = granular.Viscoelastic(delta0 / (4 * gas.temperature) ** 0.1, 1.0)
+    return gas.replace(restitution=law)
+
+
+def test_clustering_warning_for_a_viscoelastic_gas_at_its_effective_restitution():
+    """N = 1000 disks of r = 0.005 in the unit box (eta = 0.079), delta(T0) = 0.1: the law
+    cools like a constant xi_eff = 0.888, whose L_c = 0.75 < 1 (such a gas runs 5-7 % warmer
+    than the cooling law).  The first run is warned at any length (linear theory's onset
+    is no bound for a gas whose L_c grows as it cools), with xi_eff and its L_c."""
+    scene = _viscoelastic_disks(1000, 0.005)
+    xi = clustering.effective_restitution(scene.restitution, scene.temperature)
+    lc = theory.critical_box_size(1000, 0.005, xi, 2, eta=scene.packing_fraction)
+    assert lc < 1
+    with pytest.warns(granular.ClusteringWarning) as record:
+        granular.Simulation(scene).run(t_stop=1e-3)
+    message = str(record[0].message)
+    for number in ("L = 1", f"L_c = {lc:.4g}", f"xi = {xi:.4g}", f"T = {scene.temperature:.4g}"):
+        assert number in message
+    assert "effective restitution" in message and "viscoelastic" in message
+    assert record[0].filename == __file__
+    # linear theory's outlook: here L_c(T) outgrows the box first; in a box 3.5 L_c the
+    # slowest shear modes reach the onset share
+    assert "L_c outgrows the box at about t = " in message
+    far = clustering.unstable_box(_viscoelastic_disks(4000, 0.0025, delta0=0.2))[0]
+    assert "reach 5% of the kinetic energy at about t = " in far
+
+
+def test_no_clustering_warning_for_a_viscoelastic_gas_below_its_critical_box():
+    """N = 500 disks of r = 0.007 (eta = 0.077), delta(T0) = 0.1: L_c(xi_eff) = 1.07 > 1."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        granular.Simulation(_viscoelastic_disks(500, 0.007)).run(t_stop=1e-3)
+
+
+def test_effective_restitution_is_the_energy_weighted_thermal_mean():
+    """1 - xi_eff^2 = <(1 - eps(g)^2) g^2> / <g^2> over a Maxwellian's collisions, g with
+    density (g/s^2) exp(-g^2/2s^2), s^2 = 2T/m: against scipy's adaptive quadrature (to
+    1e-12), and at small delta against the cooling theory's series, 1 - xi_eff^2 = 2 C1
+    Gamma(21/10) delta - (C1^2 + 2 C2) Gamma(11/5) delta^2 + O(delta^3) (the dropped
+    terms, ~10 delta^3, stay below 2e-5 at delta = 0.01).  At delta(T) = 0.2 and 0.3 a
+    fair share of the collisions is past max_speed (delta = 0.25), where eps is clamped."""
+    from scipy import integrate
+
+    mass = 2.0
+    for delta, temperature in ((0.01, 0.5), (0.1, 3.0), (0.2, 1.0), (0.3, 1.0)):
+        law = granular.Viscoelastic(delta / (4 * temperature / mass) ** 0.1, 1.0)
+        xi = clustering.effective_restitution(law, temperature, mass)
+        s2 = 2 * temperature / mass
+
+        def weight(g, law=law, s2=s2):
+            return (1 - law(g) ** 2) * g**3 * np.exp(-(g**2) / (2 * s2)) / (2 * s2**2)
+
+        top = 40 * math.sqrt(s2)
+        kink = [law.max_speed] if law.max_speed < top else None
+        loss = integrate.quad(weight, 0, top, epsabs=0, epsrel=1e-13, points=kink)[0]
+        assert 1 - xi**2 == pytest.approx(loss, rel=1e-12)
+        if delta == 0.01:
+            c1, c2 = theory.VISCOELASTIC_C1, theory.VISCOELASTIC_C2
+            series = (
+                2 * c1 * math.gamma(2.1) * delta - (c1**2 + 2 * c2) * math.gamma(2.2) * delta**2
+            )
+            assert 1 - xi**2 == pytest.approx(series, abs=2e-5)
+    assert clustering.effective_restitution(0.7, 1.0) == 0.7
+    np.testing.assert_allclose(
+        clustering.effective_restitution(law, [1.0, 2.0]),
+        [clustering.effective_restitution(law, 1.0), clustering.effective_restitution(law, 2.0)],
+    )
+    with pytest.raises(ValueError, match="temperatures > 0"):
+        clustering.effective_restitution(law, 0.0)
+
+
 def test_no_warning_for_a_restitution_that_is_not_a_number():
-    """Restitution law objects (velocity-dependent restitution) are left alone."""
+    """Restitution law objects other than Viscoelastic (a table has no cooling theory here)
+    are left alone."""
 
     class Law:
         pass

@@ -13,7 +13,15 @@ import pytest
 from scipy import stats
 
 import granular
-from granular import Scene, Simulation, TabulatedRestitution, Viscoelastic, langevin, theory
+from granular import (
+    Scene,
+    Simulation,
+    TabulatedRestitution,
+    Viscoelastic,
+    clustering,
+    langevin,
+    theory,
+)
 
 from helpers.margins import diffusion_margin
 
@@ -127,15 +135,17 @@ def test_viscoelastic_gas_is_in_range_and_below_the_critical_box(cooling_runs):
     """The runs stay where the law and the cooling theory hold: no collision beyond the
     series' delta = 0.25 (max_speed = 160 against a thermal speed of 1.4: a Maxwellian
     pair exceeds it with probability exp(-160^2 / (4 T0)), i.e. never), and the box is
-    below the critical size of the shear instability even for the most inelastic moment,
-    eps_eff = 1 - C1 Gamma(21/10) delta(T0) at T0 (the gas grows more elastic as it cools,
-    and L_c falls with growing eps)."""
+    below the critical size of the shear instability even at its most inelastic, at T0:
+    L_c at the law's effective restitution there (the constant xi that cools as fast,
+    0.888) is 2.07, and L_c only grows as the gas cools and grows more elastic.  So the
+    ClusteringWarning has nothing to say."""
     r = cooling_runs
     assert r["clamped"] == 0
     eq = r["eq"]
-    eps_eff = 1 - theory.VISCOELASTIC_C1 * math.gamma(2.1) * DELTA0
-    lc = theory.critical_box_size(DENSITY, R, eps_eff, eta=eq.packing_fraction)
+    xi_eff = clustering.effective_restitution(r["law"], eq.temperature)
+    lc = theory.critical_box_size(DENSITY, R, xi_eff, eta=eq.packing_fraction)
     assert eq.upper[0] - eq.lower[0] < 0.5 * lc
+    assert clustering.unstable_box(eq.replace(restitution=r["law"])) is None
 
 
 def test_viscoelastic_gas_cools_as_the_second_order_theory(cooling_runs):
