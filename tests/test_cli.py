@@ -70,11 +70,11 @@ def _euler_maruyama_margin():
     (granular.langevin); the MSD and the time-averaged MSD by at most that.  For the
     largest gamma0 of the quick reproduction's Langevin systems."""
     from granular import theory
-    from granular.cli import reproduce
+    from granular.cli import reproduce, reproduce_text
 
     cfg = reproduce.Config(quick=True)
     g = max(
-        theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, reproduce.THESIS_T0).gamma0
+        theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, reproduce_text.THESIS_T0).gamma0
         for xi in (1.0, 0.8, 0.5)
     )
     return 2 / (2 - g * 0.01) - 1
@@ -220,7 +220,7 @@ def test_reproduce_quick(tmp_path):
     over runs agrees with theory within its error bars and the theory's stated accuracy
     (REPRODUCE_MARGINS), energy is conserved to rounding, and report.md's verdicts are the
     ones the numbers give."""
-    from granular.cli import reproduce
+    from granular.cli import reproduce_text
 
     run("reproduce", "--quick", "--out", "rep", cwd=tmp_path)
     rows = {r["id"]: r for r in strict_json(tmp_path / "rep" / "summary.json")}
@@ -263,7 +263,7 @@ def test_reproduce_quick(tmp_path):
     for r in statistical:
         sentence = re.search(rf"^- `{re.escape(r['id'])}`.*$", report, re.M).group(0)
         z = (r["ours"] - r["theory"]) / r["ours_error"]
-        verdict = "agrees within" if abs(z) <= reproduce.SIGMA else "differs by"
+        verdict = "agrees within" if abs(z) <= reproduce_text.SIGMA else "differs by"
         assert f"theory {r['theory']:.4g}: {verdict}" in sentence, sentence
     pngs = {p.name for p in (tmp_path / "rep").glob("*.png")}
     assert len(pngs) >= 27 and "fig4_23_ergodicity_udsbm_tstop.png" in pngs
@@ -274,3 +274,84 @@ def test_reproduce_quick(tmp_path):
     assert (
         math.isfinite(rows["ergodicity.udsbm"]["theory"]) and rows["ergodicity.udsbm"]["theory"] < 1
     )
+
+
+# -- the command line's pages and the reproduction's progress ---------------------------------
+
+
+def _subcommands():
+    import argparse
+
+    from granular.__main__ import _parser
+
+    (sub,) = [a for a in _parser()._actions if isinstance(a, argparse._SubParsersAction)]
+    return sub.choices
+
+
+def test_every_subcommand_has_a_help_page_with_defaults(capsys):
+    """``python -m granular CMD --help`` says what CMD does and, for every option, its
+    default; the reproduction's page lists the experiments ``--only`` takes."""
+    from granular.__main__ import main
+    from granular.cli import reproduce
+
+    commands = _subcommands()
+    assert set(commands) == {"demo", "reproduce", "bench"}
+    for name, page in commands.items():
+        assert page.description and len(page.description) > 40, name
+        options = [a for a in page._actions if a.option_strings and a.dest != "help"]
+        assert options, name
+        undefaulted = [a.option_strings[0] for a in options if "(default: " not in (a.help or "")]
+        assert not undefaulted, f"{name}: options without their default: {undefaulted}"
+        with pytest.raises(SystemExit) as done:
+            main([name, "--help"])
+        assert done.value.code == 0
+        text = capsys.readouterr().out
+        assert page.description.split()[0] in text and "(default: " in text
+    with pytest.raises(SystemExit):
+        main(["reproduce", "--help"])
+    page = capsys.readouterr().out
+    assert list(reproduce.ABOUT) == list(reproduce.FIGURES)
+    for name, (what, *_) in reproduce.ABOUT.items():
+        assert re.search(rf"^  {re.escape(name)} +{re.escape(what)}$", page, re.M), name
+
+
+def test_reproduce_refuses_an_unknown_experiment_listing_the_valid_ones(tmp_path, capsys):
+    """An unknown ``--only`` name stops before any work, naming every valid one; from
+    Python too (``main(only=...)``), before the output folder is made."""
+    from granular.__main__ import main
+    from granular.cli import reproduce
+
+    with pytest.raises(SystemExit) as done:
+        main(["reproduce", "--only", "4.x", "--out", str(tmp_path / "rep")])
+    assert done.value.code == 2
+    err = capsys.readouterr().err
+    assert "'4.x'" in err and all(repr(name) in err for name in reproduce.FIGURES)
+    with pytest.raises(ValueError, match=r"unknown experiment 'nope'; choose from 4\.1, ") as e:
+        reproduce.main(out=str(tmp_path / "rep"), only=["4.1", "nope"])
+    assert all(name in str(e.value) for name in reproduce.FIGURES)
+    assert not (tmp_path / "rep").exists()
+
+
+@pytest.mark.slow  # a fresh interpreter and two small experiments: 3-5 s
+def test_reproduce_only_runs_the_named_experiments_saying_each_first(tmp_path):
+    """``--only`` runs just the experiments named, in the thesis' order; before each, a line
+    on stderr says which (i of n), what it shows and its expected time; the summary and the
+    report hold only their rows and sections."""
+    from granular.cli import reproduce
+
+    out = run(
+        "reproduce", "--quick", "--only", "4.9", "--only", "4.1", "--out", "rep", cwd=tmp_path
+    )
+    lines = [line for line in out.stderr.splitlines() if line.startswith("[")]
+    assert len(lines) == 2, out.stderr
+    for i, name in enumerate(("4.1", "4.9")):
+        what, _, quick = reproduce.ABOUT[name]
+        assert lines[i].startswith(f"[{i + 1}/2] {name}: {what} (expected ~{quick:g} s"), lines
+    assert "expected ~" in out.stderr.splitlines()[0]  # the total, first
+    assert {p.name for p in (tmp_path / "rep").glob("*.png")} == {
+        "fig4_1_head_on.png",
+        "fig4_9_clusters_2d.png",
+    }
+    assert strict_json(tmp_path / "rep" / "summary.json") == []
+    report = (tmp_path / "rep" / "report.md").read_text()
+    assert "### Energy" not in report and "![fig4_9_clusters_2d.png]" in report
