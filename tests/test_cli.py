@@ -180,6 +180,10 @@ def test_demo_quick(tmp_path):
     assert (tmp_path / "demo" / "brownian_msd.png").stat().st_size > 10_000
     (b,) = strict_json(tmp_path / "demo" / "brownian.json")
     assert "Brownian tracer" in out.stdout and "correlated collisions" in out.stdout
+    # the ratio said to be at t = 1/gamma is sampled there, and the line says the time
+    assert b["t_one_over_gamma"] == pytest.approx(1 / b["gamma_theory"], rel=1e-12)
+    assert f"at t = 1/gamma = {b['t_one_over_gamma']:.3g}," in out.stdout
+    assert b["t_free_sample"] == pytest.approx(b["t_free"], rel=1e-12)
     assert_agrees(
         "tracer MSD(1/gamma) / Langevin",
         b["msd_ratio_one_over_gamma"],

@@ -191,7 +191,17 @@ def brownian(out, quick=False, runs=None, backend="processes"):
     )
     anim.save(os.path.join(out, "brownian.gif"), dpi=60 if quick else 70)
 
-    times = np.concatenate([[0.0], np.logspace(-1, math.log10(t_msd), 30)])
+    # the walls: the tracer's centre stays within a = 3 - R of the middle; its MSD from the
+    # middle saturates at the mean square distance of a uniform square, 2 a^2 / 3, and the
+    # walls are not felt while 3 standard deviations of free diffusion stay inside a
+    a = 3.0 - float(scene.radii[0])
+    plateau = 2 * a * a / 3
+    t_free = (a / 3) ** 2 / (2 * c.D0)
+    # log-spaced samples, and the two times the ratios are quoted at, exactly
+    times = np.unique(
+        np.concatenate([[0.0, 1 / c.gamma0, t_free], np.logspace(-1, math.log10(t_msd), 30)])
+    )
+    times = times[times <= t_msd]
     res = ensemble(
         functools.partial(tracer_run, times=times),
         runs,
@@ -204,16 +214,10 @@ def brownian(out, quick=False, runs=None, backend="processes"):
         raise RuntimeError(f"{len(res.failures)} runs failed: {res.failures[0]}")
     v0_sq = float(res.mean["v0_sq"])
     msd_th = theory.msd_langevin(times, c.D0, c.gamma0, dim=2, v0_sq=v0_sq)
-    # the walls: the tracer's centre stays within a = 3 - R of the middle; its MSD from the
-    # middle saturates at the mean square distance of a uniform square, 2 a^2 / 3, and the
-    # walls are not felt while 3 standard deviations of free diffusion stay inside a
-    a = 3.0 - float(scene.radii[0])
-    plateau = 2 * a * a / 3
-    t_free = (a / 3) ** 2 / (2 * c.D0)
     k_free = int(np.searchsorted(times, t_free, side="right")) - 1
     ratio = res.mean["msd"][1:] / msd_th[1:]
     ratio_err = res.error["msd"][1:] / msd_th[1:]
-    k1 = int(np.argmin(np.abs(times[1:] - 1 / c.gamma0))) + 1
+    k1 = int(np.searchsorted(times, 1 / c.gamma0))  # a sample time
     row = dict(
         runs=res.count,
         density=density,
@@ -233,7 +237,8 @@ def brownian(out, quick=False, runs=None, backend="processes"):
         f"Brownian tracer (R = 0.5, M = 25 among 150 disks, bulk n = {density:.3f}): "
         f"kinetic theory gamma = {c.gamma0:.3f}, D = {c.D0:.4f}; MSD over {res.count} runs / "
         f"Langevin: {row['msd_ratio_one_over_gamma']:.3f} +- "
-        f"{row['msd_ratio_one_over_gamma_error']:.3f} at t = 1/gamma, "
+        f"{row['msd_ratio_one_over_gamma_error']:.3f} at t = 1/gamma = "
+        f"{row['t_one_over_gamma']:.3g}, "
         f"{row['msd_ratio_free']:.3f} +- {row['msd_ratio_free_error']:.3f} at t = "
         f"{row['t_free_sample']:.3g} (walls felt beyond ~{t_free:.3g}).\n  Enskog's friction "
         "holds at short times; later, correlated collisions lower it and the tracer diffuses "
