@@ -16,6 +16,8 @@ import sys
 import pytest
 from scipy import stats
 
+from granular.cli.reproduce import FIGURES
+
 from helpers.margins import haff_margin, msd_margin_bound, tracer_langevin_margin
 
 FALSE_ALARM = 1e-4  # per check, two-sided
@@ -359,3 +361,153 @@ def test_reproduce_only_runs_the_named_experiments_saying_each_first(tmp_path):
     assert strict_json(tmp_path / "rep" / "summary.json") == []
     report = (tmp_path / "rep" / "report.md").read_text()
     assert "### Energy" not in report and "![fig4_9_clusters_2d.png]" in report
+
+
+def test_demo_draws_each_gas_over_its_theory_with_error_bars():
+    """Below the log-log panels the demo draws ours / theory with the standard errors over
+    theory, where deviations of a few percent (the ones its printed lines quote) show."""
+    from types import SimpleNamespace
+
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from granular.cli import demo
+
+    times = np.array([0.0, 0.1, 1.0, 10.0])
+    theory_values = np.array([0.0, 0.2, 2.0, 20.0])
+    results = {}
+    for label, excess in (("molecular", 1.04), ("granular", 1.08)):
+        res = SimpleNamespace(
+            mean={"msd": excess * theory_values, "temperature": np.ones(4)},
+            error={"msd": 0.01 * theory_values, "temperature": np.zeros(4)},
+        )
+        results[label] = (res, theory_values, np.ones(4), None)
+    fig, ax = plt.subplots()
+    demo._ratio(ax, times, results, "msd")
+    bars = [c for c in ax.containers if hasattr(c, "has_yerr") and c.has_yerr]
+    assert len(bars) == 2
+    for bar, excess in zip(bars, (1.04, 1.08), strict=True):
+        x, y = bar.lines[0].get_data()
+        np.testing.assert_allclose(x, times[1:])
+        np.testing.assert_allclose(y, excess)
+        (segments,) = bar.lines[2]
+        spans = np.array([s[1, 1] - s[0, 1] for s in segments.get_segments()])
+        np.testing.assert_allclose(spans, 2 * 0.01)  # +- error / theory
+    assert "theory" in ax.get_ylabel() and "dimensionless" in ax.get_ylabel()
+    plt.close(fig)
+
+
+# -- what the figures say ----------------------------------------------------------------------
+
+
+def _mathtext_free(text):
+    """``text`` without its $...$ parts (mathtext subscripts have underscores)."""
+    return re.sub(r"\$[^$]*\$", "", text)
+
+
+def figure_text_problems(fig):
+    """What a reader of ``fig`` would trip over: an equation number without its source
+    ("(2.68)" rather than "[G20] eq. 2.68"), a Python name in a legend, a unit written
+    "(length^2)" rather than in the figures' [L^2] style, PBC/RBC not spelt out, an axis
+    with ticks but no tick labels."""
+    problems = []
+    fig.canvas.draw()  # tick labels are made when drawn
+
+    def labelled(ax):
+        return any(t.get_text() for t in ax.get_xticklabels())
+
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        texts = [ax.get_title(), ax.get_xlabel(), ax.get_ylabel()]
+        texts += [t.get_text() for t in legend.get_texts()] if legend else []
+        for text in filter(None, texts):
+            plain = _mathtext_free(text)
+            if re.search(r"(?<!eq\. )\(\d\.\d+\)", text):
+                problems.append(f"equation without its source: {text!r}")
+            if re.search(r"\b[a-z]+_[a-z_]+\b", plain):
+                problems.append(f"a Python name: {text!r}")
+            if "(length" in plain or "units of the scene" in plain:
+                problems.append(f"unit not in the [L] style: {text!r}")
+            if re.search(r"\b[PR]BC\b", plain) and not re.search(r"periodic|walls", plain):
+                problems.append(f"PBC/RBC unexplained: {text!r}")
+        # an axis shared with a panel below may leave its labels to that panel
+        shared = ax.get_shared_x_axes().get_siblings(ax)
+        if ax.get_xticks().size and not any(labelled(a) for a in shared):
+            problems.append(f"no tick labels on {ax.get_title()!r}")
+    return problems
+
+
+def test_figure_text_problems_are_found():
+    """The checker finds what it looks for (so the tests below can fail)."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([1, 2], [1, 2], label="msd_viscoelastic_second_order")
+    ax.plot([1, 2], [2, 1], label="(2.68)")
+    ax.set_ylabel("MSD (length$^2$)")
+    ax.set_title("PBC, t = 2.5")
+    ax.set_xticks([1, 2], ["", ""])
+    ax.legend()
+    assert len(figure_text_problems(fig)) == 5
+    plt.close(fig)
+
+
+# the experiments that take more than 3 s at quick sizes
+SLOW_FIGURES = ("4.11-4.16+F", "4.17-4.23", "clustering", "viscoelastic")
+
+
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_FIGURES else n for n in FIGURES],
+)
+def test_reproduced_figures_say_what_they_show(name, tmp_path, monkeypatch):
+    """Every figure of the reproduction (quick sizes), as drawn: no bare equation numbers,
+    Python names, off-style units, unexplained PBC/RBC or missing tick labels."""
+    from granular.cli import reproduce
+
+    drawn = []
+    save = reproduce._save
+
+    def keep(fig, out, file_name):
+        drawn.append((file_name, figure_text_problems(fig)))
+        return save(fig, out, file_name)
+
+    monkeypatch.setattr(reproduce, "_save", keep)
+    reproduce.figure(name, quick=True, out=str(tmp_path))
+    assert drawn
+    problems = {file_name: p for file_name, p in drawn if p}
+    assert not problems, problems
+
+
+@pytest.mark.slow  # four figures drawn: 3-8 s
+def test_demo_figures_say_what_they_show(tmp_path, monkeypatch):
+    """The demo's figures, drawn from a stand-in result, pass the same reading, and each
+    log-log panel has its ratio-to-theory panel below."""
+    from types import SimpleNamespace
+
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from granular.cli import demo
+
+    times = np.array([0.0, 0.1, 1.0, 10.0])
+    rng = np.random.default_rng(2)
+    results = {}
+    for label in ("molecular", "granular"):
+        res = SimpleNamespace(
+            mean={"msd": times + 0.1, "temperature": np.ones(4)},
+            error={"msd": 0.01 * times, "temperature": np.full(4, 0.01)},
+            runs=[{"velocities": rng.normal(size=(4, 50, 3))} for _ in range(3)],
+            times=times,
+        )
+        results[label] = (res, times + 0.1, np.ones(4), SimpleNamespace(tau0=1.0))
+    seen = {}
+
+    def keep(fig, path, **kwargs):  # read, not written
+        seen[str(path).rsplit("/", 1)[-1]] = (figure_text_problems(fig), len(fig.axes))
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    names = demo._figures(str(tmp_path), times, results)
+    assert set(names) == set(seen) == {"demo.png", "msd.png", "temperature.png", "speeds.png"}
+    assert {name: p for name, (p, _) in seen.items() if p} == {}
+    assert seen["demo.png"][1] == 4 and seen["msd.png"][1] == seen["temperature.png"][1] == 2

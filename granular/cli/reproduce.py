@@ -78,6 +78,10 @@ class Config:
         self.c_speed = 0.2  # collisions per particle per particle (c_stop = 0.2 N)
 
 
+# the thesis' names of the boundaries, spelt out where a figure shows them
+BOUNDARY_NAMES = (("periodic", "periodic box (PBC)"), ("walls", "reflecting walls (RBC)"))
+
+
 def _checked_ensemble(*args, **kwargs):
     return _checked(ensemble(*args, **kwargs))
 
@@ -175,7 +179,7 @@ def _fig_4_2_to_4_4(cfg, out):
             )
     fig, ax = _fig()
     drifts = []
-    for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
+    for boundary, name in BOUNDARY_NAMES:
         r = res[boundary, 1.0]
         rel = np.array([run["kinetic_energy"] / run["kinetic_energy"][0] - 1 for run in r.runs])
         drifts.append(np.max(np.abs(rel)))
@@ -187,7 +191,7 @@ def _fig_4_2_to_4_4(cfg, out):
     names = [_save(fig, out, "fig4_2_energy.png")]
     for xi, fig_no in ((1.0, "4_3"), (0.8, "4_4")):
         fig, ax = _fig()
-        for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
+        for boundary, name in BOUNDARY_NAMES:
             r = res[boundary, xi]
             ax.errorbar(
                 t,
@@ -265,9 +269,9 @@ def _fig_4_8_and_4_10(cfg, out):
     names, rows = [], []
     fig, ax = _fig()
     for label, boundary, wall_e in (
-        ("PBC", "periodic", 1.0),
-        ("RBC", "walls", 1.0),
-        ("RBC, inelastic walls", "walls", 0.8),
+        (dict(BOUNDARY_NAMES)["periodic"], "periodic", 1.0),
+        (dict(BOUNDARY_NAMES)["walls"], "walls", 1.0),
+        ("reflecting walls, wall restitution 0.8", "walls", 0.8),
     ):
         eq = equilibrium_scene(cfg, boundary=boundary)
         s = eq.replace(restitution=0.8, wall_restitution=wall_e)
@@ -283,7 +287,7 @@ def _fig_4_8_and_4_10(cfg, out):
         ax.plot(t[1:], r.mean["temperature"][1:], label=label)
         T0 = eq.temperature
     c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, 0.8, T0)
-    ax.plot(t[1:], theory.haff_temperature(t[1:], T0, c.tau0), "k--", label="Haff (2.40)")
+    ax.plot(t[1:], theory.haff_temperature(t[1:], T0, c.tau0), "k--", label="Haff, [G20] eq. 2.40")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(plot.TIME)
@@ -332,7 +336,7 @@ def _fig_4_9(cfg, out):
     thesis used against collapse in 2D)."""
     fig, axes = _fig(4, size=(3.6, 3.6))
     k = 0
-    for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
+    for boundary, name in BOUNDARY_NAMES:
         s = Scene.random(
             cfg.n2, cfg.r2, dim=2, boundary=boundary, restitution=0.8, contact_duration=1e-3, seed=3
         )
@@ -343,9 +347,7 @@ def _fig_4_9(cfg, out):
                 warnings.simplefilter("ignore", ClusteringWarning)
                 sim.run(t_stop=t_snap, sample_times=[t_snap], store=())
             plot.snapshot(sim.scene.positions, s.radii, s.lower, s.upper, ax=axes[k])
-            axes[k].set_title(f"{name}, t = {t_snap}")
-            axes[k].set_xticks([])
-            axes[k].set_yticks([])
+            axes[k].set_title(f"{name}, t = {t_snap:g}", fontsize="medium")
             k += 1
     fig.suptitle(rf"Fig. 4.9: 2D granular gas, $\xi$ = 0.8, N = {cfg.n2}")
     return [_save(fig, out, "fig4_9_clusters_2d.png")], []
@@ -378,7 +380,7 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
         )
         c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, eq.temperature)
         th = theory.msd_granular(t, c.D0, c.gamma0, c.tau0)
-        equation = "(2.68)" if xi == 1 else "(2.79)"
+        equation = "[G20] eq. 2.68" if xi == 1 else "[G20] eq. 2.79"
         fig, ax = _fig()
         plot.msd(
             t,
@@ -492,7 +494,7 @@ def _fig_4_17_to_4_23(cfg, out):
             theory_values=th,
             ax=ax,
             label=r"Euler-Maruyama, $\Delta t$ = 0.01",
-            theory_label="(2.68)" if xi == 1 else "(2.113) + start",
+            theory_label="[G20] eq. 2.68" if xi == 1 else "[G20] eq. 2.113, initial speed √2",
         )
         ax.set_title(
             f"Fig. {fig_no.replace('_', '.')}: "
@@ -530,7 +532,7 @@ def _fig_4_17_to_4_23(cfg, out):
             )
             + ")",
         )
-    ax.plot(t_samples[1:], msd_theory(0.8, t_samples[1:]), "k--", label="theory")
+    ax.plot(t_samples[1:], msd_theory(0.8, t_samples[1:]), "k--", label="theory, [G20] eq. 2.113")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(plot.TIME)

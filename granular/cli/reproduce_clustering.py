@@ -211,7 +211,7 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax3.axvline(1.0, color="0.5", ls=":", label="critical size (theory)")
     ax3.axhline(0.0, color="k", lw=0.8)
     ax3.set_xlabel(r"box side over critical size, $L / L_c$ (dimensionless)")
-    ax3.set_ylabel(r"fitted $\tau_0$ / (2.45) - 1 (dimensionless)")
+    ax3.set_ylabel(r"fitted $\tau_0$ / [G20] eq. 2.45 $-$ 1 (dimensionless)")
     ax3.set_title(r"Haff's $\tau_0$ against box size (n = 1000, $\eta$ = 0.065)")
     ax3.legend()
     names.append(save(f3, out, "cluster_tau0_vs_box.png"))

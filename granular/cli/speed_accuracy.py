@@ -693,7 +693,7 @@ def _charts(out, points, refs, stab, cells, dense):
         )
     ax.axvline(2.0, color="r", ls=":", label=r"EM refused ($\gamma_0 \Delta t \geq 2$)")
     ax.set_xlabel(r"$\gamma_0 \Delta t$")
-    ax.set_ylabel("max relative MSD error vs (2.68)")
+    ax.set_ylabel("max relative MSD error vs [G20] eq. 2.68 (dimensionless)")
     ax.legend()
     fig.savefig(os.path.join(out, "em_stability.png"), dpi=110)
     plt.close(fig)
