@@ -53,6 +53,7 @@ from .. import (
     langevin,
     theory,
 )
+from ..restitution import matched_viscoelastic
 from ..simulation import _LIST_SHELL  # the shell of shell="auto": dense_cost measures it
 from .bench_langevin import log_lags
 from .output import write_json
@@ -290,51 +291,6 @@ def em_stability(quick=False):
                 row[f"{scheme}_v2_bias"] = None
         rows.append(row)
     return rows
-
-
-# The viscoelastic law's series holds for eps >= 0.76 only (granular.restitution.DELTA_MAX):
-# a constant xi is matched by a law only if at most this share of the initial collisions
-# would be faster than the law's max_speed (and get the clamped eps).
-MATCH_CLAMPED_SHARE = 0.01
-
-
-def matched_viscoelastic(xi, temperature, mass=1.0):
-    """The viscoelastic law with the same mean restitution as a constant xi, or None.
-
-    "Same mean restitution" as in tests/test_restitution.py's no-collapse test: eps(g)
-    averaged over the initial collisions of a gas at ``temperature``, whose normal relative
-    speeds g have the Rayleigh density g / s^2 exp(-g^2 / 2 s^2), s^2 = 2 T / m (collisions
-    weight the Gaussian normal relative velocity by g).  The mean falls with the damping
-    (bisection), down to about 0.76, the law's clamp: a xi whose matched law would send
-    more than ``MATCH_CLAMPED_SHARE`` of the initial collisions past ``max_speed`` is
-    outside the law's range, and None is returned with the reason.
-
-    Returns
-    -------
-    (law or None, dict)
-        The law (kappa = 1, the damping found) and {"mean_eps", "clamped_share"}; or None
-        and the share the closest law reached.
-    """
-    sd = math.sqrt(2.0 * temperature / mass)
-    g = np.linspace(0.0, 12 * sd, 20_001)
-    weight = g / sd**2 * np.exp(-(g**2) / (2 * sd**2))
-
-    def mean_eps(damping):
-        return float(np.trapezoid(Viscoelastic(damping, 1.0)(g) * weight, g))
-
-    def clamped(law):
-        return math.exp(-(law.max_speed**2) / (2 * sd**2))  # Rayleigh tail beyond max_speed
-
-    lo, hi = 1e-6, 10.0
-    if mean_eps(hi) > xi:  # even the strongest damping keeps the mean above xi
-        law = Viscoelastic(hi, 1.0)
-        return None, dict(mean_eps=mean_eps(hi), clamped_share=clamped(law))
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if mean_eps(mid) > xi else (lo, mid)
-    law = Viscoelastic(lo, 1.0)
-    info = dict(mean_eps=mean_eps(lo), clamped_share=clamped(law))
-    return (law if info["clamped_share"] <= MATCH_CLAMPED_SHARE else None), info
 
 
 # The collapse map's goal: at 100 collisions per particle constant xi = 0.8 does not yet
