@@ -338,6 +338,23 @@ def test_reproduce_refuses_an_unknown_experiment_listing_the_valid_ones(tmp_path
     assert not (tmp_path / "rep").exists()
 
 
+def test_progress_scales_the_reference_time_by_the_pace_so_far():
+    """On a busy machine the expected time of the next experiment is its reference time
+    times how much slower the experiments done so far ran than theirs."""
+    from granular.cli import reproduce
+
+    assert reproduce._pace(2.0, 4.0) == 1.0  # too little done to tell
+    assert reproduce._pace(30.0, 10.0) == 3.0
+    reference = reproduce.ABOUT["4.17-4.23"][1]
+    line = reproduce._progress(7, 9, "4.17-4.23", reproduce.Config(), pace=3.0)
+    assert line.startswith("[7/9] 4.17-4.23: ")
+    assert (
+        f"(expected ~{3 * reference:.0f} s: {reference:g} s on the reference machine x 3," in line
+    )
+    line = reproduce._progress(1, 9, "4.1", reproduce.Config(runs=2))
+    assert line.endswith("the reference machine's time, at the default run counts)")
+
+
 @pytest.mark.slow  # a fresh interpreter and two small experiments: 3-5 s
 def test_reproduce_only_runs_the_named_experiments_saying_each_first(tmp_path):
     """``--only`` runs just the experiments named, in the thesis' order; before each, a line
@@ -352,8 +369,8 @@ def test_reproduce_only_runs_the_named_experiments_saying_each_first(tmp_path):
     assert len(lines) == 2, out.stderr
     for i, name in enumerate(("4.1", "4.9")):
         what, _, quick = reproduce.ABOUT[name]
-        assert lines[i].startswith(f"[{i + 1}/2] {name}: {what} (expected ~{quick:g} s"), lines
-    assert "expected ~" in out.stderr.splitlines()[0]  # the total, first
+        assert lines[i].startswith(f"[{i + 1}/2] {name}: {what} (expected ~{quick:.0f} s"), lines
+    assert "s on the reference machine" in out.stderr.splitlines()[0]  # the total, first
     assert {p.name for p in (tmp_path / "rep").glob("*.png")} == {
         "fig4_1_head_on.png",
         "fig4_9_clusters_2d.png",

@@ -661,19 +661,21 @@ FIGURES = {
     "viscoelastic": _fig_visco,
 }
 
-# What each experiment shows (``--help`` lists them), and its wall time in seconds on a quiet
-# 2-core machine, at the thesis' sizes and with ``quick``: the progress line says it before the
-# experiment starts.  Other load on the cores stretches every one of them alike.
+# What each experiment shows (``--help`` lists them), and its wall time in seconds on the
+# reference machine, at the thesis' sizes and with ``quick``: one run each on a 2-core virtual
+# machine shared with other work -- the full run's first six experiments at a load average
+# below 2.5, its last three near 5; the quick run at 7-8.5.  Before each experiment the
+# progress line scales its time by how much slower or faster the ones done so far ran.
 ABOUT = {
-    "4.1": ("a head-on collision of two disks between walls", 1, 1),
-    "4.2-4.4": ("energy and collisions per particle, periodic and wall boxes", 4, 3),
-    "4.5-4.7": ("speed distributions in 2D and 3D against Maxwell-Boltzmann (Table 4.1)", 25, 3),
-    "4.8+4.10": ("Haff's law: three boundaries at xi = 0.8, then xi = 0.99, 0.5, 0.3", 8, 2),
-    "4.9": ("2D granular gas at t = 2.5 and 10: clusters in periodic and wall boxes", 1, 1),
-    "4.11-4.16+F": ("MSD, diffusivity and long-time slopes of the EDMD gas", 14, 2),
-    "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 20, 5),
-    "clustering": ("where homogeneous cooling ends: three boxes around L_c", 25, 14),
-    "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 10, 5),
+    "4.1": ("a head-on collision of two disks between walls", 0.7, 1.6),
+    "4.2-4.4": ("energy and collisions per particle, periodic and wall boxes", 4.1, 4.4),
+    "4.5-4.7": ("speeds in 2D and 3D against Maxwell-Boltzmann (Table 4.1)", 24.5, 4.4),
+    "4.8+4.10": ("Haff's law: three boundaries at xi = 0.8, then xi = 0.99, 0.5, 0.3", 7.6, 8.3),
+    "4.9": ("2D granular gas at t = 2.5 and 10: clusters in periodic and wall boxes", 0.4, 3.2),
+    "4.11-4.16+F": ("MSD, diffusivity and long-time slopes of the EDMD gas", 13.9, 19.1),
+    "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
+    "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
+    "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
 }
 
 
@@ -725,15 +727,25 @@ def _selected(only):
     return [name for name in FIGURES if name in only]
 
 
-def _progress(i, count, name, cfg):
-    """The line said before experiment ``name`` starts (to stderr: stdout keeps the results)."""
+def _pace(seconds_done, reference_done):
+    """How much slower than the reference this machine runs: the wall time of the
+    experiments done over their reference time, once that is long enough (5 s) to say;
+    1 before."""
+    return seconds_done / reference_done if reference_done >= 5.0 else 1.0
+
+
+def _progress(i, count, name, cfg, pace=1.0):
+    """The line said before experiment ``name`` starts (to stderr: stdout keeps the results):
+    what it shows and its reference time (``ABOUT``) times the ``pace`` so far."""
     what, full, quick = ABOUT[name]
-    expected = quick if cfg.quick else full
-    scaled = "" if cfg.runs_given is None else ", at the default run counts"
-    return (
-        f"[{i}/{count}] {name}: {what} (expected ~{expected:g} s on a quiet 2-core machine"
-        f"{scaled}; longer under load)"
+    reference = quick if cfg.quick else full
+    how = (
+        "the reference machine's time"
+        if pace == 1.0
+        else f"{reference:g} s on the reference machine x {pace:.2g}, the pace so far"
     )
+    runs = "" if cfg.runs_given is None else ", at the default run counts"
+    return f"[{i}/{count}] {name}: {what} (expected ~{reference * pace:.0f} s: {how}{runs})"
 
 
 def main(out="granular-reproduce", quick=False, runs=None, backend=None, only=None):
@@ -765,21 +777,26 @@ def main(out="granular-reproduce", quick=False, runs=None, backend=None, only=No
     matplotlib.use("Agg")
     cfg = Config(quick=quick, runs=runs, backend=backend)
     started = time.perf_counter()
-    expected = sum(ABOUT[name][2 if quick else 1] for name in selected)
+    reference = {name: ABOUT[name][2 if quick else 1] for name in selected}
     print(
-        f"reproducing {len(selected)} experiment(s) into {out}/, expected ~{expected:g} s in all "
-        "on a quiet 2-core machine",
+        f"reproducing {len(selected)} experiment(s) into {out}/: ~{sum(reference.values()):.0f} s "
+        "on the reference machine (2 cores), longer on a busy one",
         file=sys.stderr,
         flush=True,
     )
     names, rows = [], []
+    seconds_done = reference_done = 0.0
     for i, name in enumerate(selected, 1):
-        print(_progress(i, len(selected), name, cfg), file=sys.stderr, flush=True)
+        pace = _pace(seconds_done, reference_done)
+        print(_progress(i, len(selected), name, cfg, pace), file=sys.stderr, flush=True)
         t0 = time.perf_counter()
         n, r = _run(name, cfg, out)
         names += n
         rows += r
-        print(f"  Fig. {name:<12} {time.perf_counter() - t0:6.1f} s  {', '.join(n)}", flush=True)
+        seconds = time.perf_counter() - t0
+        seconds_done += seconds
+        reference_done += reference[name]
+        print(f"  Fig. {name:<12} {seconds:6.1f} s  {', '.join(n)}", flush=True)
     write_json(os.path.join(out, "summary.json"), rows)
     with open(os.path.join(out, "report.md"), "w") as f:
         f.write(report(rows, cfg, names, time.perf_counter() - started))
