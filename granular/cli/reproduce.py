@@ -430,6 +430,7 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
                 ax=ax,
                 loglog=False,
                 label="EDMD",
+                theory_label=equation,
             )
             if log:
                 ax.set_xscale("log")

@@ -517,6 +517,18 @@ COLLAPSE_STATUS = {
 }
 
 
+def _log_ticks(axis, limits):
+    """Ticks of a log axis that never collide: matplotlib labels every minor tick of an
+    axis spanning about a decade (2e-3, 3e-3, ... run into each other); such an axis gets
+    labels at 1, 2 and 5 times the powers of ten, and no minor labels."""
+    from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
+
+    axis.set_minor_formatter(NullFormatter())
+    if math.log10(limits[1] / limits[0]) < 1.5:
+        axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+        axis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False))
+
+
 def _em_chart(plt, out, stab):
     """em_stability.png: each scheme's MSD error against gamma0 dt (rows of ``em_stability``)."""
     fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
@@ -599,7 +611,6 @@ def _charts(out, points, refs, stab, cells, dense):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import NullFormatter
 
     gases = [
         g for g in ("granular", "molecular", "viscoelastic") if any(p["gas"] == g for p in points)
@@ -638,9 +649,8 @@ def _charts(out, points, refs, stab, cells, dense):
                         xytext=(3, 3),
                         textcoords="offset points",
                     )
-            # a log axis spanning less than a decade labels its minor ticks, which collide
-            ax.xaxis.set_minor_formatter(NullFormatter())
-            ax.yaxis.set_minor_formatter(NullFormatter())
+            for axis, limits in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+                _log_ticks(axis, limits)
             ax.set_xlabel("CPU seconds, one core (EDMD: equilibration included)")
             ax.set_ylabel(
                 (
