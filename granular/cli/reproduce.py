@@ -397,7 +397,11 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
         dims = [analysis.diffusivity(t, run["msd"]) for run in r.runs]
         dm, _ = analysis.ensemble_mean(dims)
         plot.diffusivity(t, dm, theory_values=c.D0 / (1 + t / c.tau0), ax=ax, label="EDMD")
-        ax.set_title(f"Fig. {fig_d.replace('_', '.')}: diffusivity, " + rf"$\xi$ = {xi:g}")
+        ax.set_title(
+            f"Fig. {fig_d.replace('_', '.')}: diffusivity, "
+            + rf"$\xi$ = {xi:g}; theory $D_0 / (1 + t/\tau_0)$",
+            fontsize="medium",
+        )
         names.append(_save(fig, out, f"fig{fig_d}_diffusivity_xi{xi}.png"))
         if xi in THESIS_SLOPES:
             log = xi < 1
