@@ -1,25 +1,35 @@
 # Two commands from a fresh machine (Python >= 3.10, pip, a C compiler):
-#   make demo   -- set up .venv and run the main job
-#   make test   -- set up .venv and run the whole test suite (CI)
+#   make demo   -- set up .venv with the plot extra only and run the main job
+#   make test   -- set up .venv with the test extra and run the whole test suite (CI)
 #   make test-quick -- the same without the tests marked slow, for daily work
 #   make lint   -- ruff check and ruff format --check (CI runs it before the tests)
 #   make docs   -- the documentation site into build/docs/html, failing on any warning
-# and for the C core: make test-asan (the suite against an ASan + UBSan build, in its own venv)
+# and for the C core: make test-asan (the suite against an ASan + UBSan build of it, in its own venv)
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
+SOURCES := pyproject.toml setup.py $(wildcard csrc/*.c csrc/*.h)
 
 .PHONY: setup demo test test-quick lint docs test-asan test-asan-ci bench clean
 
-$(VENV)/.installed: pyproject.toml setup.py $(wildcard csrc/*.c csrc/*.h)
+$(VENV)/.created:
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
+	touch $@
+
+# One venv, one marker per extra installed into it: the demo needs only matplotlib (the plot
+# extra, a few packages), not the test extra's ~130 (Jupyter, MDAnalysis, Dask, Sphinx, ...)
+$(VENV)/.installed-plot: $(SOURCES) | $(VENV)/.created
+	$(PY) -m pip install --quiet -e '.[plot]'
+	touch $@
+
+$(VENV)/.installed-test: $(SOURCES) | $(VENV)/.created
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $@
 
-setup: $(VENV)/.installed
+setup: $(VENV)/.installed-test
 
-demo: setup
+demo: $(VENV)/.installed-plot
 	$(PY) -m granular demo
 
 test: setup

@@ -13,7 +13,10 @@ What a frame shows, and why it is drawn that way:
 - in 3D a projection along one axis onto the plane of the other two, optionally only the
   slab ``|depth - z0| < w`` (minimum image in a periodic box);
 - trails of chosen particles from their unwrapped positions at every sample (not only the
-  frames shown), wrapped into the box and broken where they cross a periodic edge.
+  frames shown), wrapped into the box and broken where they cross a periodic edge;
+- the time in a strip above the box, never over a particle;
+- with ``color_by_speed`` each frame's speeds over its own rms speed unless a ``norm`` is
+  given: a cooling gas keeps its colours.
 """
 
 from __future__ import annotations
@@ -249,6 +252,7 @@ def animate(
     trails: int | Sequence[int] | NDArray[np.integer] | None = None,
     trail_length: int | None = None,
     color_by_speed: bool = False,
+    norm: Any = None,
     color: Any = "C0",
     trail_color: Any = "C3",
     plane: str | tuple[int, int] | None = None,
@@ -276,6 +280,11 @@ def animate(
         How many samples back a trail reaches (default: to the first sample).
     color_by_speed : bool
         Colour each disk by its speed at the sample (viridis, with a colour bar).
+    norm : matplotlib.colors.Normalize, optional
+        With ``color_by_speed``: the scale of speeds (units sqrt(epsilon / m)) onto colours,
+        the same in every frame, e.g. ``Normalize(0, 3)``.  By default each frame is coloured
+        by its speeds over its own root-mean-square speed (dimensionless), so that a cooling
+        gas keeps its contrast instead of fading into the low end of one fixed scale.
     color, trail_color : matplotlib colours
         Of the disks, and of the trail particles' disks and paths.
     plane : "xy", "xz", "yz" or a pair of axis numbers, 3D only
@@ -327,6 +336,8 @@ def animate(
     speeds = None
     if color_by_speed:
         speeds = np.linalg.norm(traj._need("velocities"), axis=-1)
+    elif norm is not None:
+        raise ValueError("norm sets the colours of speeds: pass color_by_speed=True with it")
 
     from matplotlib import colors as mcolors
     from matplotlib.collections import EllipseCollection
@@ -345,10 +356,17 @@ def animate(
     is_trail = np.zeros(n, dtype=bool)
     is_trail[trail_ids] = True
     if speeds is not None:
-        norm = mcolors.Normalize(0.0, float(speeds[samples].max()) or 1.0)
         from matplotlib import colormaps
 
         cmap = colormaps["viridis"]
+        speed_label = plot.SPEED
+        if norm is None:
+            # each sample's speeds over its rms speed: a cooling gas' speed distribution keeps
+            # its shape while its scale falls, so one fixed scale would fade to dark
+            rms = np.sqrt(np.mean(speeds**2, axis=-1, keepdims=True))
+            speeds = speeds / np.where(rms > 0, rms, 1.0)
+            norm = mcolors.Normalize(0.0, float(speeds[samples].max()) or 1.0)
+            speed_label = "speed / rms speed of the frame (dimensionless)"
     # a trail particle's disk is see-through, so that its own path shows across it
     trail_rgba = mcolors.to_rgba(trail_color, alpha=0.55)
     base = np.tile(mcolors.to_rgba(color), (n, 1))
@@ -364,15 +382,22 @@ def animate(
 
     disks = collection()
     # a periodic box: each disk's three nearest images in the plane (shifted by one box
-    # length towards the far side along each drawn axis, and along both); the axes span
-    # exactly the box, so only the parts that reach into it are seen
+    # length towards the far side along each drawn axis, and along both), clipped by the
+    # box (below), so only the parts that reach into it are seen
     images = [collection() for _ in range(3)] if periodic else []
     lines = [ax.plot([], [], "-", lw=1.2, color=trail_color, zorder=3)[0] for _ in trail_ids]
     outline = ax.add_patch(
         Rectangle((lo[ax0], lo[ax1]), length[ax0], length[ax1], fill=False, lw=1.5, clip_on=False)
     )
+    for c in (disks, *images):  # periodic images and wrapped disks end at the box' edges
+        c.set_clip_path(outline)
+    # the clock sits in a strip above the box, where it never covers a particle; the box'
+    # outline is the frame, the axes' own spines only carry the ticks along it
+    strip = 0.09 * length[ax1]
     ax.set_xlim(lo[ax0], hi[ax0])
-    ax.set_ylim(lo[ax1], hi[ax1])
+    ax.set_ylim(lo[ax1], hi[ax1] + strip)
+    ax.spines[["top", "right"]].set_visible(False)
+    ax.spines["left"].set_bounds(lo[ax1], hi[ax1])
     ax.set_aspect("equal")
     ax.set_xlabel(plot.POSITION.format("xyz"[ax0]))
     ax.set_ylabel(plot.POSITION.format("xyz"[ax1]))
@@ -381,19 +406,11 @@ def animate(
         title = title or f"{what} onto the {'xyz'[ax0]}{'xyz'[ax1]} plane"
     if title:
         ax.set_title(title, fontsize="medium")
-    clock = ax.text(
-        0.02,
-        0.98,
-        "",
-        transform=ax.transAxes,
-        va="top",
-        bbox=dict(boxstyle="round", fc="white", alpha=0.8, lw=0),
-        zorder=5,
-    )
+    clock = ax.text(lo[ax0], hi[ax1] + strip / 2, "", va="center", fontsize="small", zorder=5)
     if speeds is not None:
         from matplotlib.cm import ScalarMappable
 
-        fig.colorbar(ScalarMappable(norm, cmap), ax=ax, shrink=0.8, label=plot.SPEED)
+        fig.colorbar(ScalarMappable(norm, cmap), ax=ax, shrink=0.8, label=speed_label)
 
     def update(k):
         s = samples[k]

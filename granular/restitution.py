@@ -431,3 +431,60 @@ def from_description(description: float | dict) -> float | RestitutionLaw:
     if name not in _LAWS:
         raise ValueError(f"unknown restitution law {name!r}")
     return _LAWS[name](**args)
+
+
+# The viscoelastic law's series holds for eps >= 0.76 only (DELTA_MAX):
+# a constant xi is matched by a law only if at most this share of the initial collisions
+# would be faster than the law's max_speed (and get the clamped eps).
+MATCH_CLAMPED_SHARE: float = 0.01
+
+
+def matched_viscoelastic(
+    xi: float, temperature: float, mass: float = 1.0
+) -> tuple[Viscoelastic | None, dict[str, float]]:
+    """The viscoelastic law with the same mean restitution as a constant xi, or None.
+
+    "Same mean restitution": eps(g) averaged over the initial collisions of a Maxwellian
+    gas at ``temperature``, whose normal relative speeds g have the Rayleigh density
+    g / s^2 exp(-g^2 / 2 s^2), s^2 = 2 T / m (collisions weight the Gaussian normal
+    relative velocity by g).  The mean falls with the damping (bisection), down to about
+    0.76, the law's clamp: a xi whose matched law would send more than
+    ``MATCH_CLAMPED_SHARE`` of the initial collisions past ``max_speed`` is outside the
+    law's range, and None is returned with the reason.  The speed-accuracy benchmark's
+    collapse map compares a constant xi with the law matched this way.
+
+    Parameters
+    ----------
+    xi : float
+        The constant restitution to match (dimensionless, 0 < xi < 1).
+    temperature : float
+        The gas' temperature (energy, k_B = 1), which sets the impact speeds.
+    mass : float
+        The particle mass (mass units; equal masses).
+
+    Returns
+    -------
+    (Viscoelastic or None, dict)
+        The law (kappa = 1, the damping found) and {"mean_eps", "clamped_share"}; or None
+        and the mean and share the closest law reached.
+    """
+    sd = math.sqrt(2.0 * temperature / mass)
+    g = np.linspace(0.0, 12 * sd, 20_001)
+    weight = g / sd**2 * np.exp(-(g**2) / (2 * sd**2))
+
+    def mean_eps(damping):
+        return float(np.trapezoid(Viscoelastic(damping, 1.0)(g) * weight, g))
+
+    def clamped(law):
+        return math.exp(-(law.max_speed**2) / (2 * sd**2))  # Rayleigh tail beyond max_speed
+
+    lo, hi = 1e-6, 10.0
+    if mean_eps(hi) > xi:  # even the strongest damping keeps the mean above xi
+        law = Viscoelastic(hi, 1.0)
+        return None, dict(mean_eps=mean_eps(hi), clamped_share=clamped(law))
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if mean_eps(mid) > xi else (lo, mid)
+    law = Viscoelastic(lo, 1.0)
+    info = dict(mean_eps=mean_eps(lo), clamped_share=clamped(law))
+    return (law if info["clamped_share"] <= MATCH_CLAMPED_SHARE else None), info

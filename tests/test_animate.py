@@ -67,7 +67,12 @@ def test_frames_match_wrapped_positions(periodic_2d):
     if hasattr(anim.disks, "get_widths"):
         np.testing.assert_allclose(anim.disks.get_widths(), 2 * traj.radii)
     assert anim.disks.get_offset_transform() is anim.ax.transData
-    assert anim.ax.get_xlim() == (-0.5, 0.5) and anim.ax.get_ylim() == (-0.5, 0.5)
+    # the axes span the box across, and the box with the clock's strip above it upwards;
+    # the disks and their periodic images are clipped by the box
+    assert anim.ax.get_xlim() == (-0.5, 0.5) and anim.ax.get_ylim()[0] == -0.5
+    box = anim.ax.transData.transform([traj.lower, traj.upper])
+    for c in (anim.disks, *anim.images):
+        np.testing.assert_allclose(c.get_clip_box().get_points(), box, atol=1e-9)
 
 
 def test_frames_option_and_stride(periodic_2d):
@@ -173,15 +178,59 @@ def test_3d_projection_and_slab():
     assert "slice" in anim.ax.get_title()
 
 
-def test_colour_by_speed(periodic_2d):
+def test_colour_by_speed_on_a_given_scale(periodic_2d):
     import matplotlib as mpl
 
-    anim = plot.animate(periodic_2d, color_by_speed=True, frames=[4, 9])
+    top = np.linalg.norm(periodic_2d.velocities[[4, 9]], axis=2).max()
+    anim = plot.animate(
+        periodic_2d, color_by_speed=True, frames=[4, 9], norm=mpl.colors.Normalize(0, top)
+    )
     anim.draw(1)
     speeds = np.linalg.norm(periodic_2d.velocities[9], axis=1)
-    top = np.linalg.norm(periodic_2d.velocities[[4, 9]], axis=2).max()
     expected = mpl.colormaps["viridis"](speeds / top)
     np.testing.assert_allclose(anim.disks.get_facecolor(), expected, atol=1e-12)
+    with pytest.raises(ValueError, match="color_by_speed=True"):
+        plot.animate(periodic_2d, norm=mpl.colors.Normalize(0, top))
+
+
+def test_colour_by_speed_keeps_a_cooling_gas_coloured():
+    """By default each frame is coloured by its speeds over its own rms speed: a gas whose
+    speeds fall a hundredfold (velocities scaled, positions fixed) shows the same colours
+    at the end as at the start, spread over the colour map, where one fixed scale would
+    paint the last frame uniformly dark."""
+    import matplotlib as mpl
+
+    rng = np.random.default_rng(1)
+    v = rng.normal(size=(40, 2))
+    velocities = np.stack([v, v / 10, v / 100])
+    traj = synthetic(np.zeros((3, 40, 2)) + 0.5, [0, 0], [1, 1], velocities=velocities)
+    anim = plot.animate(traj, color_by_speed=True)
+    anim.draw(0)
+    first = anim.disks.get_facecolor().copy()
+    anim.draw(2)
+    last = anim.disks.get_facecolor()
+    np.testing.assert_allclose(last, first, atol=1e-12)
+    reduced = np.linalg.norm(v, axis=1) / np.sqrt(np.mean(np.sum(v**2, axis=1)))
+    expected = mpl.colormaps["viridis"](reduced / reduced.max())
+    np.testing.assert_allclose(last, expected, atol=1e-12)
+    assert anim.disks.figure.axes[-1].get_ylabel().startswith("speed / rms speed")
+
+
+def test_the_clock_never_covers_a_particle(periodic_2d):
+    """The time is written in a strip above the box, not over the particles (it used to
+    cover the top-left corner of the box in a white box)."""
+    anim = plot.animate(periodic_2d, title="a title")
+    anim.draw(3)
+    fig = anim.ax.figure
+    renderer = fig.canvas.get_renderer() if hasattr(fig.canvas, "get_renderer") else None
+    if renderer is None:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        renderer = FigureCanvasAgg(fig).get_renderer()
+    clock = anim.ax.texts[0]
+    assert clock.get_text() == f"t = {periodic_2d.times[3]:.4g}"
+    box_top = anim.ax.transData.transform((0.0, periodic_2d.upper[1]))[1]
+    assert clock.get_window_extent(renderer).y0 >= box_top
 
 
 def test_notebook_and_writers(periodic_2d, tmp_path, monkeypatch):

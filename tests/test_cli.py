@@ -16,6 +16,8 @@ import sys
 import pytest
 from scipy import stats
 
+from granular.cli.reproduce import FIGURES
+
 from helpers.margins import haff_margin, msd_margin_bound, tracer_langevin_margin
 
 FALSE_ALARM = 1e-4  # per check, two-sided
@@ -70,11 +72,11 @@ def _euler_maruyama_margin():
     (granular.langevin); the MSD and the time-averaged MSD by at most that.  For the
     largest gamma0 of the quick reproduction's Langevin systems."""
     from granular import theory
-    from granular.cli import reproduce
+    from granular.cli import reproduce, reproduce_text
 
     cfg = reproduce.Config(quick=True)
     g = max(
-        theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, reproduce.THESIS_T0).gamma0
+        theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, reproduce_text.THESIS_T0).gamma0
         for xi in (1.0, 0.8, 0.5)
     )
     return 2 / (2 - g * 0.01) - 1
@@ -180,6 +182,10 @@ def test_demo_quick(tmp_path):
     assert (tmp_path / "demo" / "brownian_msd.png").stat().st_size > 10_000
     (b,) = strict_json(tmp_path / "demo" / "brownian.json")
     assert "Brownian tracer" in out.stdout and "correlated collisions" in out.stdout
+    # the ratio said to be at t = 1/gamma is sampled there, and the line says the time
+    assert b["t_one_over_gamma"] == pytest.approx(1 / b["gamma_theory"], rel=1e-12)
+    assert f"at t = 1/gamma = {b['t_one_over_gamma']:.3g}," in out.stdout
+    assert b["t_free_sample"] == pytest.approx(b["t_free"], rel=1e-12)
     assert_agrees(
         "tracer MSD(1/gamma) / Langevin",
         b["msd_ratio_one_over_gamma"],
@@ -220,7 +226,7 @@ def test_reproduce_quick(tmp_path):
     over runs agrees with theory within its error bars and the theory's stated accuracy
     (REPRODUCE_MARGINS), energy is conserved to rounding, and report.md's verdicts are the
     ones the numbers give."""
-    from granular.cli import reproduce
+    from granular.cli import reproduce_text
 
     run("reproduce", "--quick", "--out", "rep", cwd=tmp_path)
     rows = {r["id"]: r for r in strict_json(tmp_path / "rep" / "summary.json")}
@@ -263,7 +269,7 @@ def test_reproduce_quick(tmp_path):
     for r in statistical:
         sentence = re.search(rf"^- `{re.escape(r['id'])}`.*$", report, re.M).group(0)
         z = (r["ours"] - r["theory"]) / r["ours_error"]
-        verdict = "agrees within" if abs(z) <= reproduce.SIGMA else "differs by"
+        verdict = "agrees within" if abs(z) <= reproduce_text.SIGMA else "differs by"
         assert f"theory {r['theory']:.4g}: {verdict}" in sentence, sentence
     pngs = {p.name for p in (tmp_path / "rep").glob("*.png")}
     assert len(pngs) >= 27 and "fig4_23_ergodicity_udsbm_tstop.png" in pngs
@@ -274,3 +280,251 @@ def test_reproduce_quick(tmp_path):
     assert (
         math.isfinite(rows["ergodicity.udsbm"]["theory"]) and rows["ergodicity.udsbm"]["theory"] < 1
     )
+
+
+# -- the command line's pages and the reproduction's progress ---------------------------------
+
+
+def _subcommands():
+    import argparse
+
+    from granular.__main__ import _parser
+
+    (sub,) = [a for a in _parser()._actions if isinstance(a, argparse._SubParsersAction)]
+    return sub.choices
+
+
+def test_every_subcommand_has_a_help_page_with_defaults(capsys):
+    """``python -m granular CMD --help`` says what CMD does and, for every option, its
+    default; the reproduction's page lists the experiments ``--only`` takes."""
+    from granular.__main__ import main
+    from granular.cli import reproduce
+
+    commands = _subcommands()
+    assert set(commands) == {"demo", "reproduce", "bench"}
+    for name, page in commands.items():
+        assert page.description and len(page.description) > 40, name
+        options = [a for a in page._actions if a.option_strings and a.dest != "help"]
+        assert options, name
+        undefaulted = [a.option_strings[0] for a in options if "(default: " not in (a.help or "")]
+        assert not undefaulted, f"{name}: options without their default: {undefaulted}"
+        with pytest.raises(SystemExit) as done:
+            main([name, "--help"])
+        assert done.value.code == 0
+        text = capsys.readouterr().out
+        assert page.description.split()[0] in text and "(default: " in text
+    with pytest.raises(SystemExit):
+        main(["reproduce", "--help"])
+    page = capsys.readouterr().out
+    assert list(reproduce.ABOUT) == list(reproduce.FIGURES)
+    for name, (what, *_) in reproduce.ABOUT.items():
+        assert re.search(rf"^  {re.escape(name)} +{re.escape(what)}$", page, re.M), name
+
+
+def test_reproduce_refuses_an_unknown_experiment_listing_the_valid_ones(tmp_path, capsys):
+    """An unknown ``--only`` name stops before any work, naming every valid one; from
+    Python too (``main(only=...)``), before the output folder is made."""
+    from granular.__main__ import main
+    from granular.cli import reproduce
+
+    with pytest.raises(SystemExit) as done:
+        main(["reproduce", "--only", "4.x", "--out", str(tmp_path / "rep")])
+    assert done.value.code == 2
+    err = capsys.readouterr().err
+    assert "'4.x'" in err and all(repr(name) in err for name in reproduce.FIGURES)
+    with pytest.raises(ValueError, match=r"unknown experiment 'nope'; choose from 4\.1, ") as e:
+        reproduce.main(out=str(tmp_path / "rep"), only=["4.1", "nope"])
+    assert all(name in str(e.value) for name in reproduce.FIGURES)
+    assert not (tmp_path / "rep").exists()
+
+
+def test_progress_scales_the_reference_time_by_the_pace_so_far():
+    """On a busy machine the expected time of the next experiment is its reference time
+    times how much slower the experiments done so far ran than theirs."""
+    from granular.cli import reproduce
+
+    assert reproduce._pace(2.0, 4.0) == 1.0  # too little done to tell
+    assert reproduce._pace(30.0, 10.0) == 3.0
+    reference = reproduce.ABOUT["4.17-4.23"][1]
+    line = reproduce._progress(7, 9, "4.17-4.23", reproduce.Config(), pace=3.0)
+    assert line.startswith("[7/9] 4.17-4.23: ")
+    assert (
+        f"(expected ~{3 * reference:.0f} s: {reference:g} s on the reference machine x 3," in line
+    )
+    line = reproduce._progress(1, 9, "4.1", reproduce.Config(runs=2))
+    assert line.endswith("the reference machine's time, at the default run counts)")
+
+
+@pytest.mark.slow  # a fresh interpreter and two small experiments: 3-5 s
+def test_reproduce_only_runs_the_named_experiments_saying_each_first(tmp_path):
+    """``--only`` runs just the experiments named, in the thesis' order; before each, a line
+    on stderr says which (i of n), what it shows and its expected time; the summary and the
+    report hold only their rows and sections."""
+    from granular.cli import reproduce
+
+    out = run(
+        "reproduce", "--quick", "--only", "4.9", "--only", "4.1", "--out", "rep", cwd=tmp_path
+    )
+    lines = [line for line in out.stderr.splitlines() if line.startswith("[")]
+    assert len(lines) == 2, out.stderr
+    for i, name in enumerate(("4.1", "4.9")):
+        what, _, quick = reproduce.ABOUT[name]
+        assert lines[i].startswith(f"[{i + 1}/2] {name}: {what} (expected ~{quick:.0f} s"), lines
+    assert "s on the reference machine" in out.stderr.splitlines()[0]  # the total, first
+    assert {p.name for p in (tmp_path / "rep").glob("*.png")} == {
+        "fig4_1_head_on.png",
+        "fig4_9_clusters_2d.png",
+    }
+    assert strict_json(tmp_path / "rep" / "summary.json") == []
+    report = (tmp_path / "rep" / "report.md").read_text()
+    assert "### Energy" not in report and "![fig4_9_clusters_2d.png]" in report
+
+
+def test_demo_draws_each_gas_over_its_theory_with_error_bars():
+    """Below the log-log panels the demo draws ours / theory with the standard errors over
+    theory, where deviations of a few percent (the ones its printed lines quote) show."""
+    from types import SimpleNamespace
+
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from granular.cli import demo
+
+    times = np.array([0.0, 0.1, 1.0, 10.0])
+    theory_values = np.array([0.0, 0.2, 2.0, 20.0])
+    results = {}
+    for label, excess in (("molecular", 1.04), ("granular", 1.08)):
+        res = SimpleNamespace(
+            mean={"msd": excess * theory_values, "temperature": np.ones(4)},
+            error={"msd": 0.01 * theory_values, "temperature": np.zeros(4)},
+        )
+        results[label] = (res, theory_values, np.ones(4), None)
+    fig, ax = plt.subplots()
+    demo._ratio(ax, times, results, "msd")
+    bars = [c for c in ax.containers if hasattr(c, "has_yerr") and c.has_yerr]
+    assert len(bars) == 2
+    for bar, excess in zip(bars, (1.04, 1.08), strict=True):
+        x, y = bar.lines[0].get_data()
+        np.testing.assert_allclose(x, times[1:])
+        np.testing.assert_allclose(y, excess)
+        (segments,) = bar.lines[2]
+        spans = np.array([s[1, 1] - s[0, 1] for s in segments.get_segments()])
+        np.testing.assert_allclose(spans, 2 * 0.01)  # +- error / theory
+    assert "theory" in ax.get_ylabel() and "dimensionless" in ax.get_ylabel()
+    plt.close(fig)
+
+
+# -- what the figures say ----------------------------------------------------------------------
+
+
+def _mathtext_free(text):
+    """``text`` without its $...$ parts (mathtext subscripts have underscores)."""
+    return re.sub(r"\$[^$]*\$", "", text)
+
+
+def figure_text_problems(fig):
+    """What a reader of ``fig`` would trip over: an equation number without its source
+    ("(2.68)" rather than "[G20] eq. 2.68"), a Python name in a legend, a unit written
+    "(length^2)" rather than in the figures' [L^2] style, PBC/RBC not spelt out, an axis
+    with ticks but no tick labels."""
+    problems = []
+    fig.canvas.draw()  # tick labels are made when drawn
+
+    def labelled(ax):
+        return any(t.get_text() for t in ax.get_xticklabels())
+
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        texts = [ax.get_title(), ax.get_xlabel(), ax.get_ylabel()]
+        texts += [t.get_text() for t in legend.get_texts()] if legend else []
+        for text in filter(None, texts):
+            plain = _mathtext_free(text)
+            if re.search(r"(?<!eq\. )\(\d\.\d+\)", text):
+                problems.append(f"equation without its source: {text!r}")
+            if re.search(r"\b[a-z]+_[a-z_]+\b", plain):
+                problems.append(f"a Python name: {text!r}")
+            if "(length" in plain or "units of the scene" in plain:
+                problems.append(f"unit not in the [L] style: {text!r}")
+            if re.search(r"\b[PR]BC\b", plain) and not re.search(r"periodic|walls", plain):
+                problems.append(f"PBC/RBC unexplained: {text!r}")
+        # an axis shared with a panel below may leave its labels to that panel
+        shared = ax.get_shared_x_axes().get_siblings(ax)
+        if ax.get_xticks().size and not any(labelled(a) for a in shared):
+            problems.append(f"no tick labels on {ax.get_title()!r}")
+    return problems
+
+
+def test_figure_text_problems_are_found():
+    """The checker finds what it looks for (so the tests below can fail)."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([1, 2], [1, 2], label="msd_viscoelastic_second_order")
+    ax.plot([1, 2], [2, 1], label="(2.68)")
+    ax.set_ylabel("MSD (length$^2$)")
+    ax.set_title("PBC, t = 2.5")
+    ax.set_xticks([1, 2], ["", ""])
+    ax.legend()
+    assert len(figure_text_problems(fig)) == 5
+    plt.close(fig)
+
+
+# the experiments that take more than 3 s at quick sizes
+SLOW_FIGURES = ("4.8+4.10", "4.11-4.16+F", "4.17-4.23", "clustering", "viscoelastic")
+
+
+@pytest.mark.parametrize(
+    "name",
+    [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_FIGURES else n for n in FIGURES],
+)
+def test_reproduced_figures_say_what_they_show(name, tmp_path, monkeypatch):
+    """Every figure of the reproduction (quick sizes), as drawn: no bare equation numbers,
+    Python names, off-style units, unexplained PBC/RBC or missing tick labels."""
+    from granular.cli import reproduce
+
+    drawn = []
+    save = reproduce._save
+
+    def keep(fig, out, file_name):
+        drawn.append((file_name, figure_text_problems(fig)))
+        return save(fig, out, file_name)
+
+    monkeypatch.setattr(reproduce, "_save", keep)
+    reproduce.figure(name, quick=True, out=str(tmp_path))
+    assert drawn
+    problems = {file_name: p for file_name, p in drawn if p}
+    assert not problems, problems
+
+
+@pytest.mark.slow  # four figures drawn: 3-8 s
+def test_demo_figures_say_what_they_show(tmp_path, monkeypatch):
+    """The demo's figures, drawn from a stand-in result, pass the same reading, and each
+    log-log panel has its ratio-to-theory panel below."""
+    from types import SimpleNamespace
+
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from granular.cli import demo
+
+    times = np.array([0.0, 0.1, 1.0, 10.0])
+    rng = np.random.default_rng(2)
+    results = {}
+    for label in ("molecular", "granular"):
+        res = SimpleNamespace(
+            mean={"msd": times + 0.1, "temperature": np.ones(4)},
+            error={"msd": 0.01 * times, "temperature": np.full(4, 0.01)},
+            runs=[{"velocities": rng.normal(size=(4, 50, 3))} for _ in range(3)],
+            times=times,
+        )
+        results[label] = (res, times + 0.1, np.ones(4), SimpleNamespace(tau0=1.0))
+    seen = {}
+
+    def keep(fig, path, **kwargs):  # read, not written
+        seen[str(path).rsplit("/", 1)[-1]] = (figure_text_problems(fig), len(fig.axes))
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    names = demo._figures(str(tmp_path), times, results)
+    assert set(names) == set(seen) == {"demo.png", "msd.png", "temperature.png", "speeds.png"}
+    assert {name: p for name, (p, _) in seen.items() if p} == {}
+    assert seen["demo.png"][1] == 4 and seen["msd.png"][1] == seen["temperature.png"][1] == 2

@@ -134,3 +134,40 @@ def test_einstein_msd_with_its_default_fft_on_an_exported_trajectory():
     direct = EinsteinMSD(u, select="all", fft=False).run().results.timeseries
     np.testing.assert_allclose(fft, direct, rtol=1e-5, atol=1e-6 * direct.max())
     assert mda is not None
+
+
+# the extras for the documentation and the test suite: tools, not something a user wants
+TOOL_EXTRAS = ("docs", "test", "all")
+
+
+def test_all_extra_covers_every_user_extra():
+    """``pip install 'granular[all]'`` brings everything any user extra brings."""
+    extras = _extras()
+    assert "all" in extras, "no `all` extra in pyproject.toml"
+    user = set().union(*(names for extra, names in extras.items() if extra not in TOOL_EXTRAS))
+    assert {"matplotlib", "mdanalysis", "gsd", "dask", "ipykernel"} <= user  # seen
+    missing = user - extras["all"]
+    assert not missing, f"the all extra lacks {sorted(missing)}"
+
+
+def _make_dry_run(target, tmp_path):
+    """The commands ``make TARGET`` would run for a fresh venv (make -n: nothing is run)."""
+    if shutil.which("make") is None:
+        pytest.skip("needs make")
+    done = subprocess.run(
+        ["make", "-n", target, f"VENV={tmp_path / 'venv'}"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    return [line for line in done.stdout.splitlines() if "pip install" in line and " -e " in line]
+
+
+def test_make_demo_installs_only_what_the_demo_needs(tmp_path):
+    """``make demo`` on a fresh machine installs the plot extra (matplotlib), not the test
+    extra's ~130 packages; ``make test`` installs the test extra."""
+    (demo,) = _make_dry_run("demo", tmp_path)
+    assert "'.[plot]'" in demo, demo
+    (test,) = _make_dry_run("test", tmp_path)
+    assert "'.[test]'" in test, test

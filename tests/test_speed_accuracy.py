@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from granular import Viscoelastic
+from granular import Viscoelastic, restitution
 from granular.cli import speed_accuracy
 from granular.simulation import _LIST_SHELL
 
@@ -170,7 +170,8 @@ def _labels_inside_squares(fig):
 
 
 def test_matched_viscoelastic_law_has_the_mean_restitution():
-    """The law matched to a constant xi has eps(g) averaged over the Rayleigh density of
+    """granular.restitution.matched_viscoelastic (with the laws; the benchmark's collapse
+    map uses it): the law matched to a constant xi has eps(g) averaged over the Rayleigh density of
     initial impact speeds equal to xi, checked here by Monte Carlo: g = s sqrt(-2 ln U) is
     Rayleigh with s^2 = 2 T / m; 400 000 draws give the mean to about 2e-5 (the spread of
     eps over g, < 0.1, over sqrt(4e5)), so 2e-4 is ten standard errors.  Below the law's
@@ -178,10 +179,10 @@ def test_matched_viscoelastic_law_has_the_mean_restitution():
     rng = np.random.default_rng(1)
     g = math.sqrt(2 * 1.5) * np.sqrt(-2 * np.log(rng.random(400_000)))
     for xi in (0.95, 0.85):
-        law, info = speed_accuracy.matched_viscoelastic(xi, 1.5)
+        law, info = restitution.matched_viscoelastic(xi, 1.5)
         assert isinstance(law, Viscoelastic)
         assert law(g).mean() == pytest.approx(xi, abs=2e-4)
-        assert info["clamped_share"] <= speed_accuracy.MATCH_CLAMPED_SHARE
+        assert info["clamped_share"] <= restitution.MATCH_CLAMPED_SHARE
     for xi in (0.7, 0.5):  # the series stops at eps = 0.7615: out of reach
-        law, info = speed_accuracy.matched_viscoelastic(xi, 1.5)
+        law, info = restitution.matched_viscoelastic(xi, 1.5)
         assert law is None and info["mean_eps"] > 0.76

@@ -12,7 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from granular import langevin, theory
+from granular import langevin, plot, theory
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_langevin_powerlaw import _scheme_moments  # the noise-free moments of each scheme
@@ -25,7 +25,7 @@ def main():
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
     ax_msd, ax_tamsd, ax_err = axes
     t_stop = 200.0
-    for a, colour in ((1.0, "C0"), (5 / 6, "C3")):
+    for a, colour, name in ((1.0, "C0", "1"), (5 / 6, "C3", "5/6")):
         r = langevin.run(
             2000,
             gamma0=G0,
@@ -38,7 +38,7 @@ def main():
             seed=1,
         )
         ok = r.times > 0
-        label = f"a = {a:.3g}"
+        label = f"a = {name}"
         ax_msd.loglog(r.times[ok], r.msd()[ok], "o", ms=3, color=colour, label=f"{label}: run")
         ax_msd.loglog(r.times[ok], r.theory_msd()[ok], "-", color=colour, label=f"{label}: theory")
         ax_tamsd.loglog(r.tamsd_lags, r.tamsd(), "s", ms=4, color=colour, label=f"{label}: TAMSD")
@@ -52,14 +52,20 @@ def main():
         theory.msd_powerlaw_udsbm_asymptote(t, D0=D0, tau0=TAU0, exponent=5 / 6),
         "k--",
         lw=1,
-        label="a = 5/6 overdamped: ~ t^(1/6)",
+        label=r"a = 5/6 overdamped: $\propto t^{1/6}$",
     )
     ax_msd.loglog(
         t, theory.msd_powerlaw_udsbm(t, D0=D0, gamma0=G0, tau0=TAU0, exponent=5 / 6), "C3-", lw=0.8
     )
-    ax_msd.set(xlabel="t", ylabel="MSD (3D)", title="ensemble MSD, N = 2000, dt = 0.01")
+    ax_msd.set(
+        xlabel=plot.TIME, ylabel=plot.MSD, title=r"ensemble MSD (3D), N = 2000, $\Delta t$ = 0.01"
+    )
     ax_msd.legend(fontsize=8)
-    ax_tamsd.set(xlabel="lag", ylabel="TAMSD (3D)", title=f"time-averaged MSD over t = {t_stop:g}")
+    ax_tamsd.set(
+        xlabel=plot.LAG_OR_TIME,
+        ylabel=plot.MSD_AND_TAMSD,
+        title=f"time-averaged MSD (3D) over t = {t_stop:g}",
+    )
     ax_tamsd.legend(fontsize=7, ncol=2)
 
     t_end = 5.0
@@ -70,12 +76,13 @@ def main():
             abs(_scheme_moments(scheme, 5 / 6, dt, round(t_end / dt), D0 * G0)[-1, 0] / xx - 1)
             for dt in dts
         ]
-        ax_err.loglog(dts, err, marker, label=scheme)
-    ax_err.loglog(dts, 0.2 * dts, "k:", lw=1, label="~ dt")
-    ax_err.loglog(dts, 0.009 * dts**2, "k--", lw=1, label="~ dt^2")
+        name = {"exact": "exact scheme", "em": "Euler-Maruyama"}[scheme]
+        ax_err.loglog(dts, err, marker, label=name)
+    ax_err.loglog(dts, 0.2 * dts, "k:", lw=1, label=r"$\propto \Delta t$")
+    ax_err.loglog(dts, 0.009 * dts**2, "k--", lw=1, label=r"$\propto \Delta t^2$")
     ax_err.set(
-        xlabel="dt",
-        ylabel="|<x^2> / theory - 1| at t = 5",
+        xlabel=r"time step $\Delta t$ [$L\sqrt{m/\varepsilon}$]",
+        ylabel=r"$|\langle x^2 \rangle$ / theory $- 1|$ at t = 5 (dimensionless)",
         title="scheme error without noise, a = 5/6",
     )
     ax_err.legend(fontsize=8)

@@ -191,7 +191,17 @@ def brownian(out, quick=False, runs=None, backend="processes"):
     )
     anim.save(os.path.join(out, "brownian.gif"), dpi=60 if quick else 70)
 
-    times = np.concatenate([[0.0], np.logspace(-1, math.log10(t_msd), 30)])
+    # the walls: the tracer's centre stays within a = 3 - R of the middle; its MSD from the
+    # middle saturates at the mean square distance of a uniform square, 2 a^2 / 3, and the
+    # walls are not felt while 3 standard deviations of free diffusion stay inside a
+    a = 3.0 - float(scene.radii[0])
+    plateau = 2 * a * a / 3
+    t_free = (a / 3) ** 2 / (2 * c.D0)
+    # log-spaced samples, and the two times the ratios are quoted at, exactly
+    times = np.unique(
+        np.concatenate([[0.0, 1 / c.gamma0, t_free], np.logspace(-1, math.log10(t_msd), 30)])
+    )
+    times = times[times <= t_msd]
     res = ensemble(
         functools.partial(tracer_run, times=times),
         runs,
@@ -204,16 +214,10 @@ def brownian(out, quick=False, runs=None, backend="processes"):
         raise RuntimeError(f"{len(res.failures)} runs failed: {res.failures[0]}")
     v0_sq = float(res.mean["v0_sq"])
     msd_th = theory.msd_langevin(times, c.D0, c.gamma0, dim=2, v0_sq=v0_sq)
-    # the walls: the tracer's centre stays within a = 3 - R of the middle; its MSD from the
-    # middle saturates at the mean square distance of a uniform square, 2 a^2 / 3, and the
-    # walls are not felt while 3 standard deviations of free diffusion stay inside a
-    a = 3.0 - float(scene.radii[0])
-    plateau = 2 * a * a / 3
-    t_free = (a / 3) ** 2 / (2 * c.D0)
     k_free = int(np.searchsorted(times, t_free, side="right")) - 1
     ratio = res.mean["msd"][1:] / msd_th[1:]
     ratio_err = res.error["msd"][1:] / msd_th[1:]
-    k1 = int(np.argmin(np.abs(times[1:] - 1 / c.gamma0))) + 1
+    k1 = int(np.searchsorted(times, 1 / c.gamma0))  # a sample time
     row = dict(
         runs=res.count,
         density=density,
@@ -233,14 +237,21 @@ def brownian(out, quick=False, runs=None, backend="processes"):
         f"Brownian tracer (R = 0.5, M = 25 among 150 disks, bulk n = {density:.3f}): "
         f"kinetic theory gamma = {c.gamma0:.3f}, D = {c.D0:.4f}; MSD over {res.count} runs / "
         f"Langevin: {row['msd_ratio_one_over_gamma']:.3f} +- "
-        f"{row['msd_ratio_one_over_gamma_error']:.3f} at t = 1/gamma, "
+        f"{row['msd_ratio_one_over_gamma_error']:.3f} at t = 1/gamma = "
+        f"{row['t_one_over_gamma']:.3g}, "
         f"{row['msd_ratio_free']:.3f} +- {row['msd_ratio_free_error']:.3f} at t = "
         f"{row['t_free_sample']:.3g} (walls felt beyond ~{t_free:.3g}).\n  Enskog's friction "
         "holds at short times; later, correlated collisions lower it and the tracer diffuses "
         "faster than predicted (its Knudsen number, gas mean free path / R, is only ~0.6)."
     )
 
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.6), layout="constrained")
+    fig, axes = plt.subplot_mosaic(
+        [["path", "msd"], ["path", "ratio"]],
+        figsize=(11.0, 5.6),
+        layout="constrained",
+        height_ratios=[2, 1],
+    )
+    left, right, below = axes["path"], axes["msd"], axes["ratio"]
     still = plot.animate(traj, trails=[0], ax=left)
     still.draw(len(still.samples) - 1)
     left.set_title(f"the tracer's path, t = 0 .. {t_gif:g}", fontsize="medium")
@@ -255,8 +266,18 @@ def brownian(out, quick=False, runs=None, backend="processes"):
     )
     right.axhline(plateau, color="0.5", ls=":", label=r"walls: $2a^2/3$ (uniform square)")
     right.axvspan(t_free, times[-1], color="0.9", zorder=0, label="walls felt")
-    right.legend(fontsize="small", loc="upper left")
+    right.legend(fontsize="small", loc="lower right")
     right.set_title("tracer MSD against the heavy-particle Langevin MSD", fontsize="medium")
+    right.set_xlabel("")
+    below.errorbar(times[1:], ratio, yerr=ratio_err, fmt="o", ms=3, label="tracer / Langevin")
+    below.axhline(1.0, color="k", lw=0.8)
+    below.axvline(1 / c.gamma0, color="0.5", ls="--", lw=0.8, label=r"$t = 1/\gamma$")
+    below.axvspan(t_free, times[-1], color="0.9", zorder=0)
+    below.set_xscale("log")
+    below.set_xlim(right.get_xlim())
+    below.set_xlabel(plot.TIME)
+    below.set_ylabel("MSD / Langevin (dimensionless)")
+    below.legend(fontsize="small")
     fig.savefig(os.path.join(out, "brownian_msd.png"), dpi=120)
     plt.close(fig)
     return ["brownian.gif", "brownian_msd.png", "brownian.json"]
@@ -272,7 +293,8 @@ def _msd(ax, times, results):
             ax=ax,
             label=f"{label} gas (EDMD)",
             theory_style="k--" if label == "molecular" else "k:",
-            theory_label=f"{label}: theory " + ("(2.68)" if label == "molecular" else "(2.79)"),
+            theory_label=f"{label}: theory, [G20] eq. "
+            + ("2.68" if label == "molecular" else "2.79"),
         )
     ax.set_title("mean squared displacement")
 
@@ -291,6 +313,30 @@ def _temperature(ax, times, results):
     ax.plot(times[1:], mol.mean["temperature"][1:], "-", color="0.5", label="molecular gas (EDMD)")
     ax.legend()
     ax.set_title(r"temperature: Haff's law for $\xi$ = 0.8")
+
+
+def _ratio(ax, times, results, quantity):
+    """Each gas' ``quantity`` ("msd" or "temperature") over its theory, with standard
+    errors: the few-percent deviations the printed lines quote, which log-log axes hide."""
+    for i, (label, (res, msd_th, T_th, _)) in enumerate(results.items()):
+        th = msd_th if quantity == "msd" else T_th
+        over_t0 = quantity != "msd" and label == "molecular"  # a molecular gas keeps T0
+        keep = times > 0
+        ax.errorbar(
+            times[keep],
+            res.mean[quantity][keep] / th[keep],
+            yerr=res.error[quantity][keep] / th[keep],
+            fmt="o" if label == "molecular" else "s",
+            ms=3,
+            color=f"C{i}",
+            label=f"{label} gas" + (", over $T_0$" if over_t0 else ""),
+        )
+    ax.axhline(1.0, color="k", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_xlabel(plot.TIME)
+    what = "MSD / theory" if quantity == "msd" else "T / theory"
+    ax.set_ylabel(f"{what} (dimensionless)")
+    ax.legend(fontsize="small")
 
 
 def _speeds(ax, label, results):
@@ -312,12 +358,26 @@ def _figures(out, times, results):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    def save(name, *draws):
+    def save(name, *draws, ratios=()):
+        """One column per draw; with ``ratios`` (one per draw) a panel of the ratio to
+        theory below each."""
+        rows = 2 if ratios else 1
         fig, axes = plt.subplots(
-            1, len(draws), figsize=(5.5 * len(draws), 4.2), layout="constrained", squeeze=False
+            rows,
+            len(draws),
+            figsize=(5.5 * len(draws), 4.2 + 2.2 * (rows - 1)),
+            layout="constrained",
+            squeeze=False,
+            sharex="col",
+            height_ratios=[2, 1] if ratios else None,
         )
         for ax, draw in zip(axes[0], draws, strict=True):
             draw(ax)
+        for ax, quantity in zip(axes[1] if ratios else (), ratios, strict=True):
+            _ratio(ax, times, results, quantity)
+        if ratios:
+            for ax in axes[0]:
+                ax.set_xlabel("")
         fig.savefig(os.path.join(out, name), dpi=120)
         plt.close(fig)
         return name
@@ -329,9 +389,9 @@ def _figures(out, times, results):
         return _temperature(ax, times, results)
 
     return [
-        save("demo.png", msd, temperature),
-        save("msd.png", msd),
-        save("temperature.png", temperature),
+        save("demo.png", msd, temperature, ratios=("msd", "temperature")),
+        save("msd.png", msd, ratios=("msd",)),
+        save("temperature.png", temperature, ratios=("temperature",)),
         save(
             "speeds.png",
             lambda ax: _speeds(ax, "molecular", results),

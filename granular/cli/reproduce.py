@@ -10,9 +10,12 @@ Public entry points
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
-``main(out="granular-reproduce", quick=False, runs=None, backend=None)``
-    Every experiment, then ``summary.json`` and ``report.md`` (``python -m granular
-    reproduce``); returns all rows.
+``ABOUT``
+    Per experiment: what it shows, and its expected wall time (full, quick) on a quiet
+    2-core machine, which the progress line says before it starts.
+``main(out="granular-reproduce", quick=False, runs=None, backend=None, only=None)``
+    Every experiment (or those named in ``only``), then ``summary.json`` and ``report.md``
+    (``python -m granular reproduce``); returns the rows.
 
 ``backend`` is the ensembles' (``granular.ensemble``; the results are the same on each):
 by default threads in quick mode, processes otherwise.
@@ -25,9 +28,9 @@ central-limit standard error over ``runs`` independent runs (both None where the
 not a mean over runs), the thesis' value where it printed one for the same system (the App. F
 slopes are None in quick mode, whose system is smaller; the quantity text quotes them), and
 theory's; non-finite numbers are written as null (strict JSON has no Infinity).
-``report.md`` shows the table beside the figures; its sentences are generated from the
-rows: each comparison with its relative deviation and whether it lies within ``SIGMA``
-standard errors.
+``report.md`` (written by ``reproduce_text``, which holds the report's prose) shows the table
+beside the figures; its sentences are generated from the rows: each comparison with its
+relative deviation and whether it lies within ``reproduce_text.SIGMA`` standard errors.
 
 Where the thesis had a slip we use the correct physics: isotropic initial directions
 instead of eq. 3.3, and the mean collision time of (2.42) rather than the printed
@@ -40,6 +43,7 @@ from __future__ import annotations
 import functools
 import math
 import os
+import sys
 import time
 import warnings
 
@@ -47,12 +51,9 @@ import numpy as np
 
 from .. import ClusteringWarning, Scene, Simulation, analysis, ensemble, langevin, plot, theory
 from .output import write_json
+from .reproduce_text import THESIS_SLOPES, THESIS_T0, report
 
 QUICK_RUNS = 20  # runs per experiment in quick mode: enough for Student-t error bars
-SIGMA = 3.0  # the report calls a value "in agreement" within this many standard errors
-THESIS_T0 = 2.0 / 3.0  # the thesis' temperature: speed sqrt(2) in 3D
-# App. F: the thesis' long-time MSD slopes (N = 1000), measured and as it computed theory
-THESIS_SLOPES = {1.0: (0.364, 0.350), 0.8: (0.420, 0.451)}
 
 
 class Config:
@@ -60,6 +61,7 @@ class Config:
 
     def __init__(self, quick=False, runs=None, backend=None):
         self.quick = quick
+        self.runs_given = runs
         # the ensembles' backend (results are the same on every one): quick mode runs many
         # small ensembles, where starting worker processes costs more than the runs (threads:
         # 18 s against 31 s for all of it), and the C core releases the GIL
@@ -76,9 +78,8 @@ class Config:
         self.c_speed = 0.2  # collisions per particle per particle (c_stop = 0.2 N)
 
 
-def _thesis_coefficients(xi):
-    """gamma0, D0, tau0 of the thesis' system (N = 1000, r = 0.025, T0 = 2/3), (2.45-2.55)."""
-    return theory.langevin_coefficients(1000, 0.025, 1.0, xi, THESIS_T0)
+# the thesis' names of the boundaries, spelt out where a figure shows them
+BOUNDARY_NAMES = (("periodic", "periodic box (PBC)"), ("walls", "reflecting walls (RBC)"))
 
 
 def _checked_ensemble(*args, **kwargs):
@@ -178,7 +179,7 @@ def _fig_4_2_to_4_4(cfg, out):
             )
     fig, ax = _fig()
     drifts = []
-    for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
+    for boundary, name in BOUNDARY_NAMES:
         r = res[boundary, 1.0]
         rel = np.array([run["kinetic_energy"] / run["kinetic_energy"][0] - 1 for run in r.runs])
         drifts.append(np.max(np.abs(rel)))
@@ -190,7 +191,7 @@ def _fig_4_2_to_4_4(cfg, out):
     names = [_save(fig, out, "fig4_2_energy.png")]
     for xi, fig_no in ((1.0, "4_3"), (0.8, "4_4")):
         fig, ax = _fig()
-        for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
+        for boundary, name in BOUNDARY_NAMES:
             r = res[boundary, xi]
             ax.errorbar(
                 t,
@@ -268,9 +269,9 @@ def _fig_4_8_and_4_10(cfg, out):
     names, rows = [], []
     fig, ax = _fig()
     for label, boundary, wall_e in (
-        ("PBC", "periodic", 1.0),
-        ("RBC", "walls", 1.0),
-        ("RBC, inelastic walls", "walls", 0.8),
+        (dict(BOUNDARY_NAMES)["periodic"], "periodic", 1.0),
+        (dict(BOUNDARY_NAMES)["walls"], "walls", 1.0),
+        ("reflecting walls, wall restitution 0.8", "walls", 0.8),
     ):
         eq = equilibrium_scene(cfg, boundary=boundary)
         s = eq.replace(restitution=0.8, wall_restitution=wall_e)
@@ -286,7 +287,7 @@ def _fig_4_8_and_4_10(cfg, out):
         ax.plot(t[1:], r.mean["temperature"][1:], label=label)
         T0 = eq.temperature
     c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, 0.8, T0)
-    ax.plot(t[1:], theory.haff_temperature(t[1:], T0, c.tau0), "k--", label="Haff (2.40)")
+    ax.plot(t[1:], theory.haff_temperature(t[1:], T0, c.tau0), "k--", label="Haff, [G20] eq. 2.40")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(plot.TIME)
@@ -335,7 +336,7 @@ def _fig_4_9(cfg, out):
     thesis used against collapse in 2D)."""
     fig, axes = _fig(4, size=(3.6, 3.6))
     k = 0
-    for boundary, name in (("periodic", "PBC"), ("walls", "RBC")):
+    for boundary, name in BOUNDARY_NAMES:
         s = Scene.random(
             cfg.n2, cfg.r2, dim=2, boundary=boundary, restitution=0.8, contact_duration=1e-3, seed=3
         )
@@ -346,9 +347,7 @@ def _fig_4_9(cfg, out):
                 warnings.simplefilter("ignore", ClusteringWarning)
                 sim.run(t_stop=t_snap, sample_times=[t_snap], store=())
             plot.snapshot(sim.scene.positions, s.radii, s.lower, s.upper, ax=axes[k])
-            axes[k].set_title(f"{name}, t = {t_snap}")
-            axes[k].set_xticks([])
-            axes[k].set_yticks([])
+            axes[k].set_title(f"{name}, t = {t_snap:g}", fontsize="medium")
             k += 1
     fig.suptitle(rf"Fig. 4.9: 2D granular gas, $\xi$ = 0.8, N = {cfg.n2}")
     return [_save(fig, out, "fig4_9_clusters_2d.png")], []
@@ -381,7 +380,7 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
         )
         c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, eq.temperature)
         th = theory.msd_granular(t, c.D0, c.gamma0, c.tau0)
-        equation = "(2.68)" if xi == 1 else "(2.79)"
+        equation = "[G20] eq. 2.68" if xi == 1 else "[G20] eq. 2.79"
         fig, ax = _fig()
         plot.msd(
             t,
@@ -398,7 +397,11 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
         dims = [analysis.diffusivity(t, run["msd"]) for run in r.runs]
         dm, _ = analysis.ensemble_mean(dims)
         plot.diffusivity(t, dm, theory_values=c.D0 / (1 + t / c.tau0), ax=ax, label="EDMD")
-        ax.set_title(f"Fig. {fig_d.replace('_', '.')}: diffusivity, " + rf"$\xi$ = {xi:g}")
+        ax.set_title(
+            f"Fig. {fig_d.replace('_', '.')}: diffusivity, "
+            + rf"$\xi$ = {xi:g}; theory $D_0 / (1 + t/\tau_0)$",
+            fontsize="medium",
+        )
         names.append(_save(fig, out, f"fig{fig_d}_diffusivity_xi{xi}.png"))
         if xi in THESIS_SLOPES:
             log = xi < 1
@@ -431,6 +434,7 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
                 ax=ax,
                 loglog=False,
                 label="EDMD",
+                theory_label=equation,
             )
             if log:
                 ax.set_xscale("log")
@@ -495,7 +499,7 @@ def _fig_4_17_to_4_23(cfg, out):
             theory_values=th,
             ax=ax,
             label=r"Euler-Maruyama, $\Delta t$ = 0.01",
-            theory_label="(2.68)" if xi == 1 else "(2.113) + start",
+            theory_label="[G20] eq. 2.68" if xi == 1 else "[G20] eq. 2.113, initial speed √2",
         )
         ax.set_title(
             f"Fig. {fig_no.replace('_', '.')}: "
@@ -533,7 +537,7 @@ def _fig_4_17_to_4_23(cfg, out):
             )
             + ")",
         )
-    ax.plot(t_samples[1:], msd_theory(0.8, t_samples[1:]), "k--", label="theory")
+    ax.plot(t_samples[1:], msd_theory(0.8, t_samples[1:]), "k--", label="theory, [G20] eq. 2.113")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(plot.TIME)
@@ -662,10 +666,27 @@ FIGURES = {
     "viscoelastic": _fig_visco,
 }
 
+# What each experiment shows (``--help`` lists them), and its wall time in seconds on the
+# reference machine, at the thesis' sizes and with ``quick``: one run each on a 2-core virtual
+# machine shared with other work -- the full run's first six experiments at a load average
+# below 2.5, its last three near 5; the quick run at 7-8.5.  Before each experiment the
+# progress line scales its time by how much slower or faster the ones done so far ran.
+ABOUT = {
+    "4.1": ("a head-on collision of two disks between walls", 0.7, 1.6),
+    "4.2-4.4": ("energy and collisions per particle, periodic and wall boxes", 4.1, 4.4),
+    "4.5-4.7": ("speeds in 2D and 3D against Maxwell-Boltzmann (Table 4.1)", 24.5, 4.4),
+    "4.8+4.10": ("Haff's law: three boundaries at xi = 0.8, then xi = 0.99, 0.5, 0.3", 7.6, 8.3),
+    "4.9": ("2D granular gas at t = 2.5 and 10: clusters in periodic and wall boxes", 0.4, 3.2),
+    "4.11-4.16+F": ("MSD, diffusivity and long-time slopes of the EDMD gas", 13.9, 19.1),
+    "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
+    "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
+    "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
+}
+
 
 def _run(name, cfg, out):
     if name not in FIGURES:
-        raise ValueError(f"unknown figure {name!r}; choose from {list(FIGURES)}")
+        raise ValueError(f"unknown experiment {name!r}; choose from {', '.join(FIGURES)}")
     os.makedirs(out, exist_ok=True)
     return FIGURES[name](cfg, out)
 
@@ -674,263 +695,118 @@ def figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)
     """Run one experiment of ``FIGURES`` (e.g. ``"4.8+4.10"``) at the thesis' sizes or, with
     ``quick``, small ones; write its PNG files into ``out``.
 
-    Returns ``(paths, rows)``: the paths of the files written and the experiment's rows
-    for ``summary.json`` (see the module docstring).
+    Parameters
+    ----------
+    name : str
+        The experiment, a key of ``FIGURES``.
+    quick : bool
+        Small systems over short times, ``QUICK_RUNS`` runs each.
+    out : str
+        The folder the PNG files are written into (made if missing).
+    runs : int, optional
+        Runs per experiment (default: five times the thesis' count, or ``QUICK_RUNS``).
+    backend : str or distributed.Client, optional
+        The ensembles' backend (``granular.ensemble``).
+
+    Returns
+    -------
+    (list of str, list of dict)
+        The paths of the files written and the experiment's rows for ``summary.json`` (see
+        the module docstring).
     """
     names, rows = _run(name, Config(quick=quick, runs=runs, backend=backend), out)
     return [os.path.join(out, n) for n in names], rows
 
 
-def main(out="granular-reproduce", quick=False, runs=None, backend=None):
-    """Every experiment of ``FIGURES``, then ``summary.json`` and ``report.md`` in ``out``;
-    prints progress and returns the rows."""
+def _selected(only):
+    """The experiments to run, in the thesis' order: all, or those named in ``only``."""
+    if only is None:
+        return list(FIGURES)
+    only = [only] if isinstance(only, str) else list(only)
+    unknown = [name for name in only if name not in FIGURES]
+    if unknown or not only:
+        raise ValueError(
+            f"unknown experiment {', '.join(map(repr, unknown)) or '(none given)'}; "
+            f"choose from {', '.join(FIGURES)}"
+        )
+    return [name for name in FIGURES if name in only]
+
+
+def _pace(seconds_done, reference_done):
+    """How much slower than the reference this machine runs: the wall time of the
+    experiments done over their reference time, once that is long enough (5 s) to say;
+    1 before."""
+    return seconds_done / reference_done if reference_done >= 5.0 else 1.0
+
+
+def _progress(i, count, name, cfg, pace=1.0):
+    """The line said before experiment ``name`` starts (to stderr: stdout keeps the results):
+    what it shows and its reference time (``ABOUT``) times the ``pace`` so far."""
+    what, full, quick = ABOUT[name]
+    reference = quick if cfg.quick else full
+    how = (
+        "the reference machine's time"
+        if pace == 1.0
+        else f"{reference:g} s on the reference machine x {pace:.2g}, the pace so far"
+    )
+    runs = "" if cfg.runs_given is None else ", at the default run counts"
+    return f"[{i}/{count}] {name}: {what} (expected ~{reference * pace:.0f} s: {how}{runs})"
+
+
+def main(out="granular-reproduce", quick=False, runs=None, backend=None, only=None):
+    """The experiments of ``FIGURES`` (all, or those in ``only``), then ``summary.json`` and
+    ``report.md`` in ``out``; says each experiment before it starts and its time after.
+
+    Parameters
+    ----------
+    out : str
+        The output folder (made if missing).
+    quick : bool
+        Small systems over short times, ``QUICK_RUNS`` runs each.
+    runs : int, optional
+        Runs per experiment (default: five times the thesis' count, or ``QUICK_RUNS``).
+    backend : str or distributed.Client, optional
+        The ensembles' backend (``granular.ensemble``).
+    only : str or list of str, optional
+        Run only these experiments (keys of ``FIGURES``); an unknown name raises ValueError
+        listing the valid ones, before anything runs.
+
+    Returns
+    -------
+    list of dict
+        The rows of ``summary.json``.
+    """
+    selected = _selected(only)
     import matplotlib
 
     matplotlib.use("Agg")
     cfg = Config(quick=quick, runs=runs, backend=backend)
     started = time.perf_counter()
+    reference = {name: ABOUT[name][2 if quick else 1] for name in selected}
+    print(
+        f"reproducing {len(selected)} experiment(s) into {out}/: ~{sum(reference.values()):.0f} s "
+        "on the reference machine (2 cores), longer on a busy one",
+        file=sys.stderr,
+        flush=True,
+    )
     names, rows = [], []
-    for name in FIGURES:
+    seconds_done = reference_done = 0.0
+    for i, name in enumerate(selected, 1):
+        pace = _pace(seconds_done, reference_done)
+        print(_progress(i, len(selected), name, cfg, pace), file=sys.stderr, flush=True)
         t0 = time.perf_counter()
         n, r = _run(name, cfg, out)
         names += n
         rows += r
-        print(f"  Fig. {name:<12} {time.perf_counter() - t0:6.1f} s  {', '.join(n)}", flush=True)
+        seconds = time.perf_counter() - t0
+        seconds_done += seconds
+        reference_done += reference[name]
+        print(f"  Fig. {name:<12} {seconds:6.1f} s  {', '.join(n)}", flush=True)
     write_json(os.path.join(out, "summary.json"), rows)
     with open(os.path.join(out, "report.md"), "w") as f:
-        f.write(_report(rows, cfg, names, time.perf_counter() - started))
+        f.write(report(rows, cfg, names, time.perf_counter() - started))
     print(
         f"reproduced {len(names)} figures, {len(rows)} summary rows in {out}/ "
         f"({time.perf_counter() - started:.0f} s)"
     )
     return rows
-
-
-# -- report.md ---------------------------------------------------------------------------------
-
-
-def _num(x):
-    return "--" if x is None else f"{x:.4g}"
-
-
-def _fmt(x, e=None):
-    return _num(x) + (f" ± {e:.2g}" if x is not None and e is not None else "")
-
-
-def _z(row, key="theory"):
-    """(ours - reference) / standard error, or None when there is no error to judge by."""
-    ref, err = row[key], row["ours_error"]
-    if ref is None or err is None or not err > 0:
-        return None
-    return (row["ours"] - ref) / err
-
-
-def _compare(row, key):
-    """'theory 1.3: agrees within 2 sigma (+0.4%)' or 'theory 1.3: differs by +5.0% (6.1 sigma)'."""
-    ref = row[key]
-    if ref is None:
-        return None
-    z = _z(row, key)
-    if z is None:
-        return f"{key} {_num(ref)}"
-    rel = row["ours"] / ref - 1
-    if abs(z) <= SIGMA:
-        return f"{key} {_num(ref)}: agrees within {max(1, math.ceil(abs(z)))} sigma ({rel:+.1%})"
-    return f"{key} {_num(ref)}: differs by {rel:+.1%} ({z:+.1f} sigma)"
-
-
-def _sentence(row):
-    runs = f" ({row['runs']} runs)" if row["runs"] else ""
-    parts = [p for p in (_compare(row, "theory"), _compare(row, "thesis")) if p]
-    return (
-        f"- `{row['id']}`, {row['quantity']}: ours {_fmt(row['ours'], row['ours_error'])}{runs}"
-        + "".join("; " + p for p in parts)
-        + "."
-    )
-
-
-def _xi(row):
-    return row["id"].rsplit("xi", 1)[1]
-
-
-def _notes(cfg, by_id):
-    """The physics beside the numbers, per section: (title, row id prefix, sentences).
-    Every claim about agreement is conditional on the rows."""
-
-    def significant(prefix, sign):
-        return [r for i, r in by_id.items() if i.startswith(prefix) and (_z(r) or 0) * sign > SIGMA]
-
-    drift = by_id["energy.drift.xi1"]["ours"]
-    energy = [
-        f"The largest relative change of the molecular gas' energy, {drift:.1e}, is "
-        + ("rounding (below 1e-12)." if drift < 1e-12 else "more than rounding (above 1e-12).")
-    ]
-
-    speeds = [
-        "<v^2> agrees by construction: T is measured from the kinetic energy of the same runs, as "
-        "in the thesis.  The thesis' own Table 4.1 numbers did not survive the text conversion, so "
-        "that column is empty."
-    ]
-
-    haff = [
-        "(2.45) is Enskog's tau0 for a homogeneous cooling state with a Maxwellian velocity "
-        "distribution.  The real cooling state is not quite Maxwellian (Sonine coefficient a2), "
-        "and inelastic collisions build up velocity correlations and, at late times, "
-        "inhomogeneities: corrections of a few percent that grow with 1 - xi."
-    ]
-    above, below = significant("haff.", 1), significant("haff.", -1)
-    if above:
-        haff.append(
-            f"Where the fit lies above (2.45) (xi = {', '.join(map(_xi, above))}) the gas cools "
-            "more slowly than that theory says; the thesis too found 'computed values somewhat "
-            "higher than theory' at low xi."
-        )
-    if below:
-        haff.append(
-            f"Where the fit lies below (2.45) (xi = {', '.join(map(_xi, below))}) the gas cools "
-            "faster than that theory says."
-        )
-    if not above and not below:
-        haff.append(f"Every fitted tau0 agrees with (2.45) within {SIGMA:g} standard errors.")
-
-    (m1, t1), (m8, t8) = THESIS_SLOPES[1.0], THESIS_SLOPES[0.8]
-    c1, c8 = _thesis_coefficients(1.0), _thesis_coefficients(0.8)
-    ours8 = 6 * c8.D0 * c8.tau0
-    slopes = [
-        "Theory's slope is its MSD curve fitted over the same window with the same fit, so the "
-        "columns compare like with like; the asymptotic slopes the thesis quoted are in the "
-        "quantity text."
-    ]
-    if cfg.quick:
-        slopes.append(
-            "Quick mode runs a smaller system over shorter times, so the thesis' App. F values "
-            "(N = 1000) are quoted, not compared."
-        )
-    slopes.append(
-        f"The thesis measured its molecular slope {m1:.3f} against 6 D0 = {t1:.3f} "
-        f"({m1 / t1 - 1:+.0%}); (2.52) for its system gives 6 D0 = {6 * c1.D0:.3f}.  For xi = 0.8 "
-        f"it measured {m8:.3f} and quoted {t8:.3f} as theory, while (2.45) and (2.52) for its "
-        f"system give 6 D0 tau0 = {ours8:.3f}"
-        + (
-            ": its theory value does not follow from its own equations."
-            if abs(ours8 / t8 - 1) > 0.02
-            else "."
-        )
-    )
-    above = significant("msd.slope.", 1)
-    if above:
-        slopes.append(
-            f"Where our slope lies above theory ({', '.join(r['id'] for r in above)}): Enskog's D0 "
-            "(2.52) neglects velocity correlations and underestimates hard-sphere self-diffusion "
-            "by a few percent at eta = 0.065, and for xi < 1 a tau0 above (2.45) (see Haff's law) "
-            "raises the slope against ln t further."
-        )
-
-    cq = {xi: theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, THESIS_T0) for xi in (1.0, 0.8)}
-    g_max = max(c.gamma0 for c in cq.values()) * 0.01
-    g_dt1, g_thesis = cq[0.8].gamma0, c8.gamma0
-    sde = [
-        f"Euler-Maruyama at dt = 0.01 (gamma0 dt up to {g_max:.3f} here) biases the stationary "
-        f"<v^2> by up to 2 / (2 - gamma0 dt) - 1 = {2 / (2 - g_max) - 1:.1%}; the theory includes "
-        "the transient of the thesis' fixed initial speed sqrt(2).",
-        f"At dt = 1 (Fig. 4.20) gamma0 dt = {g_dt1:.1f} for xi = 0.8 here"
-        + (
-            ", past Euler-Maruyama's stability limit 2, so the figure shows the exact scheme there."
-            if g_dt1 >= 2
-            else ", within Euler-Maruyama's stability limit 2."
-        )
-        + (
-            f"  With the thesis' coefficients gamma0 dt = {g_thesis:.1f}: its dt = 1 curve cannot "
-            "have been Euler-Maruyama as printed."
-            if g_thesis >= 2
-            else ""
-        ),
-        "UDSBM is a model of the granular gas, not the gas: it tracks the EDMD MSD only up to "
-        "O(1 - xi), because its velocity autocorrelation (2.111) differs from the gas' (2.77) "
-        "unless gamma0 tau0 >> 1 (thesis 4.2.2); here gamma0 tau0 = "
-        f"{cq[0.8].gamma0 * cq[0.8].tau0:.1f} at xi = 0.8.",
-    ]
-
-    ud = by_id["ergodicity.udsbm"]
-    ergodicity = [
-        "Theory: for the Langevin model the ratio is 1 (the thermal initial <v^2> makes its "
-        "increments stationary); for UDSBM it is the expected time average over the same windows, "
-        "from the velocity correlations of the linear SDE, over its ensemble MSD."
-    ]
-    if ud["ours"] + SIGMA * ud["ours_error"] < 1:
-        ergodicity.append(
-            "UDSBM's time average stays below its ensemble MSD: it is not ergodic, as in the "
-            "thesis and ref. [15]."
-        )
-    ergodicity.append(
-        "Fig. 4.23 sets its time averages for t_stop = "
-        + ", ".join(f"{t:g}" for t in cfg.tamsd_t_stops)
-        + " beside their theory."
-    )
-
-    return [
-        ("Energy (Fig. 4.2)", "energy.", energy),
-        ("Speed distributions (Table 4.1, Figs 4.5-4.7)", "table4.1.", speeds),
-        ("Haff's law (Fig. 4.10)", "haff.", haff),
-        ("Long-time MSD slopes (App. F)", "msd.slope.", slopes),
-        ("Langevin and UDSBM (Figs 4.17-4.20)", "sde.", sde),
-        ("Ergodicity (Figs 4.21-4.23)", "ergodicity.", ergodicity),
-        ("Where homogeneous cooling ends (clustering)", "cluster.", _clustering_notes(by_id)),
-        ("Viscoelastic gases", "visco.", _visco_notes(by_id)),
-    ]
-
-
-def _clustering_notes(by_id):
-    from . import reproduce_clustering
-
-    return reproduce_clustering.notes(by_id)
-
-
-def _visco_notes(by_id):
-    from . import reproduce_visco
-
-    return reproduce_visco.notes(by_id)
-
-
-def _report(rows, cfg, names, seconds):
-    """The text of ``report.md``: the table, a sentence per row generated from it, the
-    physics of each section and the figures."""
-    lines = [
-        "# Thesis chapter 4, reproduced by granular",
-        "",
-        f"System: N = {cfg.n3}, r = {cfg.r3:.4g} (3D), N = {cfg.n2}, r = {cfg.r2:.4g} (2D); "
-        f"{cfg.runs_few} runs where the thesis used 4, {cfg.runs_many} where it used 20"
-        + (" (quick mode: small sizes, short times)" if cfg.quick else "")
-        + f". Took {seconds:.0f} s.",
-        "Errors are standard errors of the mean over the runs (central limit theorem); 'agrees' "
-        f"means within {SIGMA:g} of them.",
-        "",
-        "| id | quantity | ours | runs | thesis | theory | ours/theory - 1 |",
-        "|---|---|---|---|---|---|---|",
-    ]
-    for r in rows:
-        rel = f"{r['ours'] / r['theory'] - 1:+.2%}" if r["theory"] else "--"
-        quantity = r["quantity"].replace("|", "\\|")
-        lines.append(
-            f"| {r['id']} | {quantity} | {_fmt(r['ours'], r['ours_error'])} | {r['runs'] or '--'} "
-            f"| {_num(r['thesis'])} | {_num(r['theory'])} | {rel} |"
-        )
-    lines += ["", "## Where we agree, and where not"]
-    by_id = {r["id"]: r for r in rows}
-    for title, prefix, notes in _notes(cfg, by_id):
-        lines += ["", f"### {title}", ""]
-        lines += [_sentence(r) for r in rows if r["id"].startswith(prefix)]
-        lines += ["", " ".join(notes)]
-    lines += [
-        "",
-        "### Slips of the thesis, corrected",
-        "",
-        "Isotropic initial directions instead of eq. 3.3 (a uniform polar angle puts too much "
-        "speed along z), the mean collision time of (2.42) instead of (2.70)-(2.71) (which make "
-        "it proportional to sqrt(T)), and the Euler-Maruyama noise term sqrt(2D) gamma dW.",
-        "",
-        "## Figures",
-        "",
-    ]
-    lines += [f"![{n}]({n})" for n in names]
-    return "\n".join(lines) + "\n"

@@ -157,7 +157,7 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
             r = result[name, xi]
             per, tau0 = r["per"], r["tau0"]
             s = times[1:] / tau0
-            label = f"N = {n}, L / L_c = {r['L'] / r['lc']:.2f}"
+            label = f"N = {n}, $L / L_c$ = {r['L'] / r['lc']:.2f}"
             temps = np.array([p["temperature"] for p in per])
             haff = theory.haff_temperature(times, r["T0"], tau0)
             dev, dev_err = analysis.ensemble_mean(temps / haff - 1)
@@ -169,7 +169,9 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
             ax.fill_between(s, (exc - exc_err)[1:], (exc + exc_err)[1:], color=colour, alpha=0.1)
             onset = [p["onset_t"] / tau0 for p in per if np.isfinite(p["onset_t"])]
             if name == "thesis" and onset:
-                ax.axvline(np.median(onset), color="0.5", ls=":", lw=1)
+                ax.axvline(
+                    np.median(onset), color="0.5", ls=":", lw=1, label="onset (N = 1000, median)"
+                )
             ax2 = axes2[k]
             s_perp, s_err = analysis.ensemble_mean(np.array([p["s_perp"] for p in per]))
             ax2.errorbar(s, s_perp[1:], yerr=s_err[1:], color=colour, fmt=".-", label=label)
@@ -178,7 +180,7 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
             if r["L"] < r["lc"]:
                 ax2.axhline(theory.shear_mode_level(r["L"], r["lc"]), color=colour, ls="--", lw=1)
         ax = axes[k]
-        ax.axhline(ONSET, color="0.5", lw=0.8)
+        ax.axhline(ONSET, color="0.5", lw=0.8, label=f"onset threshold, {ONSET:g}")
         ax.set_xscale("log")
         ax.set_xlabel(r"$t / \tau_0$ (dimensionless)")
         ax.set_ylabel("relative deviation, energy ratio (dimensionless)")
@@ -191,7 +193,7 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
         ax2.set_ylabel(r"correlation at $k = 2\pi/L$ (dimensionless; 1: uncorrelated)")
         ax2.set_title(
             rf"$\xi$ = {xi}: transverse current (dots), $S(k)$ (dotted),"
-            + "\ntheory below L_c (dashed)"
+            + "\ntheory below $L_c$ (dashed)"
         )
         ax2.legend(fontsize="x-small")
     names.append(save(f, out, "cluster_haff_and_flow.png"))
@@ -211,7 +213,7 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax3.axvline(1.0, color="0.5", ls=":", label="critical size (theory)")
     ax3.axhline(0.0, color="k", lw=0.8)
     ax3.set_xlabel(r"box side over critical size, $L / L_c$ (dimensionless)")
-    ax3.set_ylabel(r"fitted $\tau_0$ / (2.45) - 1 (dimensionless)")
+    ax3.set_ylabel(r"fitted $\tau_0$ / [G20] eq. 2.45 $-$ 1 (dimensionless)")
     ax3.set_title(r"Haff's $\tau_0$ against box size (n = 1000, $\eta$ = 0.065)")
     ax3.legend()
     names.append(save(f3, out, "cluster_tau0_vs_box.png"))

@@ -37,7 +37,7 @@ import warnings
 
 import numpy as np
 
-from .. import Scene, Simulation, Viscoelastic, analysis, langevin, theory
+from .. import Scene, Simulation, Viscoelastic, analysis, langevin, plot, theory
 from ..errors import InelasticCollapseError
 
 DENSITY, RADIUS, N = 1000.0, 0.025, 250  # the thesis' density; a box below L_c
@@ -245,8 +245,8 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax = axes[1]
     m, me = res.mean["msd"], res.error["msd"]
     ax.errorbar(s, m[1:], yerr=me[1:], fmt=".", color="C0", label="EDMD")
-    ax.plot(s, m2[1:], "-", color="C1", label="msd_viscoelastic_second_order")
-    ax.plot(s, m1[1:], "--", color="C2", label="msd_viscoelastic (leading order)")
+    ax.plot(s, m2[1:], "-", color="C1", label="theory, second order")
+    ax.plot(s, m1[1:], "--", color="C2", label=r"leading order ($\propto t^{1/6}$ late)")
     ax.plot(
         s, theory.msd_viscoelastic_asymptote(times[1:], D0=c.D0, tau0=tau), ":", color="0.4",
         label=r"asymptote $\propto t^{1/6}$",
@@ -257,7 +257,7 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(r"$t / \tau_0'$ (dimensionless)")
-    ax.set_ylabel("MSD (length$^2$)")
+    ax.set_ylabel(plot.MSD)
     ax.set_title("Mean squared displacement")
     ax.legend(fontsize="x-small")
     ax = axes[2]
@@ -284,20 +284,24 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
 
     # figure: collapse against no collapse
     f2, ax2 = fig(1)
+    constant = rf"constant $\xi$ = {COLLAPSE_XI}: collapse"
+    visco = r"viscoelastic, mean $\varepsilon$ = $\xi$: end of run (o) or collapse (x)"
     for k, (eta_, seed, t_c, v) in enumerate(collapsing):
         ax2.plot([k, k], [t_c, v[0]], "-", color="0.7", lw=1)
-        ax2.plot(k, t_c, "x", color="C3", label=f"xi = {COLLAPSE_XI}: collapse" if k == 0 else None)
+        ax2.plot(k, t_c, "x", color="C3", label=constant if k == 0 else None)
         marker, colour = ("x", "C3") if v[1] else ("o", "C2")
         ax2.plot(
             k, v[0], marker, color=colour, mfc="none",
-            label="viscoelastic: end of run (o) or collapse (x)" if k == 0 else None,
+            label=visco if k == 0 else None,
         )  # fmt: skip
         ax2.annotate(f"{eta_:g}/{seed}", (k, t_c), fontsize=6, xytext=(2, -8),
                      textcoords="offset points")  # fmt: skip
     ax2.set_yscale("log")
-    ax2.set_xlabel("scene (area fraction / seed) that collapses with constant xi")
-    ax2.set_ylabel("time (units of the scene)")
-    ax2.set_title(f"2D walls, N = {COLLAPSE_N}: collapse at xi = {COLLAPSE_XI}, not viscoelastic")
+    ax2.set_xlabel(r"scene (label: area fraction / seed) that collapses at constant $\xi$")
+    ax2.set_ylabel(plot.TIME)
+    ax2.set_title(
+        rf"2D walls, N = {COLLAPSE_N}: collapse at $\xi$ = {COLLAPSE_XI}, not viscoelastic"
+    )
     ax2.legend(fontsize="small")
     names.append(save(f2, out, "visco_collapse.png"))
     return names, rows

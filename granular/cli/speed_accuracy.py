@@ -53,6 +53,7 @@ from .. import (
     langevin,
     theory,
 )
+from ..restitution import matched_viscoelastic
 from ..simulation import _LIST_SHELL  # the shell of shell="auto": dense_cost measures it
 from .bench_langevin import log_lags
 from .output import write_json
@@ -288,51 +289,6 @@ def em_stability(quick=False):
     return rows
 
 
-# The viscoelastic law's series holds for eps >= 0.76 only (granular.restitution.DELTA_MAX):
-# a constant xi is matched by a law only if at most this share of the initial collisions
-# would be faster than the law's max_speed (and get the clamped eps).
-MATCH_CLAMPED_SHARE = 0.01
-
-
-def matched_viscoelastic(xi, temperature, mass=1.0):
-    """The viscoelastic law with the same mean restitution as a constant xi, or None.
-
-    "Same mean restitution" as in tests/test_restitution.py's no-collapse test: eps(g)
-    averaged over the initial collisions of a gas at ``temperature``, whose normal relative
-    speeds g have the Rayleigh density g / s^2 exp(-g^2 / 2 s^2), s^2 = 2 T / m (collisions
-    weight the Gaussian normal relative velocity by g).  The mean falls with the damping
-    (bisection), down to about 0.76, the law's clamp: a xi whose matched law would send
-    more than ``MATCH_CLAMPED_SHARE`` of the initial collisions past ``max_speed`` is
-    outside the law's range, and None is returned with the reason.
-
-    Returns
-    -------
-    (law or None, dict)
-        The law (kappa = 1, the damping found) and {"mean_eps", "clamped_share"}; or None
-        and the share the closest law reached.
-    """
-    sd = math.sqrt(2.0 * temperature / mass)
-    g = np.linspace(0.0, 12 * sd, 20_001)
-    weight = g / sd**2 * np.exp(-(g**2) / (2 * sd**2))
-
-    def mean_eps(damping):
-        return float(np.trapezoid(Viscoelastic(damping, 1.0)(g) * weight, g))
-
-    def clamped(law):
-        return math.exp(-(law.max_speed**2) / (2 * sd**2))  # Rayleigh tail beyond max_speed
-
-    lo, hi = 1e-6, 10.0
-    if mean_eps(hi) > xi:  # even the strongest damping keeps the mean above xi
-        law = Viscoelastic(hi, 1.0)
-        return None, dict(mean_eps=mean_eps(hi), clamped_share=clamped(law))
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if mean_eps(mid) > xi else (lo, mid)
-    law = Viscoelastic(lo, 1.0)
-    info = dict(mean_eps=mean_eps(lo), clamped_share=clamped(law))
-    return (law if info["clamped_share"] <= MATCH_CLAMPED_SHARE else None), info
-
-
 # The collapse map's goal: at 100 collisions per particle constant xi = 0.8 does not yet
 # collapse anywhere, at 400 it does in the dense cells -- where the viscoelastic law of the
 # same mean restitution (the lowest xi it can match) is put to the test.
@@ -557,6 +513,37 @@ COLLAPSE_STATUS = {
 }
 
 
+def _log_ticks(axis, limits):
+    """Ticks of a log axis that never collide: matplotlib labels every minor tick of an
+    axis spanning about a decade (2e-3, 3e-3, ... run into each other); such an axis gets
+    labels at 1, 2 and 5 times the powers of ten, and no minor labels."""
+    from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
+
+    axis.set_minor_formatter(NullFormatter())
+    if math.log10(limits[1] / limits[0]) < 1.5:
+        axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+        axis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False))
+
+
+def _em_chart(plt, out, stab):
+    """em_stability.png: each scheme's MSD error against gamma0 dt (rows of ``em_stability``)."""
+    fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
+    g = [r["gamma_dt"] for r in stab]
+    for scheme, marker in (("em", "s-"), ("exact", "^-")):
+        ax.loglog(
+            g,
+            [r[scheme] if r[scheme] is not None else np.nan for r in stab],
+            marker,
+            label={"em": "Euler-Maruyama", "exact": "exact scheme"}[scheme],
+        )
+    ax.axvline(2.0, color="r", ls=":", label=r"EM refused ($\gamma_0 \Delta t \geq 2$)")
+    ax.set_xlabel(r"$\gamma_0 \Delta t$ (dimensionless)")
+    ax.set_ylabel("max relative MSD error\nvs [G20] eq. 2.68 (dimensionless)")
+    ax.legend()
+    fig.savefig(os.path.join(out, "em_stability.png"), dpi=110)
+    plt.close(fig)
+
+
 def _collapse_map(plt, cells):
     """One panel per law and contact duration (constant xi without and with the TC model,
     then the viscoelastic law): a grid of cells (area fraction x restitution), each
@@ -658,13 +645,18 @@ def _charts(out, points, refs, stab, cells, dense):
                         xytext=(3, 3),
                         textcoords="offset points",
                     )
+            for axis, limits in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+                _log_ticks(axis, limits)
             ax.set_xlabel("CPU seconds, one core (EDMD: equilibration included)")
             ax.set_ylabel(
-                "max relative MSD error vs EDMD reference"
-                if key == "msd_error"
-                else "relative error of the late exponent d ln MSD / d ln t"
-                if gas == "viscoelastic"
-                else "relative error of the long-time slope"
+                (
+                    "max relative MSD error vs EDMD reference"
+                    if key == "msd_error"
+                    else "relative error of the late exponent d ln MSD / d ln t"
+                    if gas == "viscoelastic"
+                    else "relative error of the long-time slope"
+                )
+                + " (dimensionless)"
             )
             ax.set_title(
                 f"{gas} gas"
@@ -678,21 +670,7 @@ def _charts(out, points, refs, stab, cells, dense):
     fig.savefig(os.path.join(out, "speed_accuracy.png"), dpi=110)
     plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(6, 4.2), layout="constrained")
-    g = [r["gamma_dt"] for r in stab]
-    for scheme, marker in (("em", "s-"), ("exact", "^-")):
-        ax.loglog(
-            g,
-            [r[scheme] if r[scheme] is not None else np.nan for r in stab],
-            marker,
-            label={"em": "Euler-Maruyama", "exact": "exact scheme"}[scheme],
-        )
-    ax.axvline(2.0, color="r", ls=":", label=r"EM refused ($\gamma_0 \Delta t \geq 2$)")
-    ax.set_xlabel(r"$\gamma_0 \Delta t$")
-    ax.set_ylabel("max relative MSD error vs (2.68)")
-    ax.legend()
-    fig.savefig(os.path.join(out, "em_stability.png"), dpi=110)
-    plt.close(fig)
+    _em_chart(plt, out, stab)
 
     fig = _collapse_map(plt, cells)
     fig.savefig(os.path.join(out, "collapse_map.png"), dpi=110)
