@@ -163,6 +163,20 @@ def _array(value, name, shape):
     return a
 
 
+# what Scene.replace changes
+_FIELDS = (
+    "positions",
+    "velocities",
+    "radii",
+    "masses",
+    "box",
+    "boundary",
+    "wall_restitution",
+    "restitution",
+    "contact_duration",
+)
+
+
 def _set(scene: Scene, name: str, value: Any) -> None:
     """Set a field while the Scene is made (``Scene.__setattr__`` refuses it after)."""
     object.__setattr__(scene, name, value)
@@ -263,9 +277,14 @@ class Scene:
     def __setattr__(self, name: str, value: Any) -> None:
         # a field set after the checks would skip them (a restitution of 7.5, an overlap)
         field = "box" if name in ("lower", "upper") else name
+        how = (
+            f"scene.replace({field}=...)"
+            if field in _FIELDS
+            else f"scene.replace(...) of its fields {', '.join(_FIELDS)}"
+        )
         raise AttributeError(
             f"a Scene is immutable: {name} cannot be set; make a changed copy, checked "
-            f"anew, with scene.replace({field}=...)"
+            f"anew, with {how}"
         )
 
     def __delattr__(self, name: str) -> None:
