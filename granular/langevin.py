@@ -402,7 +402,7 @@ class LangevinResult:
         """(T,) the temperature at the sample times, an energy (k_B = 1) as on every
         result: ``mass * v2 / dim``.
 
-        Until granular 0.1 it was the temperature per unit mass, ``v2 / dim``; the numbers
+        It used to be the temperature per unit mass, ``v2 / dim``; the numbers
         differ only for a mass other than 1 (a ``from_scene`` run of heavier or lighter
         particles), which warns (FutureWarning) until granular 0.2.0."""
         if self.mass != 1.0:
