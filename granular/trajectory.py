@@ -192,7 +192,7 @@ class Trajectory:
         """(T - 1,) the lags ``tamsd()`` takes by default: every sample time after the first,
         less the first (``times[k] - times[0]``), each a difference of sample times; with
         uniform sampling, every multiple of the spacing the run spans."""
-        return readonly(self.times[1:] - self.times[0])
+        return readonly(self.times[1:] - self.times[:1])
 
     def tamsd(
         self,
