@@ -236,6 +236,35 @@ def _tamsd_direct(x, t, lags):
     return out
 
 
+def ergodicity_breaking(tamsd_per_particle: ArrayLike) -> NDArray[np.float64]:
+    """Ergodicity-breaking parameter at each lag from the particles' time-averaged MSDs,
+    ``EB = (<delta^2 ^2> - <delta^2>^2) / <delta^2>^2`` over the particles (thesis
+    2.114-2.119; He, Burov, Metzler & Barkai, PRL 101, 058101 (2008)); it goes to 0 for an
+    ergodic process as the run grows long against the lag.  The variance is the
+    particles' own (ddof 0), as in the definition.
+
+    Parameters
+    ----------
+    tamsd_per_particle : (N, L) array_like
+        One row per particle, one column per lag (length^2): e.g.
+        ``tamsd(..., per_particle=True)`` of any result.
+
+    Returns
+    -------
+    (L,) ndarray, dimensionless.
+    """
+    per = np.asarray(tamsd_per_particle, dtype=np.float64)
+    if per.ndim != 2:
+        raise ValueError(f"tamsd_per_particle must have shape (N, L), got {per.shape}")
+    if per.shape[0] < 2:
+        raise ValueError(
+            f"the ergodicity-breaking parameter is a variance over particles: it needs at "
+            f"least 2, got {per.shape[0]}"
+        )
+    mean = per.mean(axis=0)
+    return per.var(axis=0) / mean**2
+
+
 def diffusivity(times: ArrayLike, msd_values: ArrayLike, dim: int = 3) -> NDArray[np.float64]:
     """Time-dependent diffusivity ``D(t) = (1 / 2d) d MSD / dt`` (3D form of 2.64), with
     the derivative taken as the mean of the forward and backward differences (4.1, 4.2)

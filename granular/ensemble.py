@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._results import readonly
 from .errors import ProcessBackendError
 from .scene import Scene
 from .simulation import _STOP_KEYS, Simulation
@@ -87,11 +88,16 @@ _GUARD_ADVICE = (
 
 @dataclass(frozen=True, eq=False, repr=False)
 class EnsembleResult:
-    """Per-run results and their ensemble statistics.
+    """Per-run results and their ensemble statistics: read-only (a frozen dataclass whose
+    arrays are read-only views), as every result is (see docs/analysis.md, "Results").
 
-    The MSDs are reached as on a ``Trajectory`` and a ``LangevinResult``:
-    ``result.msd(per_dimension=False)`` and ``result.tamsd(lags=None, *, lag_samples=None)``
-    give the ensemble means (errors in ``error["msd"]``, ``error["tamsd"]``, ...).
+    The quantities every result offers under the same names and units, as a
+    ``Trajectory`` and a ``LangevinResult`` do, here the ensemble means: ``times``,
+    ``temperature`` (an energy, k_B = 1), ``msd(per_dimension=False, particles=None)``,
+    ``tamsd(lags=None, *, lag_samples=None, particles=None, per_particle=False)``,
+    ``tamsd_lags`` and ``ergodicity_breaking(lags=None, *, lag_samples=None,
+    particles=None)``.  Their standard errors are in ``error`` (``error["msd"]``,
+    ``error["temperature"]``, ``error["tamsd"]``, ...).
 
     Attributes
     ----------
@@ -115,6 +121,11 @@ class EnsembleResult:
         shape differs between runs (e.g. runs stopped by ``stop_when`` at different
         samples) or they are not numbers.  ``ensemble`` warns about them; each run's
         values stay in ``runs``.
+    temperature : (T,) ndarray
+        The mean temperature, an energy (EDMD runs collect ``"temperature"``; Langevin
+        runs always give it).
+    tamsd_lags : (L,) ndarray
+        The lags of ``tamsd()`` by default.
     """
 
     runs: list[dict[str, NDArray[Any]]]
@@ -125,6 +136,14 @@ class EnsembleResult:
     times: NDArray[np.float64] | None
     counts: dict[str, int] = field(default_factory=dict)
     left_out: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        # read-only views: a caller writing into an array the result hands out gets a
+        # ValueError instead of changing the means (or a run) unseen
+        object.__setattr__(self, "times", readonly(self.times))
+        for values in (self.mean, self.error, *self.runs):
+            for k, v in values.items():
+                values[k] = readonly(v)
 
     def _quantity(self, name: str, hint: str) -> NDArray[np.float64]:
         if name in self.mean:
@@ -143,25 +162,66 @@ class EnsembleResult:
             f"this ensemble collected no {name!r} ({hint}); it has {sorted(self.mean)}"
         )
 
+    def _runs_with(self, name: str, why: str, hint: str) -> list[dict[str, NDArray[Any]]]:
+        """The runs, each of which must hold ``name``: what a choice of particles (or a
+        TAMSD of EDMD runs) is computed from."""
+        if not self.runs:
+            raise ValueError(
+                f"{why} needs each run's {name}, and this ensemble kept no runs "
+                "(ensemble(..., keep_runs=True), the default, keeps them)"
+            )
+        missing = [r for r, run in enumerate(self.runs) if name not in run]
+        if missing:
+            raise ValueError(
+                f"{why} needs each run's {name!r}, which run {missing[0]} does not hold ({hint})"
+            )
+        return self.runs
+
+    @property
+    def temperature(self) -> NDArray[np.float64]:
+        """(T,) the mean temperature of the runs at the sample times, an energy (k_B = 1)
+        as on every result; its standard error is ``error["temperature"]``."""
+        return self._quantity(
+            "temperature", 'ensemble(quantities=(..., "temperature")) for EDMD runs'
+        )
+
     def msd(
         self, per_dimension: bool = False, particles: ArrayLike | None = None
     ) -> NDArray[np.float64]:
         """The ensemble mean of the runs' MSDs at the sample times: (T,) summed over
         dimensions, or (T, d) with ``per_dimension=True`` (for EDMD, collect
         ``"msd_per_dimension"`` among ``quantities``).  Its standard error is
-        ``error["msd"]`` (``error["msd_per_dimension"]``).
+        ``error["msd"]`` (``error["msd_per_dimension"]``).  The same call as
+        ``Trajectory.msd`` and ``LangevinResult.msd``.
 
-        ``particles`` cannot apply: each run's MSD is already averaged over its particles
-        before the runs are reduced; a tracer is chosen in the runs themselves (e.g. a
-        model function returning ``langevin.run(...)``'s tracer MSD, or
-        ``quantities=("positions",)`` and ``analysis.msd(run["positions"], particles=...)``
-        over ``runs``)."""
+        Parameters
+        ----------
+        per_dimension : bool
+            Return (T, d), one column per axis, instead of the sum over axes.
+        particles : array_like of int or bool, optional
+            The mean over the runs of the MSD of these particles only (indices, or a
+            boolean mask over each run's N), e.g. a tracer: computed from each run's
+            positions, which the runs must keep (EDMD: ``quantities=(..., "positions")``;
+            Langevin: ``store_positions=True``), as ``msd(particles=...)`` of each run
+            would.  No standard error is kept for it.
+        """
         if particles is not None:
-            raise TypeError(
-                "an ensemble holds each run's MSD averaged over its particles; "
-                "particles= cannot apply here (choose particles in the runs: "
-                "see EnsembleResult.msd)"
+            from .analysis import _select
+
+            runs = self._runs_with(
+                "positions",
+                "msd(particles=...)",
+                'EDMD: quantities=(..., "positions"); Langevin: store_positions=True',
             )
+            out = []
+            for run in runs:
+                x = _select(np.asarray(run["positions"]), particles)
+                # a Langevin run (the one with "v2") starts every particle at the origin at
+                # t = 0, which need not be a sample; an EDMD run's MSD is from its first sample
+                d = x if "v2" in run else x - x[0]
+                out.append(np.einsum("tna,tna->ta", d, d) / x.shape[1])
+            per = np.mean(out, axis=0)
+            return per if per_dimension else per.sum(axis=1)
         if per_dimension:
             return self._quantity(
                 "msd_per_dimension", 'ensemble(quantities=(..., "msd_per_dimension"))'
@@ -170,8 +230,59 @@ class EnsembleResult:
 
     @property
     def tamsd_lags(self) -> NDArray[np.float64]:
-        """(L,) lags in time of ``tamsd()``: those of the runs (Langevin ensembles)."""
-        return self._quantity("tamsd_lags", "a TAMSD comes from Langevin runs with tamsd_lags")
+        """(L,) the lags ``tamsd()`` takes by default: those the runs accumulated (Langevin
+        runs with ``tamsd_lags``), or for EDMD runs that kept their positions every sample
+        time after the first, less the first (as ``Trajectory.tamsd_lags``)."""
+        if "tamsd_lags" in self.mean or "tamsd_lags" in self.left_out:
+            return self._quantity("tamsd_lags", "")
+        if self.times is not None and self.runs and "positions" in self.runs[0]:
+            return readonly(self.times[1:] - self.times[0])
+        return self._quantity(
+            "tamsd_lags",
+            "a TAMSD comes from Langevin runs with tamsd_lags, or EDMD runs with "
+            'quantities=(..., "positions")',
+        )
+
+    def _tamsd_rows(
+        self, lags: ArrayLike | None, lag_samples: ArrayLike | None, particles: ArrayLike | None
+    ) -> list[NDArray[np.float64]]:
+        """Each run's (N, L) TAMSD of the chosen particles: the rows a Langevin run kept,
+        or ``analysis.tamsd`` of an EDMD run's positions."""
+        from . import analysis
+        from .langevin import _lag_indices
+
+        if "tamsd_lags" in self.mean or (self.runs and "tamsd_per_particle" in self.runs[0]):
+            runs = self._runs_with(
+                "tamsd_per_particle",
+                "tamsd(particles=...) or tamsd(per_particle=True)",
+                "the rows of a Langevin run with tamsd_lags",
+            )
+            rows = []
+            for run in runs:
+                pick = _lag_indices(run["tamsd_lags"], float(run["dt"]), lags, lag_samples)
+                per = np.asarray(run["tamsd_per_particle"])[:, pick]
+                rows.append(per if particles is None else analysis._select(per[None], particles)[0])
+            return rows
+        runs = self._runs_with(
+            "positions",
+            "a TAMSD of EDMD runs",
+            'collect quantities=(..., "positions"); Langevin runs need tamsd_lags',
+        )
+        if lags is not None and lag_samples is not None:
+            raise TypeError("give at most one of lags (in time) and lag_samples (in samples)")
+        if lags is None and lag_samples is None:
+            lags = self.tamsd_lags
+        return [
+            analysis.tamsd(
+                run["positions"],
+                lags,
+                times=run["times"],
+                lag_samples=lag_samples,
+                particles=particles,
+                per_particle=True,
+            )
+            for run in runs
+        ]
 
     def tamsd(
         self,
@@ -181,30 +292,57 @@ class EnsembleResult:
         particles: ArrayLike | None = None,
         per_particle: bool = False,
     ) -> NDArray[np.float64]:
-        """The ensemble mean of the runs' time-averaged MSDs, (L,), at the lags the runs
-        accumulated (``tamsd_lags``: Langevin runs with ``tamsd_lags``), or at those of
-        them chosen by ``lags`` (in time) or ``lag_samples`` (in steps), as
-        ``LangevinResult.tamsd``.  Its standard error is ``error["tamsd"]``.
+        """The ensemble mean of the runs' time-averaged MSDs, (L,); the same call,
+        defaults and errors as ``Trajectory.tamsd`` and ``LangevinResult.tamsd``: by
+        default at every lag the runs have (``tamsd_lags``), or at those of them chosen by
+        ``lags`` (in time) or ``lag_samples`` (in steps or samples).  Its standard error
+        is ``error["tamsd"]`` (Langevin runs).
 
-        ``particles`` and ``per_particle`` cannot apply: the runs are reduced to means
-        over their particles (``runs[r]["tamsd_per_particle"]`` keeps each run's rows).
-        EDMD ensembles collect no TAMSD: collect ``"positions"`` and apply
-        ``granular.analysis.tamsd`` to each run."""
-        if particles is not None or per_particle:
-            raise TypeError(
-                "an ensemble holds each run's TAMSD averaged over its particles; "
-                "particles= and per_particle= cannot apply here (each run's rows "
-                "are in runs[r]['tamsd_per_particle'])"
-            )
-        values = self._quantity(
-            "tamsd",
-            "a TAMSD comes from Langevin runs with tamsd_lags; "
-            "for EDMD collect positions and use analysis.tamsd",
-        )
-        from .langevin import _lag_indices
+        Langevin runs give the TAMSD they accumulated; EDMD runs give it from their
+        positions (``quantities=(..., "positions")``, ``analysis.tamsd`` of each run).
 
-        dt = float(self._quantity("dt", "the runs' step"))
-        return values[_lag_indices(self.tamsd_lags, dt, lags, lag_samples)]
+        Parameters
+        ----------
+        lags, lag_samples : array_like, optional
+            The lags to return, in time or in steps (samples for EDMD), at most one.
+        particles : array_like of int or bool, optional
+            The mean over the runs of these particles' TAMSD only (indices, or a boolean
+            mask over each run's N): from each run's kept rows, which needs the runs
+            (``keep_runs=True``, the default).
+        per_particle : bool
+            Return (K N, L): one row per chosen particle of every run, the runs in order
+            (each Langevin run's ``tamsd_per_particle``), instead of the mean.
+        """
+        if particles is None and not per_particle and "tamsd" in self.mean:
+            from .langevin import _lag_indices
+
+            dt = float(self._quantity("dt", "the runs' step"))
+            return self.mean["tamsd"][_lag_indices(self.tamsd_lags, dt, lags, lag_samples)]
+        rows = self._tamsd_rows(lags, lag_samples, particles)
+        if per_particle:
+            return np.concatenate(rows)
+        return np.mean([r.mean(axis=0) for r in rows], axis=0)
+
+    def ergodicity_breaking(
+        self,
+        lags: ArrayLike | None = None,
+        *,
+        lag_samples: ArrayLike | None = None,
+        particles: ArrayLike | None = None,
+    ) -> NDArray[np.float64]:
+        """The measured ergodicity-breaking parameter at the lags of ``tamsd()`` (by
+        default ``tamsd_lags``), over the particles of every run together:
+        ``analysis.ergodicity_breaking`` of ``tamsd(..., per_particle=True)``.  The same
+        call as on the other results.
+
+        Parameters
+        ----------
+        lags, lag_samples, particles : as in ``tamsd``.
+        """
+        from . import analysis
+
+        per = self.tamsd(lags, lag_samples=lag_samples, particles=particles, per_particle=True)
+        return analysis.ergodicity_breaking(per)
 
     def __repr__(self) -> str:
         q = ", ".join(

@@ -46,6 +46,8 @@ window per lag per step.  See docs/performance.md.
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
 import os
 import warnings
@@ -57,6 +59,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._results import REMOVAL_VERSION, deprecated, readonly
 from .errors import shown
 
 if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but stay light
@@ -75,18 +78,14 @@ INITIAL = ("thermal", "udsbm", "fixed")
 _CHUNK_PARTICLE_STEPS = 10_000_000
 
 
-# the array use of LangevinResult.msd / .tamsd works, with a DeprecationWarning, for the
-# one release after the change, and goes in this one
-_ARRAY_USE_REMOVED_IN = "0.3.0"
-
-
 class _ArrayAndMethod(np.ndarray):
     """The transition from an array attribute to a method of the same name:
     ``result.msd`` used to be the (T,) array and is now the method ``result.msd()``.
     This object is both -- called, it runs the method; used as an array (indexing,
-    arithmetic, NumPy functions), it is the old array and warns that this use is
-    deprecated; the array use is removed in granular 0.3.0 (``_ARRAY_USE_REMOVED_IN``).
-    Results of array use are plain arrays."""
+    arithmetic, NumPy functions), it is the old array and warns (FutureWarning) that this
+    use goes in granular ``REMOVAL_VERSION``.  Results of array use are plain arrays.
+    ``inspect.signature`` gives the method's.  Goes in ``REMOVAL_VERSION`` with the array
+    use, leaving plain methods."""
 
     _method: Any  # the bound method (None only on views made by NumPy itself)
     _name: str
@@ -105,12 +104,15 @@ class _ArrayAndMethod(np.ndarray):
     def __call__(self, *args: Any, **kwargs: Any) -> NDArray[np.float64]:
         return self._method(*args, **kwargs)
 
+    @property
+    def __signature__(self) -> inspect.Signature:
+        return inspect.signature(self._method)
+
     def _deprecated(self) -> None:
-        warnings.warn(
-            f"using result.{self._name} as an array is deprecated and removed in granular "
-            f"{_ARRAY_USE_REMOVED_IN}; call result.{self._name}() (the same numbers)",
-            DeprecationWarning,
-            stacklevel=3,
+        deprecated(
+            f"using result.{self._name} as an array",
+            f"call result.{self._name}() (the same numbers)",
+            stacklevel=4,
         )
 
     def __getitem__(self, index: Any) -> Any:
@@ -143,6 +145,27 @@ class _ArrayAndMethod(np.ndarray):
 
     def __reduce__(self) -> Any:  # pickles as the plain array it holds
         return self.view(np.ndarray).__reduce__()
+
+
+class _MethodWithArrayShim:
+    """A method that, for one more release, is also the array it replaced: on the class it
+    is the plain function (so ``inspect.signature(LangevinResult.msd)`` and ``help`` work),
+    on a result an ``_ArrayAndMethod`` of the array in ``values`` (an attribute name).
+    Goes in ``REMOVAL_VERSION``: the methods then are plain methods."""
+
+    def __init__(self, values: str) -> None:
+        self.values = values
+
+    def __call__(self, method: Callable[..., Any]) -> _MethodWithArrayShim:
+        self.method = method
+        functools.update_wrapper(self, method)
+        return self
+
+    def __get__(self, result: Any, owner: type | None = None) -> Any:
+        if result is None:
+            return self.method
+        bound = self.method.__get__(result, owner)
+        return _ArrayAndMethod(getattr(result, self.values), bound, self.method.__name__)
 
 
 def _no_lags() -> ValueError:
@@ -225,11 +248,14 @@ def _lag_indices(
 
 @dataclass(frozen=True, eq=False, repr=False)
 class LangevinResult:
-    """What a Langevin/UDSBM run measured.
+    """What a Langevin/UDSBM run measured: read-only (a frozen dataclass whose arrays are
+    read-only views), as every result is (see docs/analysis.md, "Results").
 
-    The ensemble MSD and the time-averaged MSD are reached as on a ``Trajectory`` and an
-    ``EnsembleResult``: ``result.msd(per_dimension=False, particles=None)`` and
-    ``result.tamsd(lags=None, *, lag_samples=None, particles=None, per_particle=False)``.
+    The quantities every result offers under the same names and units, as a
+    ``Trajectory`` and an ``EnsembleResult`` do: ``times``, ``temperature`` (an energy,
+    k_B = 1), ``msd(per_dimension=False, particles=None)``, ``tamsd(lags=None, *,
+    lag_samples=None, particles=None, per_particle=False)``, ``tamsd_lags`` and
+    ``ergodicity_breaking(lags=None, *, lag_samples=None, particles=None)``.
 
     Attributes
     ----------
@@ -237,7 +263,8 @@ class LangevinResult:
     steps : (T,) the sample steps
     msd_total, msd_per_dimension : (T,), (T, d) ensemble MSD from the common start at the
         origin, summed over dimensions and per dimension (``msd()`` returns them)
-    v2 : (T,) mean squared speed; ``temperature = mass * v2 / d``
+    v2 : (T,) mean squared speed, per particle
+    temperature : (T,) the temperature, an energy: ``mass * v2 / dim``
     tamsd_lags : (L,) lags in time at which the TAMSD was accumulated
     tamsd_mean : (L,) particle-averaged time-averaged MSD (``tamsd()`` returns it)
     tamsd_per_particle : (N, L)
@@ -251,6 +278,9 @@ class LangevinResult:
     v0_sq : initial mean squared velocity per component
     initial : the initial velocities, as given to ``run``: "thermal" or "udsbm" (Gaussian)
         or "fixed" (one speed for every particle)
+    mass : the particles' mass (``run(mass=...)``; the scene's for ``from_scene``): the
+        dynamics depend on D0 and gamma0 only, the temperature is ``mass`` times
+        ``D0 gamma0`` in equilibrium
     """
 
     times: NDArray[np.float64]
@@ -277,11 +307,24 @@ class LangevinResult:
     v0_sq: float
     exponent: float = 1.0
     initial: str = "thermal"
+    mass: float = 1.0
 
-    @property
-    def msd(self) -> _ArrayAndMethod:
-        """``msd(per_dimension=False, particles=None)``: the ensemble MSD at the sample
-        times, (T,) summed over dimensions or (T, d) per dimension.
+    def __post_init__(self) -> None:
+        # read-only views: a caller writing into an array the result hands out gets a
+        # ValueError instead of changing the result unseen
+        self.__setstate__(dict(vars(self)))
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # unpickled (and copied) read-only too: NumPy does not keep the flag
+        for name, value in state.items():
+            object.__setattr__(self, name, readonly(value))
+
+    @_MethodWithArrayShim("msd_total")
+    def msd(
+        self, per_dimension: bool = False, particles: ArrayLike | None = None
+    ) -> NDArray[np.float64]:
+        """The ensemble MSD at the sample times, (T,) summed over dimensions or (T, d) per
+        dimension.  The same call as ``Trajectory.msd`` and ``EnsembleResult.msd``.
 
         Parameters
         ----------
@@ -294,12 +337,8 @@ class LangevinResult:
 
         Notes
         -----
-        Used as an array, ``result.msd`` is still the (T,) MSD, deprecated."""
-        return _ArrayAndMethod(self.msd_total, self._msd, "msd")
-
-    def _msd(
-        self, per_dimension: bool = False, particles: ArrayLike | None = None
-    ) -> NDArray[np.float64]:
+        Used as an array, ``result.msd`` is still the (T,) MSD, with a FutureWarning: that
+        use goes in granular ``REMOVAL_VERSION``."""
         if particles is None:
             return self.msd_per_dimension if per_dimension else self.msd_total
         if self.positions is None:
@@ -315,10 +354,18 @@ class LangevinResult:
         per = np.einsum("tna,tna->ta", x, x) / x.shape[1]
         return per if per_dimension else per.sum(axis=1)
 
-    @property
-    def tamsd(self) -> _ArrayAndMethod:
-        """``tamsd(lags=None, *, lag_samples=None, particles=None, per_particle=False)``:
-        the time-averaged MSD, (L,) averaged over particles or (N, L) per particle.
+    @_MethodWithArrayShim("tamsd_mean")
+    def tamsd(
+        self,
+        lags: ArrayLike | None = None,
+        *,
+        lag_samples: ArrayLike | None = None,
+        particles: ArrayLike | None = None,
+        per_particle: bool = False,
+    ) -> NDArray[np.float64]:
+        """The time-averaged MSD, (L,) averaged over particles or (N, L) per particle.
+        The same call, defaults and errors as ``Trajectory.tamsd`` and
+        ``EnsembleResult.tamsd``.
 
         The engine accumulates it on the fly at the lags given to ``run(tamsd_lags=...)``
         (``tamsd_lags``) and only there: by default all of them; ``lags`` (in time) or
@@ -337,17 +384,8 @@ class LangevinResult:
 
         Notes
         -----
-        Used as an array, ``result.tamsd`` is still the (L,) TAMSD, deprecated."""
-        return _ArrayAndMethod(self.tamsd_mean, self._tamsd, "tamsd")
-
-    def _tamsd(
-        self,
-        lags: ArrayLike | None = None,
-        *,
-        lag_samples: ArrayLike | None = None,
-        particles: ArrayLike | None = None,
-        per_particle: bool = False,
-    ) -> NDArray[np.float64]:
+        Used as an array, ``result.tamsd`` is still the (L,) TAMSD, with a FutureWarning:
+        that use goes in granular ``REMOVAL_VERSION``."""
         pick = _lag_indices(self.tamsd_lags, self.dt, lags, lag_samples)
         if particles is None and not per_particle:
             return self.tamsd_mean[pick]
@@ -361,18 +399,38 @@ class LangevinResult:
 
     @property
     def temperature(self) -> NDArray[np.float64]:
-        """(T,) temperature per unit mass, ``v2 / dim``."""
-        return self.v2 / self.dim
+        """(T,) the temperature at the sample times, an energy (k_B = 1) as on every
+        result: ``mass * v2 / dim``.
+
+        It used to be the temperature per unit mass, ``v2 / dim``; the numbers
+        differ only for a mass other than 1 (a ``from_scene`` run of heavier or lighter
+        particles), which warns (FutureWarning) until granular ``REMOVAL_VERSION``."""
+        if self.mass != 1.0:
+            warnings.warn(
+                f"LangevinResult.temperature is an energy now, mass * v2 / dim with this "
+                f"run's mass {shown(self.mass)}; it used to be per unit mass, which is "
+                f"result.v2 / result.dim.  This notice goes in granular {REMOVAL_VERSION}",
+                FutureWarning,
+                stacklevel=2,
+            )
+        return self._temperature()
+
+    def _temperature(self) -> NDArray[np.float64]:
+        return readonly(self.mass * self.v2 / self.dim)
 
     def arrays(self) -> dict[str, NDArray[Any]]:
         """The NumPy arrays and numbers of this result by name, as ``granular.ensemble``
-        collects them from each run (``msd`` and ``tamsd`` under those names)."""
+        collects them from each run (``msd``, ``tamsd`` and ``temperature`` under those
+        names, the values of ``msd()``, ``tamsd()`` and ``temperature``): a dict of a
+        result's contents, the one dict a result hands out besides an ensemble's
+        ``mean`` and ``error``."""
         out = {
             "times": self.times,
             "steps": self.steps,
             "msd": self.msd_total,
             "msd_per_dimension": self.msd_per_dimension,
             "v2": self.v2,
+            "temperature": self._temperature(),
             "tamsd_lags": self.tamsd_lags,
             "tamsd": self.tamsd_mean,
             "tamsd_per_particle": self.tamsd_per_particle,
@@ -381,7 +439,7 @@ class LangevinResult:
         }
         if self.positions is not None:
             out["positions"] = self.positions
-        for name in ("gamma0", "D0", "tau0", "dt", "t_stop", "v0_sq", "exponent"):
+        for name in ("gamma0", "D0", "tau0", "dt", "t_stop", "v0_sq", "exponent", "mass"):
             out[name] = np.asarray(getattr(self, name))
         return out
 
@@ -426,14 +484,26 @@ class LangevinResult:
             exponent=self.exponent,
         )
 
-    def ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
-        """The measured ergodicity-breaking parameter at the TAMSD lags (or ``lags``):
-        ``EB = (<TAMSD^2> - <TAMSD>^2) / <TAMSD>^2`` over the particles (thesis 2.114-2.119;
-        He, Burov, Metzler & Barkai, PRL 101, 058101 (2008)); 0 for an ergodic process as
-        t_stop / lag grows.  Theory: ``theory_ergodicity_breaking``."""
-        per = self._tamsd(lags, per_particle=True)
-        mean = per.mean(axis=0)
-        return per.var(axis=0) / mean**2
+    def ergodicity_breaking(
+        self,
+        lags: ArrayLike | None = None,
+        *,
+        lag_samples: ArrayLike | None = None,
+        particles: ArrayLike | None = None,
+    ) -> NDArray[np.float64]:
+        """The measured ergodicity-breaking parameter at the TAMSD lags (or those chosen as
+        in ``tamsd``), over the particles: ``analysis.ergodicity_breaking`` of
+        ``tamsd(..., per_particle=True)``; 0 for an ergodic process as t_stop / lag grows.
+        The same call as on the other results.  Theory: ``theory_ergodicity_breaking``.
+
+        Parameters
+        ----------
+        lags, lag_samples, particles : as in ``tamsd``.
+        """
+        from . import analysis
+
+        per = self.tamsd(lags, lag_samples=lag_samples, particles=particles, per_particle=True)
+        return analysis.ergodicity_breaking(per)
 
     def theory_ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected EB of this run's TAMSD estimator (its window starts, every
@@ -604,6 +674,7 @@ def run(
     progress: bool = False,
     threads: int | None = None,
     tamsd_estimator: str = "strided",
+    mass: float = 1.0,
 ) -> LangevinResult:
     """Integrate N independent particles from a common start at the origin.
 
@@ -649,6 +720,9 @@ def run(
         fixed blocks of particles in a fixed order.  A run of fewer particles than
         threads, or so long that one particle is stepped at a time, uses fewer (at most
         1024 are started).
+    mass : the particles' mass (default 1): the dynamics take D0 and gamma0 only (the
+        temperature per unit mass is D0 gamma0), the mass makes ``result.temperature``
+        an energy, ``mass * v2 / dim``, as every result's is
 
     Returns
     -------
@@ -667,6 +741,7 @@ def run(
     if n < 1:
         raise ValueError(f"n must be >= 1, got {n}")
     threads = _threads(threads)
+    mass = _positive("mass", mass)
     estimator = _estimator_code(tamsd_estimator)
     if dim not in (1, 2, 3):
         raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
@@ -886,6 +961,7 @@ def run(
         v0_sq=v0_sq,
         exponent=exponent if model == "udsbm" else 1.0,
         initial=initial,
+        mass=mass,
     )
 
 
@@ -963,7 +1039,9 @@ def from_scene(
     """A Langevin run (xi = 1), UDSBM run (xi < 1) or power-law UDSBM run (exponent 5/6,
     a ``Viscoelastic`` restitution) with the scene's coefficients
     (``coefficients_from_scene``), so it can be set beside an EDMD run of the same scene.
-    ``n`` defaults to the scene's N; other arguments as in ``run``.
+    ``n`` defaults to the scene's N and ``mass`` to its mean mass (so that
+    ``result.temperature`` is the scene's temperature at t = 0, an energy); other
+    arguments as in ``run``.
 
     Raises
     ------
@@ -974,6 +1052,7 @@ def from_scene(
     model = "langevin" if math.isinf(c.tau0) else "udsbm"
     if model == "udsbm":
         kwargs.setdefault("exponent", exponent)
+    kwargs.setdefault("mass", float(np.mean(scene.masses)))
     return run(
         scene.n if n is None else n,
         gamma0=c.gamma0,

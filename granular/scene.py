@@ -163,6 +163,25 @@ def _array(value, name, shape):
     return a
 
 
+# what Scene.replace changes
+_FIELDS = (
+    "positions",
+    "velocities",
+    "radii",
+    "masses",
+    "box",
+    "boundary",
+    "wall_restitution",
+    "restitution",
+    "contact_duration",
+)
+
+
+def _set(scene: Scene, name: str, value: Any) -> None:
+    """Set a field while the Scene is made (``Scene.__setattr__`` refuses it after)."""
+    object.__setattr__(scene, name, value)
+
+
 class Scene:
     """Hard disks (2D) or hard spheres (3D) in a box: positions, velocities, radii, masses.
 
@@ -190,9 +209,10 @@ class Scene:
 
     Notes
     -----
-    A Scene is immutable (its arrays are read-only) and is checked on construction:
-    shapes, finite numbers, positive radii and masses, particles inside the box, and no
-    two particles overlapping (``OverlapError`` names the pair).
+    A Scene is immutable: its attributes cannot be set (AttributeError) and its arrays are
+    read-only; ``replace`` makes a changed copy, checked anew.  It is checked on
+    construction: shapes, finite numbers, positive radii and masses, particles inside the
+    box, and no two particles overlapping (``OverlapError`` names the pair).
     """
 
     def __init__(
@@ -214,15 +234,17 @@ class Scene:
                 f"positions must have shape (N, 2) or (N, 3) with N >= 1, got {pos.shape}"
             )
         n, d = pos.shape
-        self.positions = _array(pos, "positions", (n, d))
-        self.velocities = _array(velocities, "velocities", (n, d))
-        self.radii = _array(radii, "radii", (n,))
-        self.masses = _array(masses, "masses", (n,))
+        _set(self, "positions", _array(pos, "positions", (n, d)))
+        _set(self, "velocities", _array(velocities, "velocities", (n, d)))
+        _set(self, "radii", _array(radii, "radii", (n,)))
+        _set(self, "masses", _array(masses, "masses", (n,)))
         if np.any(self.radii <= 0):
             raise ValueError(f"radii must be positive (particle {int(np.argmin(self.radii))})")
         if np.any(self.masses <= 0):
             raise ValueError(f"masses must be positive (particle {int(np.argmin(self.masses))})")
-        self.lower, self.upper = _box_corners(box, d)
+        lower, upper = _box_corners(box, d)
+        _set(self, "lower", lower)
+        _set(self, "upper", upper)
         _check_scales(self.radii, self.masses, self.velocities, self.lower, self.upper)
         with np.errstate(over="ignore"):
             finite_energy = math.isfinite(self.kinetic_energy)
@@ -232,25 +254,41 @@ class Scene:
         self.upper.setflags(write=False)
         if boundary not in BOUNDARIES:
             raise ValueError(f"boundary must be one of {BOUNDARIES}, got {boundary!r}")
-        self.boundary = boundary
-        self.wall_restitution = _restitution(wall_restitution, "wall_restitution")
+        _set(self, "boundary", boundary)
+        _set(self, "wall_restitution", _restitution(wall_restitution, "wall_restitution"))
         if not isinstance(self.wall_restitution, RestitutionLaw) and not (
             self.wall_restitution > 0 and math.isfinite(self.wall_restitution)
         ):
             raise ValueError(
                 f"wall_restitution must be positive and finite, got {wall_restitution}"
             )
-        self.restitution = _restitution(restitution, "restitution")
+        _set(self, "restitution", _restitution(restitution, "restitution"))
         if not isinstance(self.restitution, RestitutionLaw) and not (
             0.0 <= self.restitution <= 1.0
         ):
             raise ValueError(f"restitution must lie in [0, 1], got {restitution}")
-        self.contact_duration = float(contact_duration)
+        _set(self, "contact_duration", float(contact_duration))
         if not (self.contact_duration >= 0 and math.isfinite(self.contact_duration)):
             raise ValueError(f"contact_duration must be finite and >= 0, got {contact_duration}")
         # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
         # the engine's own rules in O(N) through a cell grid, without building an engine.
         _core.edmd_check(*self._engine_args(), **self._engine_laws())
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # a field set after the checks would skip them (a restitution of 7.5, an overlap)
+        field = "box" if name in ("lower", "upper") else name
+        how = (
+            f"scene.replace({field}=...)"
+            if field in _FIELDS
+            else f"scene.replace(...) of its fields {', '.join(_FIELDS)}"
+        )
+        raise AttributeError(
+            f"a Scene is immutable: {name} cannot be set; make a changed copy, checked "
+            f"anew, with {how}"
+        )
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"a Scene is immutable: {name} cannot be deleted")
 
     def _engine_laws(self) -> dict[str, Any]:
         """The restitution laws as keywords of ``_core.EDMD`` (None: the number)."""

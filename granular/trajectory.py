@@ -8,6 +8,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._results import readonly
+
 
 def _pressure_volume(lower, upper, radii, boundary):
     """The volume in the virial pressure: the box when periodic; in a walled box the volume
@@ -19,7 +21,12 @@ def _pressure_volume(lower, upper, radii, boundary):
 
 
 class Trajectory:
-    """Samples of one run.
+    """Samples of one EDMD run: read-only (its attributes cannot be set, its arrays are
+    read-only views), as every result is (see docs/analysis.md, "Results").
+
+    The quantities every result offers under the same names and units: ``times``,
+    ``temperature`` (an energy, k_B = 1), ``msd()``, ``tamsd()``, ``tamsd_lags`` and
+    ``ergodicity_breaking()``.
 
     Attributes
     ----------
@@ -35,6 +42,8 @@ class Trajectory:
         "idle" (no event will ever happen); a run cut short carries the samples so far in
         its exception's ``.trajectory``, with "error" or, after Ctrl-C, "interrupted"
     masses, radii, lower, upper, boundary : copied from the scene
+    temperature : (T,) granular temperature, an energy
+    tamsd_lags : (T - 1,) the lags of ``tamsd()`` by default
     """
 
     def __init__(
@@ -56,21 +65,40 @@ class Trajectory:
         boundary: str,
         stop_reason: str,
     ) -> None:
-        self.times = times
-        self.positions = positions
-        self.velocities = velocities
-        self.kinetic_energy = kinetic_energy
-        self.momentum = momentum
-        self.pair_collisions = pair_collisions
-        self.wall_collisions = wall_collisions
-        self.virial = virial
-        self.wall_impulse = wall_impulse
-        self.masses = masses
-        self.radii = radii
-        self.lower = lower
-        self.upper = upper
-        self.boundary = boundary
-        self.stop_reason = stop_reason
+        # read-only views: a caller writing into an array the trajectory hands out gets a
+        # ValueError instead of changing the trajectory unseen
+        fields = dict(
+            times=times,
+            positions=positions,
+            velocities=velocities,
+            kinetic_energy=kinetic_energy,
+            momentum=momentum,
+            pair_collisions=pair_collisions,
+            wall_collisions=wall_collisions,
+            virial=virial,
+            wall_impulse=wall_impulse,
+            masses=masses,
+            radii=radii,
+            lower=lower,
+            upper=upper,
+            boundary=boundary,
+            stop_reason=stop_reason,
+        )
+        for name, value in fields.items():
+            object.__setattr__(self, name, readonly(value))
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(
+            f"a Trajectory is read-only: {name} cannot be set (it is what the run recorded)"
+        )
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"a Trajectory is read-only: {name} cannot be deleted")
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # unpickled (and copied) read-only too: NumPy does not keep the flag
+        for name, value in state.items():
+            object.__setattr__(self, name, readonly(value))
 
     @property
     def n(self) -> int:
@@ -160,6 +188,13 @@ class Trajectory:
 
         return analysis.msd(positions, per_dimension=per_dimension, particles=particles)
 
+    @property
+    def tamsd_lags(self) -> NDArray[np.float64]:
+        """(T - 1,) the lags ``tamsd()`` takes by default: every sample time after the first,
+        less the first (``times[k] - times[0]``), each a difference of sample times; with
+        uniform sampling, every multiple of the spacing the run spans."""
+        return readonly(self.times[1:] - self.times[:1])
+
     def tamsd(
         self,
         lags: ArrayLike | None = None,
@@ -170,10 +205,10 @@ class Trajectory:
         method: str = "auto",
     ) -> NDArray[np.float64]:
         """Time-averaged MSD, (L,) averaged over particles or (N, L) with
-        ``per_particle=True``; see ``granular.analysis.tamsd``.  The same call as
-        ``LangevinResult.tamsd`` and ``EnsembleResult.tamsd``, except that a trajectory
-        has no lags of its own (it can compute any): give exactly one of ``lags`` and
-        ``lag_samples``.
+        ``per_particle=True``; see ``granular.analysis.tamsd``.  The same call, defaults
+        and errors as ``LangevinResult.tamsd`` and ``EnsembleResult.tamsd``: by default at
+        every lag the result has (``tamsd_lags``), or at those chosen by ``lags`` (in time)
+        or ``lag_samples`` (in samples), at most one of the two.
 
         Parameters
         ----------
@@ -181,6 +216,7 @@ class Trajectory:
             Lags in time, each a difference of sample times (with uniform sampling, a
             multiple of the spacing); any other is refused, naming the nearest lags the
             samples have (as ``LangevinResult.tamsd`` refuses a lag it did not accumulate).
+            Default: ``tamsd_lags``.
         lag_samples : array_like of int, optional
             Lags as whole numbers of samples instead (uniformly spaced samples).
         particles : array_like of int or bool, optional
@@ -188,12 +224,26 @@ class Trajectory:
         per_particle : bool
             Return (N, L) (a row per chosen particle) instead of the mean.
         method : "auto", "fft" or "direct"
-            How ``analysis.tamsd`` computes it (a trajectory's choice only: the other
-            results hold a TAMSD accumulated by the engine).
+            How ``analysis.tamsd`` computes it: a trajectory's own keyword, since it
+            computes the TAMSD from its positions where the other results hold one the
+            engine accumulated.
+
+        Raises
+        ------
+        TypeError
+            Both ``lags`` and ``lag_samples`` given.
+        ValueError
+            No positions stored, or a lag the samples do not have.
         """
         positions = self._need("positions")
         from . import analysis
 
+        if lags is not None and lag_samples is not None:
+            raise TypeError("give at most one of lags (in time) and lag_samples (in samples)")
+        if lags is None and lag_samples is None:
+            if len(self.times) < 2:
+                raise ValueError("a TAMSD needs at least two samples")
+            lags = self.tamsd_lags
         return analysis.tamsd(
             positions,
             lags,
@@ -203,6 +253,26 @@ class Trajectory:
             per_particle=per_particle,
             particles=particles,
         )
+
+    def ergodicity_breaking(
+        self,
+        lags: ArrayLike | None = None,
+        *,
+        lag_samples: ArrayLike | None = None,
+        particles: ArrayLike | None = None,
+    ) -> NDArray[np.float64]:
+        """The measured ergodicity-breaking parameter at the lags of ``tamsd()`` (by
+        default ``tamsd_lags``), over the particles: ``analysis.ergodicity_breaking`` of
+        ``tamsd(..., per_particle=True)``.  The same call as on the other results.
+
+        Parameters
+        ----------
+        lags, lag_samples, particles : as in ``tamsd``.
+        """
+        from . import analysis
+
+        per = self.tamsd(lags, lag_samples=lag_samples, particles=particles, per_particle=True)
+        return analysis.ergodicity_breaking(per)
 
     def structure_factor(self, n_max: float = 2.0) -> Any:
         """Density structure factor S(k, t) at the box's smallest wave vectors, per ``|k|``

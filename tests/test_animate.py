@@ -11,14 +11,17 @@ import granular
 from granular import Trajectory, plot
 
 
-def synthetic(positions, lower, upper, boundary="periodic", radii=0.05, velocities=None):
-    """A Trajectory holding exactly the given (T, N, d) unwrapped positions."""
+def synthetic(
+    positions, lower, upper, boundary="periodic", radii=0.05, velocities=None, stored=True
+):
+    """A Trajectory holding exactly the given (T, N, d) unwrapped positions (or, with
+    ``stored=False``, of their shape without them)."""
     x = np.asarray(positions, dtype=np.float64)
     t, n, d = x.shape
     zeros = np.zeros(t)
     return Trajectory(
         np.arange(t, dtype=np.float64),
-        x,
+        x if stored else None,
         velocities,
         zeros,
         np.zeros((t, d)),
@@ -268,8 +271,7 @@ def test_bad_input_is_refused(periodic_2d):
         plot.animate(traj, slab=(0.0, 0.1))
     with pytest.raises(ValueError, match="trail_length"):
         plot.animate(traj, trails=[0], trail_length=0)
-    no_positions = synthetic(np.zeros((2, 3, 2)), [0, 0], [1, 1])
-    no_positions.positions = None
+    no_positions = synthetic(np.zeros((2, 3, 2)), [0, 0], [1, 1], stored=False)
     with pytest.raises(ValueError, match="did not store positions"):
         plot.animate(no_positions)
     with pytest.raises(ValueError, match="did not store velocities"):

@@ -2,6 +2,7 @@
 
 import itertools
 import math
+import re
 
 import numpy as np
 import pytest
@@ -155,6 +156,30 @@ def test_replace_and_repr():
         s.replace(colour="red")
     with pytest.raises(ValueError):
         s.positions[0, 0] = 1.0  # read-only
+
+
+@pytest.mark.parametrize(
+    "field, value, instead",
+    [
+        ("restitution", 7.5, "replace(restitution="),  # a value the checks would refuse
+        ("positions", np.zeros((10, 3)), "replace(positions="),  # every particle overlapping
+        ("lower", np.zeros(3), "replace(box="),
+        ("colour", "red", "replace(...) of its fields positions, velocities"),
+    ],
+)
+def test_a_scene_is_immutable(field, value, instead):
+    """Setting a field after construction would skip its checks: refused, naming
+    ``replace``, which makes a checked copy; the scene is unchanged."""
+    s = Scene.random(10, 0.05, seed=5)
+    before = repr(s)
+    message = rf"immutable: {field} cannot be set.*{re.escape(instead)}"
+    with pytest.raises(AttributeError, match=message):
+        setattr(s, field, value)
+    with pytest.raises(AttributeError, match="cannot be deleted"):
+        delattr(s, "restitution")
+    assert repr(s) == before and not hasattr(s, "colour")
+    with pytest.raises(ValueError, match=r"restitution must lie in \[0, 1\]"):
+        s.replace(restitution=7.5)
 
 
 # -- bad input: a clear exception, never a crash --------------------------------------
