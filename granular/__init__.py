@@ -38,9 +38,8 @@ __version__ = "0.1.0"
 _LAZY = ("plot", "interop")
 
 
-# the applications moved to granular.cli; the old names work, with a DeprecationWarning,
-# for the one release after the move, and go in this one
-_MOVED_REMOVED_IN = "0.3.0"
+# the applications moved to granular.cli; the old names work with a FutureWarning
+# (granular._deprecation) for one release
 _MOVED = ("demo", "reproduce", "speed_accuracy", "bench", "bench_langevin")
 
 
@@ -50,14 +49,9 @@ def __getattr__(name):
     if name in _LAZY:
         return importlib.import_module(f".{name}", __name__)
     if name in _MOVED:
-        import warnings
+        from ._deprecation import deprecated
 
-        warnings.warn(
-            f"granular.{name} moved to granular.cli.{name}; the old name is removed in "
-            f"granular {_MOVED_REMOVED_IN}",
-            DeprecationWarning,
-            stacklevel=2,
-        )
+        deprecated(f"granular.{name}", f"it moved to granular.cli.{name}")
         return importlib.import_module(f".cli.{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

@@ -1,16 +1,11 @@
 """What the result types (``Trajectory``, ``LangevinResult``, ``EnsembleResult``) share:
-read-only arrays and the deprecation notices of forms that are going."""
+read-only arrays (deprecation notices: ``granular._deprecation``)."""
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
-
-# A form deprecated in the coming release (0.2.0) works, with a FutureWarning, through that
-# release and goes in the one after it
-REMOVAL_VERSION = "0.3.0"
 
 
 def readonly(value: Any) -> Any:
@@ -22,12 +17,3 @@ def readonly(value: Any) -> Any:
     view = value.view(np.ndarray)
     view.flags.writeable = False
     return view
-
-
-def deprecated(old: str, new: str, stacklevel: int = 3) -> None:
-    """Warn that ``old`` goes in ``REMOVAL_VERSION``, naming ``new`` to use instead."""
-    warnings.warn(
-        f"{old} is deprecated and goes in granular {REMOVAL_VERSION}; {new}",
-        FutureWarning,
-        stacklevel=stacklevel,
-    )

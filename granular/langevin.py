@@ -59,7 +59,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._results import REMOVAL_VERSION, deprecated, readonly
+from ._deprecation import REMOVAL_VERSION, deprecated
+from ._results import readonly
 from .errors import shown
 
 if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but stay light

@@ -29,7 +29,7 @@ def _warnings_of_every_shim():
         with warnings.catch_warnings(record=True) as got:
             warnings.simplefilter("always")
             use()
-        assert [w.category for w in got] == [DeprecationWarning], [str(w.message) for w in got]
+        assert [w.category for w in got] == [FutureWarning], [str(w.message) for w in got]
         caught.append(str(got[0].message))
     return caught
 

@@ -76,7 +76,7 @@ def test_old_application_names_still_work_with_a_warning(name):
 
     import granular
 
-    with pytest.warns(DeprecationWarning, match=f"granular.cli.{name}"):
+    with pytest.warns(FutureWarning, match=f"granular.cli.{name}"):
         old = getattr(granular, name)
     assert old is importlib.import_module(f"granular.cli.{name}")
 

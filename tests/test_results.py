@@ -250,7 +250,7 @@ def test_what_cannot_apply_is_refused_by_name(sde, ens, edmd_ens, lean, traj):
 def test_the_old_array_attributes_still_work_with_a_future_warning(sde):
     """``result.msd`` / ``result.tamsd`` as arrays: a FutureWarning naming the call and the
     release that removes them."""
-    with pytest.warns(FutureWarning, match=r"goes in granular 0\.2\.0; call result\.msd\(\)"):
+    with pytest.warns(FutureWarning, match=r"removed in granular 0\.3\.0; call result\.msd\(\)"):
         last = sde.msd[-1]
     assert last == sde.msd()[-1]
     with pytest.warns(FutureWarning, match=r"result\.tamsd\(\)"):
@@ -318,7 +318,7 @@ def test_temperature_is_an_energy_on_every_result():
         sample_times=[0.0, 0.1, 0.2],
     )
     sde = model(seed=1)
-    with pytest.warns(FutureWarning, match=r"an energy now.*result\.v2 / result\.dim.*0\.2\.0"):
+    with pytest.warns(FutureWarning, match=r"an energy now.*result\.v2 / result\.dim.*0\.3\.0"):
         sde_t = sde.temperature
     edmd = granular.Simulation(scene).run(**run)
     ensembles = [
