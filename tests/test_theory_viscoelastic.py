@@ -10,6 +10,7 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 
 from granular import theory
+from granular.theory import _numerics
 
 from helpers import eb_reference
 
@@ -239,7 +240,7 @@ def test_propagator_integral_against_quad(a):
             limit=500,
             points=pts,
         )[0]
-        got = theory._powerlaw_propagator_integral(s, h, G0, TAU0, a)
+        got = _numerics._powerlaw_propagator_integral(s, h, G0, TAU0, a)
         assert got == pytest.approx(want, rel=1e-9)
 
 
@@ -329,9 +330,9 @@ def test_ergodicity_breaking_matches_the_per_pair_reference(tau0, a):
     # the covariance is built in blocks of rows and mirrored block by block: blocks of 7
     # (many, unequal) give the very same numbers as one block (per-row arithmetic is the same)
     times = np.unique(np.concatenate([cases[1][1], cases[1][1] + cases[1][0]]))
-    sol = theory._powerlaw_ode(2.0, tau0, a, 0.7 / 2.6, 2.0 * times[-1])
-    one = theory._covariance_on_grid(times, sol, 1.3, 2.0, tau0, a, block=times.size)
-    many = theory._covariance_on_grid(times, sol, 1.3, 2.0, tau0, a, block=7)
+    sol = _numerics._powerlaw_ode(2.0, tau0, a, 0.7 / 2.6, 2.0 * times[-1])
+    one = _numerics._covariance_on_grid(times, sol, 1.3, 2.0, tau0, a, block=times.size)
+    many = _numerics._covariance_on_grid(times, sol, 1.3, 2.0, tau0, a, block=7)
     np.testing.assert_array_equal(many, one)
     np.testing.assert_array_equal(one, one.T)
 
