@@ -443,7 +443,11 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     eta = scene.packing_fraction
     if not 0 < eta < 1:
         return None
-    lc = float(theory.critical_box_size(density, radius, float(xi), scene.dim, eta=eta))
+    lc = float(
+        theory.critical_box_size(
+            density=density, radius=radius, restitution=float(xi), dim=scene.dim, eta=eta
+        )
+    )
     if not big > lc:
         return None
     d, n = scene.dim, scene.n
@@ -458,8 +462,22 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     mass = float(np.mean(scene.masses))
     t_star = cpp = math.inf
     if xi > 0 and temperature > 0:
-        tau0 = float(theory.haff_tau0(density, radius, float(xi), temperature, mass, d, eta))
-        omega0 = float(theory.collision_frequency(density, radius, temperature, mass, d, eta))
+        tau0 = float(
+            theory.haff_tau0(
+                density=density,
+                radius=radius,
+                restitution=float(xi),
+                temperature0=temperature,
+                mass=mass,
+                dim=d,
+                eta=eta,
+            )
+        )
+        omega0 = float(
+            theory.collision_frequency(
+                density=density, radius=radius, temperature=temperature, mass=mass, dim=d, eta=eta
+            )
+        )
         growth = _ONSET_SHARE * d * n / (2 * d * (d - 1))
         exponent = 2 * (1 - (lc / big) ** 2)
         if growth > 1:

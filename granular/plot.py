@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._animate import animate  # noqa: F401 (public here; animations have their own module)
+from ._params import keyword_only as _keyword_only
 
 if TYPE_CHECKING:  # matplotlib is an extra, imported only when a figure is drawn
     from matplotlib.axes import Axes
@@ -53,9 +54,11 @@ def _axes(ax: Axes | None) -> Axes:
     return ax
 
 
+@_keyword_only("times", "kinetic_energy", "ax", "label", "relative", validate=False)
 def energy(
     times: ArrayLike,
     kinetic_energy: ArrayLike,
+    *,
     ax: Axes | None = None,
     label: str | None = None,
     relative: bool = True,
@@ -73,8 +76,9 @@ def energy(
     return ax
 
 
+@_keyword_only("times", "collisions", "ax", "label", validate=False)
 def collisions_per_particle(
-    times: ArrayLike, collisions: ArrayLike, ax: Axes | None = None, label: str | None = None
+    times: ArrayLike, collisions: ArrayLike, *, ax: Axes | None = None, label: str | None = None
 ) -> Axes:
     """Mean collisions per particle against time (thesis Figs 4.3-4.4)."""
     ax = _axes(ax)
@@ -86,8 +90,10 @@ def collisions_per_particle(
     return ax
 
 
+@_keyword_only("velocities", "temperature", "mass", "bins", "ax", "label", validate=False)
 def speed_distribution(
     velocities: ArrayLike,
+    *,
     temperature: float | None = None,
     mass: float = 1.0,
     bins: int = 40,
@@ -108,7 +114,10 @@ def speed_distribution(
     ax.bar(centres, dens, width=width, alpha=0.5, label=label, yerr=err, ecolor="0.4")
     s = np.linspace(0.0, top, 300)
     ax.plot(
-        s, theory.maxwell_boltzmann_pdf(s, T, mass, dim), "k--", label=f"Maxwell-Boltzmann ({dim}D)"
+        s,
+        theory.maxwell_boltzmann_pdf(s, temperature=T, mass=mass, dim=dim),
+        "k--",
+        label=f"Maxwell-Boltzmann ({dim}D)",
     )
     ax.set_xlabel(SPEED)
     ax.set_ylabel(SPEED_DENSITY)
@@ -116,9 +125,13 @@ def speed_distribution(
     return ax
 
 
+@_keyword_only(
+    "times", "temperature", "tau0", "temperature0", "ax", "label", "error", validate=False
+)
 def haff(
     times: ArrayLike,
     temperature: ArrayLike,
+    *,
     tau0: float,
     temperature0: float | None = None,
     ax: Axes | None = None,
@@ -140,7 +153,7 @@ def haff(
         ax.plot(t[keep], T[keep], ".", label=label)
     ax.plot(
         t[keep],
-        theory.haff_temperature(t[keep], T0, tau0),
+        theory.haff_temperature(t[keep], temperature0=T0, tau0=tau0),
         "k--",
         label=rf"Haff, $\tau_0$ = {tau0:.3g}",
     )
@@ -152,9 +165,22 @@ def haff(
     return ax
 
 
+@_keyword_only(
+    "times",
+    "values",
+    "error",
+    "theory_values",
+    "ax",
+    "label",
+    "theory_label",
+    "loglog",
+    "theory_style",
+    validate=False,
+)
 def msd(
     times: ArrayLike,
     values: ArrayLike,
+    *,
     error: ArrayLike | None = None,
     theory_values: ArrayLike | None = None,
     ax: Axes | None = None,
@@ -184,9 +210,11 @@ def msd(
     return ax
 
 
+@_keyword_only("times", "values", "theory_values", "ax", "label", validate=False)
 def diffusivity(
     times: ArrayLike,
     values: ArrayLike,
+    *,
     theory_values: ArrayLike | None = None,
     ax: Axes | None = None,
     label: str = "simulation",
@@ -206,9 +234,11 @@ def diffusivity(
     return ax
 
 
+@_keyword_only("times", "msd_values", "lags", "tamsd_values", "ax", "label", validate=False)
 def msd_vs_tamsd(
     times: ArrayLike,
     msd_values: ArrayLike,
+    *,
     lags: ArrayLike,
     tamsd_values: ArrayLike,
     ax: Axes | None = None,
@@ -229,8 +259,10 @@ def msd_vs_tamsd(
     return ax
 
 
+@_keyword_only("positions", "radii", "lower", "upper", "ax", "color", validate=False)
 def snapshot(
     positions: ArrayLike,
+    *,
     radii: ArrayLike,
     lower: ArrayLike,
     upper: ArrayLike,
@@ -271,9 +303,11 @@ STRUCTURE_FACTOR = r"$S(k, t)$ (dimensionless; 1 for an ideal gas)"
 FLOW_RATIO = r"$E_{flow} / E_{thermal}$ (dimensionless)"
 
 
+@_keyword_only("times", "result", "ax", "shells", "transverse", validate=False)
 def structure_factor(
     times: ArrayLike,
     result,
+    *,
     ax: Axes | None = None,
     shells: int = 2,
     transverse=None,
@@ -304,9 +338,11 @@ def structure_factor(
     return ax
 
 
+@_keyword_only("times", "result", "ax", "label", "threshold", validate=False)
 def flow_energy(
     times: ArrayLike,
     result,
+    *,
     ax: Axes | None = None,
     label: str | None = None,
     threshold: float | None = None,

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from .._params import keyword_only
 from ._numerics import FloatOrArray, _check_dim
 from .equation_of_state import contact_value
 from .haff import _constant_xi, _eta, collision_frequency
@@ -24,10 +25,14 @@ from .haff import _constant_xi, _eta, collision_frequency
 # (moderate densities; velocity correlations near the threshold are neglected).
 
 
+@keyword_only(
+    "density", "radius", "xi", "temperature", "mass", "dim", "eta", renamed={"xi": "restitution"}
+)
 def cooling_rate(
+    *,
     density: FloatOrArray,
     radius: FloatOrArray,
-    xi: FloatOrArray,
+    restitution: FloatOrArray,
     temperature: FloatOrArray,
     mass: FloatOrArray = 1.0,
     dim: int = 3,
@@ -37,18 +42,22 @@ def cooling_rate(
     ``zeta = (1 - xi^2) omega / d`` with omega the Enskog collision frequency (2.42); the
     same Maxwellian estimate as ``haff_tau0`` (``zeta(T0) = 2 / tau0``), equal to Garzo &
     Dufty's ``zeta* = (d + 2) / (4 d) chi (1 - xi^2)`` at a2 = 0 in units of ``n T / eta0``."""
-    xi = _constant_xi(xi)
+    xi = _constant_xi(restitution)
     xi = np.asarray(xi, dtype=np.float64)
-    if np.any((xi < 0) | (xi > 1)):
-        raise ValueError("xi must lie in [0, 1]")
-    omega = collision_frequency(density, radius, temperature, mass, dim, eta)
+    omega = collision_frequency(
+        density=density, radius=radius, temperature=temperature, mass=mass, dim=dim, eta=eta
+    )
     return (1.0 - xi**2) * omega / dim
 
 
+@keyword_only(
+    "density", "radius", "xi", "temperature", "mass", "dim", "eta", renamed={"xi": "restitution"}
+)
 def shear_viscosity(
+    *,
     density: FloatOrArray,
     radius: FloatOrArray,
-    xi: FloatOrArray,
+    restitution: FloatOrArray,
     temperature: FloatOrArray,
     mass: FloatOrArray = 1.0,
     dim: int = 3,
@@ -67,11 +76,11 @@ def shear_viscosity(
     pi)`` in 2D (sigma = 2 r).  At xi = 1 this is Enskog's first Sonine viscosity: 3D
     ``eta0 [(1 + 8 phi chi / 5)^2 / chi + 768 phi^2 chi / (25 pi)]`` (Chapman & Cowling),
     2D ``eta0 [(1 + phi chi)^2 / chi + 8 phi^2 chi / pi]`` (Gass 1971)."""
-    xi = _constant_xi(xi)
+    xi = _constant_xi(restitution)
     _check_dim(dim)
     xi = np.asarray(xi, dtype=np.float64)
     phi = _eta(density, radius, dim, eta)
-    chi = contact_value(phi, dim)
+    chi = contact_value(phi, dim=dim)
     sigma = 2.0 * radius
     root = np.sqrt(mass * np.asarray(temperature) / math.pi)
     eta0 = 5.0 / (16.0 * sigma**2) * root if dim == 3 else root / (2.0 * sigma)
@@ -85,10 +94,12 @@ def shear_viscosity(
     )
 
 
+@keyword_only("density", "radius", "xi", "dim", "eta", renamed={"xi": "restitution"})
 def critical_box_size(
+    *,
     density: FloatOrArray,
     radius: FloatOrArray,
-    xi: FloatOrArray,
+    restitution: FloatOrArray,
     dim: int = 3,
     eta: FloatOrArray | None = None,
 ) -> FloatOrArray:
@@ -109,13 +120,14 @@ def critical_box_size(
     Parameters
     ----------
     density : float
-        Number density N / V.
+        Number density N / V (N / A in 2D) [L^-d].
     radius : float
-    xi : float in [0, 1]
-        Coefficient of restitution.
+        Particle radius [L].
+    restitution : float in [0, 1]
+        Constant coefficient of restitution xi (dimensionless).
     dim : 2 or 3
     eta : float, optional
-        Packing fraction (default: from density and radius).
+        Packing fraction (dimensionless; default: from density and radius).
 
     Returns
     -------
@@ -129,17 +141,22 @@ def critical_box_size(
     Rev. E 59, 5895.  Valid at Navier-Stokes order (L_c many mean free paths) and where the
     Enskog transport coefficients hold (packing fraction up to about 0.25 in 3D).
     """
-    xi = _constant_xi(xi)
+    xi = _constant_xi(restitution)
     xi = np.asarray(xi, dtype=np.float64)
-    zeta = cooling_rate(density, radius, xi, 1.0, 1.0, dim, eta)
-    visc = shear_viscosity(density, radius, xi, 1.0, 1.0, dim, eta)
+    zeta = cooling_rate(
+        density=density, radius=radius, restitution=xi, temperature=1.0, mass=1.0, dim=dim, eta=eta
+    )
+    visc = shear_viscosity(
+        density=density, radius=radius, restitution=xi, temperature=1.0, mass=1.0, dim=dim, eta=eta
+    )
     with np.errstate(divide="ignore"):
         lc = 2 * math.pi * np.sqrt(2 * visc / (density * zeta))
     return lc[()] if np.ndim(lc) == 0 else lc
 
 
+@keyword_only("t", "tau0", "box", "critical")
 def shear_mode_growth(
-    t: FloatOrArray, tau0: FloatOrArray, box: FloatOrArray, critical: FloatOrArray
+    t: FloatOrArray, *, tau0: FloatOrArray, box: FloatOrArray, critical: FloatOrArray
 ) -> FloatOrArray:
     """Factor by which the energy of the slowest shear mode (k = 2 pi / box) grows relative
     to the thermal energy by time t in linear theory, ``(1 + t/tau0)^(2 (1 - (L_c/L)^2))``:
@@ -150,7 +167,8 @@ def shear_mode_growth(
     return (1.0 + t / tau0) ** (2.0 * (1.0 - q2))
 
 
-def shear_mode_level(box: FloatOrArray, critical: FloatOrArray) -> FloatOrArray:
+@keyword_only("box", "critical")
+def shear_mode_level(box: FloatOrArray, *, critical: FloatOrArray) -> FloatOrArray:
     """Level at which the transverse current correlation of the slowest shear mode
     (k = 2 pi / box, 1 for an uncorrelated gas) settles in the homogeneous cooling state of
     a box below the critical size: ``1 / (1 - (L / L_c)^2)`` -- linear fluctuating

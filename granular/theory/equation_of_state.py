@@ -7,11 +7,13 @@ import math
 
 import numpy as np
 
+from .._params import keyword_only
 from ._numerics import FloatOrArray, _check_dim
 
 
+@keyword_only("n", "radius", "volume", "dim")
 def packing_fraction(
-    n: FloatOrArray, radius: FloatOrArray, volume: FloatOrArray, dim: int = 3
+    *, n: FloatOrArray, radius: FloatOrArray, volume: FloatOrArray, dim: int = 3
 ) -> FloatOrArray:
     """Fraction of the volume (area in 2D) covered by n particles of the given radius
     (2.44): ``eta = n (4/3) pi r^3 / V`` in 3D, ``n pi r^2 / A`` in 2D."""
@@ -20,7 +22,8 @@ def packing_fraction(
     return n * unit / volume
 
 
-def contact_value(eta: FloatOrArray, dim: int = 3) -> FloatOrArray:
+@keyword_only("eta", "dim")
+def contact_value(eta: FloatOrArray, *, dim: int = 3) -> FloatOrArray:
     """Contact value g2 of the equilibrium pair correlation function of hard spheres/disks.
 
     3D: Carnahan-Starling ``(2 - eta) / (2 (1 - eta)^3)`` (2.43).  2D: Henderson's
@@ -34,14 +37,16 @@ def contact_value(eta: FloatOrArray, dim: int = 3) -> FloatOrArray:
     return g[()] if g.ndim == 0 else g
 
 
-def compressibility_factor(eta: FloatOrArray, dim: int = 3) -> FloatOrArray:
+@keyword_only("eta", "dim")
+def compressibility_factor(eta: FloatOrArray, *, dim: int = 3) -> FloatOrArray:
     """Equation of state Z = P / (n T) of hard spheres (Carnahan-Starling,
     ``1 + 4 eta g2``) or disks (Henderson, ``1 + 2 eta g2``): the collision virial's
     prediction with the approximate contact value."""
-    return 1 + (4.0 if dim == 3 else 2.0) * np.asarray(eta) * contact_value(eta, dim)
+    return 1 + (4.0 if dim == 3 else 2.0) * np.asarray(eta) * contact_value(eta, dim=dim)
 
 
-def wall_adsorption(density: float, radius: float, dim: int = 3) -> float:
+@keyword_only("density", "radius", "dim")
+def wall_adsorption(*, density: float, radius: float, dim: int = 3) -> float:
     """Excess number of hard disks/spheres per unit length (2D) or area (3D) of a flat hard
     wall, to first order in the density: ``(2/3) n^2 sigma^3`` in 2D, ``(pi/4) n^2 sigma^4``
     in 3D (sigma = 2 r).  A particle near the wall misses the neighbours the wall excludes,

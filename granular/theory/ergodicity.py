@@ -8,13 +8,15 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._params import keyword_only
 from ._numerics import _check_powerlaw, _covariance_on_grid, _powerlaw_ode
 
 
+@keyword_only("lag", renamed={"starts": "start"})
 def udsbm_ergodicity_breaking(
     lag: float,
     *,
-    starts: ArrayLike,
+    start: ArrayLike,
     D0: float,
     gamma0: float,
     tau0: float = math.inf,
@@ -54,7 +56,7 @@ def udsbm_ergodicity_breaking(
     EB
     """
     _check_powerlaw(gamma0, D0, tau0, exponent)
-    s = np.asarray(starts, dtype=np.float64).reshape(-1)
+    s = np.asarray(start, dtype=np.float64).reshape(-1)
     if not lag > 0 or s.size == 0 or np.any(s < 0):
         raise ValueError("need lag > 0 and at least one window start >= 0")
     v0 = D0 * gamma0 if v0_sq is None else float(v0_sq)

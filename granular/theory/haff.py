@@ -9,15 +9,18 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import restitution as _restitution
+from .._params import keyword_only
 from ._numerics import FloatOrArray, _check_dim
 from .equation_of_state import contact_value, packing_fraction
 
 
 def _eta(density, radius, dim, eta):
-    return packing_fraction(density, radius, 1.0, dim) if eta is None else eta
+    return packing_fraction(n=density, radius=radius, volume=1.0, dim=dim) if eta is None else eta
 
 
+@keyword_only("density", "radius", "temperature", "mass", "dim", "eta")
 def collision_frequency(
+    *,
     density: FloatOrArray,
     radius: FloatOrArray,
     temperature: FloatOrArray,
@@ -32,13 +35,15 @@ def collision_frequency(
     as proportional to sqrt(T); (2.42), used here, makes it 1/sqrt(T).
     """
     _check_dim(dim)
-    g2 = contact_value(_eta(density, radius, dim, eta), dim)
+    g2 = contact_value(_eta(density, radius, dim, eta), dim=dim)
     sigma = 2.0 * radius
     geometry = 4.0 * sigma**2 if dim == 3 else 2.0 * sigma
     return geometry * math.sqrt(math.pi) * g2 * density * np.sqrt(np.asarray(temperature) / mass)
 
 
+@keyword_only("density", "radius", "temperature", "mass", "dim", "eta")
 def collision_time(
+    *,
     density: FloatOrArray,
     radius: FloatOrArray,
     temperature: FloatOrArray,
@@ -47,24 +52,30 @@ def collision_time(
     eta: FloatOrArray | None = None,
 ) -> FloatOrArray:
     """Mean time between collisions of one particle, ``1 / collision_frequency`` (2.42)."""
-    return 1.0 / collision_frequency(density, radius, temperature, mass, dim, eta)
+    return 1.0 / collision_frequency(
+        density=density, radius=radius, temperature=temperature, mass=mass, dim=dim, eta=eta
+    )
 
 
 def _constant_xi(xi):
     """A formula for a constant restitution given a law: say what to use instead."""
     if isinstance(xi, _restitution.RestitutionLaw):
         raise TypeError(
-            f"xi must be a number (a constant restitution), got a {type(xi).__name__}; for "
+            f"restitution must be a number (a constant xi), got a {type(xi).__name__}; for "
             "a viscoelastic gas use theory.viscoelastic_* with the law, or "
             "langevin.coefficients_from_scene(scene)"
         )
     return xi
 
 
+@keyword_only(
+    "density", "radius", "xi", "temperature0", "mass", "dim", "eta", renamed={"xi": "restitution"}
+)
 def haff_tau0(
+    *,
     density: FloatOrArray,
     radius: FloatOrArray,
-    xi: FloatOrArray,
+    restitution: FloatOrArray,
     temperature0: FloatOrArray,
     mass: FloatOrArray = 1.0,
     dim: int = 3,
@@ -77,27 +88,32 @@ def haff_tau0(
     ``(1 - xi^2) m (v_n)^2 / 4``, which averages to ``(1 - xi^2) T`` over collisions of a
     Maxwellian gas, so ``dT/dt = -(1 - xi^2) omega T / d``.  Infinite for xi = 1.
     """
-    xi = _constant_xi(xi)
-    if not 0.0 <= xi <= 1.0:
-        raise ValueError("xi must lie in [0, 1]")
+    xi = _constant_xi(restitution)
     if xi == 1.0:
         return math.inf
-    omega = collision_frequency(density, radius, temperature0, mass, dim, eta)
+    omega = collision_frequency(
+        density=density, radius=radius, temperature=temperature0, mass=mass, dim=dim, eta=eta
+    )
     return 2 * dim / ((1.0 - xi**2) * omega)
 
 
+@keyword_only("t", "temperature0", "tau0")
 def haff_temperature(
-    t: FloatOrArray, temperature0: FloatOrArray, tau0: FloatOrArray
+    t: FloatOrArray, *, temperature0: FloatOrArray, tau0: FloatOrArray
 ) -> FloatOrArray:
     """Haff's law ``T(t) = T0 / (1 + t/tau0)^2`` (2.40), homogeneous cooling state."""
     t = np.asarray(t, dtype=np.float64)
     return temperature0 / (1.0 + t / tau0) ** 2
 
 
+@keyword_only(
+    "density", "radius", "xi", "temperature0", "mass", "dim", "eta", renamed={"xi": "restitution"}
+)
 def diffusion_d0(
+    *,
     density: FloatOrArray,
     radius: FloatOrArray,
-    xi: FloatOrArray,
+    restitution: FloatOrArray,
     temperature0: FloatOrArray,
     mass: FloatOrArray = 1.0,
     dim: int = 3,
@@ -108,9 +124,9 @@ def diffusion_d0(
     counterpart ``1 / (2 n g2 sigma) sqrt(T0 / (pi m))`` (velocity relaxation rate
     gamma_E = (2/d) omega, the same Enskog derivation).  Per dimension:
     ``<dx^2> = 2 D t``."""
-    xi = _constant_xi(xi)
+    xi = _constant_xi(restitution)
     _check_dim(dim)
-    g2 = contact_value(_eta(density, radius, dim, eta), dim)
+    g2 = contact_value(_eta(density, radius, dim, eta), dim=dim)
     sigma = 2.0 * radius
     if dim == 3:
         d_enskog = 3.0 / (8.0 * density * g2 * sigma**2)
@@ -127,11 +143,15 @@ class LangevinCoefficients(NamedTuple):
     tau0: float
 
 
+@keyword_only(
+    "n", "radius", "volume", "xi", "temperature0", "mass", "dim", renamed={"xi": "restitution"}
+)
 def langevin_coefficients(
+    *,
     n: float,
     radius: float,
     volume: float,
-    xi: float,
+    restitution: float,
     temperature0: float,
     mass: float = 1.0,
     dim: int = 3,
@@ -139,9 +159,27 @@ def langevin_coefficients(
     """gamma0, D0, tau0 of a gas of n particles in a box of the given volume, as the thesis
     derives them for its Langevin and UDSBM models: D0 (2.52), ``gamma0 = T0 / (m D0)``
     (2.55), tau0 (2.45; infinite for xi = 1)."""
-    xi = _constant_xi(xi)
+    xi = _constant_xi(restitution)
     density = n / volume
-    d0 = float(diffusion_d0(density, radius, xi, temperature0, mass, dim))
+    d0 = float(
+        diffusion_d0(
+            density=density,
+            radius=radius,
+            restitution=xi,
+            temperature0=temperature0,
+            mass=mass,
+            dim=dim,
+        )
+    )
     gamma0 = temperature0 / (mass * d0)
-    tau0 = float(haff_tau0(density, radius, xi, temperature0, mass, dim))
+    tau0 = float(
+        haff_tau0(
+            density=density,
+            radius=radius,
+            restitution=xi,
+            temperature0=temperature0,
+            mass=mass,
+            dim=dim,
+        )
+    )
     return LangevinCoefficients(gamma0, d0, tau0)

@@ -6,11 +6,13 @@ import math
 
 import numpy as np
 
+from .._params import keyword_only
 from ._numerics import FloatOrArray, _check_dim
 
 
+@keyword_only("speed", "temperature", "mass", "dim")
 def maxwell_boltzmann_pdf(
-    speed: FloatOrArray, temperature: float, mass: float = 1.0, dim: int = 3
+    speed: FloatOrArray, *, temperature: float, mass: float = 1.0, dim: int = 3
 ) -> FloatOrArray:
     """Speed density of a gas in equilibrium (2.30 in 2D, 2.32 in 3D):
     2D ``(m v / T) exp(-m v^2 / 2T)``; 3D ``4 pi v^2 (m / 2 pi T)^(3/2) exp(-m v^2 / 2T)``."""
@@ -22,8 +24,9 @@ def maxwell_boltzmann_pdf(
     return 4 * math.pi * v * v * (b / (2 * math.pi)) ** 1.5 * np.exp(-0.5 * b * v * v)
 
 
+@keyword_only("temperature", "mass", "dim")
 def maxwell_boltzmann_moments(
-    temperature: float, mass: float = 1.0, dim: int = 3
+    *, temperature: float, mass: float = 1.0, dim: int = 3
 ) -> dict[str, float]:
     """Expectation values of Table 2.2: mean speed, mean squared speed, standard deviation
     of the speed and most probable speed."""

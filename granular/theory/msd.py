@@ -7,11 +7,13 @@ import math
 
 import numpy as np
 
+from .._params import keyword_only
 from ._numerics import FloatOrArray, _one_minus_exp_over, _x_plus_expm1
 
 
+@keyword_only("t", "D0", "gamma0", "dim", "v0_sq")
 def msd_langevin(
-    t: FloatOrArray, D0: float, gamma0: float, dim: int = 3, v0_sq: FloatOrArray | None = None
+    t: FloatOrArray, *, D0: float, gamma0: float, dim: int = 3, v0_sq: FloatOrArray | None = None
 ) -> FloatOrArray:
     """MSD of a molecular gas and of the underdamped Langevin equation (2.68), total over
     ``dim`` dimensions: ``d [2 D0 t + (2 D0/gamma0)(exp(-gamma0 t) - 1)]``.
@@ -31,8 +33,9 @@ def msd_langevin(
     return dim * out
 
 
+@keyword_only("t", "D0", "gamma0", "tau0", "dim")
 def msd_granular(
-    t: FloatOrArray, D0: float, gamma0: float, tau0: float, dim: int = 3
+    t: FloatOrArray, *, D0: float, gamma0: float, tau0: float, dim: int = 3
 ) -> FloatOrArray:
     """MSD of a granular gas in the homogeneous cooling state (2.79), total over ``dim``:
     ``d 2 D0 tau0 [ln(1 + t/tau0) + ((1 + t/tau0)^(-gamma0 tau0) - 1) / (gamma0 tau0)]``.
@@ -42,21 +45,23 @@ def msd_granular(
     ``msd_langevin`` for tau0 = inf.
     """
     if math.isinf(tau0):
-        return msd_langevin(t, D0, gamma0, dim)
+        return msd_langevin(t, D0=D0, gamma0=gamma0, dim=dim)
     a = gamma0 * tau0
     u = np.log1p(np.asarray(t, dtype=np.float64) / tau0)
     return dim * 2.0 * D0 * tau0 * _x_plus_expm1(a * u) / a
 
 
+@keyword_only("t", "temperature", "mass", "dim")
 def msd_ballistic(
-    t: FloatOrArray, temperature: float, mass: float = 1.0, dim: int = 3
+    t: FloatOrArray, *, temperature: float, mass: float = 1.0, dim: int = 3
 ) -> FloatOrArray:
     """Short-time limit of every MSD here: free flight, ``d (T/m) t^2``."""
     return dim * temperature / mass * np.asarray(t, dtype=np.float64) ** 2
 
 
+@keyword_only("t", "D0", "dim", "gamma0")
 def msd_diffusive(
-    t: FloatOrArray, D0: float, dim: int = 3, gamma0: float | None = None
+    t: FloatOrArray, *, D0: float, dim: int = 3, gamma0: float | None = None
 ) -> FloatOrArray:
     """Einstein's long-time limit of a molecular gas, ``2 d D0 t`` (2.46); with gamma0 the
     exact asymptote of (2.68), ``2 d D0 (t - 1/gamma0)``."""
@@ -64,8 +69,9 @@ def msd_diffusive(
     return 2.0 * dim * D0 * (np.asarray(t, dtype=np.float64) - shift)
 
 
+@keyword_only("t", "D0", "tau0", "dim", "gamma0")
 def msd_logarithmic(
-    t: FloatOrArray, D0: float, tau0: float, dim: int = 3, gamma0: float | None = None
+    t: FloatOrArray, *, D0: float, tau0: float, dim: int = 3, gamma0: float | None = None
 ) -> FloatOrArray:
     """Long-time limit of a granular gas, ``2 d D0 tau0 ln(1 + t/tau0)`` (2.80); with gamma0
     the exact asymptote of (2.79), ``2 d D0 tau0 (ln(1 + t/tau0) - 1/(gamma0 tau0))``."""

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from .._params import keyword_only
 from ._numerics import FloatOrArray, _check_dim
 from .equation_of_state import compressibility_factor, contact_value, packing_fraction
 from .haff import LangevinCoefficients
@@ -45,8 +46,9 @@ from .haff import LangevinCoefficients
 # 70, 1456 (1979)); the Langevin form (exponential velocity relaxation) needs m / M << 1.
 
 
+@keyword_only("eta", "tracer_radius", "radius", "dim")
 def tracer_contact_value(
-    eta: FloatOrArray, tracer_radius: float, radius: float, dim: int = 3
+    eta: FloatOrArray, *, tracer_radius: float, radius: float, dim: int = 3
 ) -> FloatOrArray:
     """Contact value chi of the gas' pair correlation at the surface of one large tracer
     (infinitely dilute) in a one-component hard-disk/sphere gas at packing fraction eta.
@@ -66,13 +68,17 @@ def tracer_contact_value(
     z = 2.0 * tracer_radius / (tracer_radius + radius)
     eta = np.asarray(eta, dtype=np.float64)
     g0 = 1.0 / (1.0 - eta)
-    g1 = contact_value(eta, dim)
-    g2 = compressibility_factor(eta, dim)
+    g1 = contact_value(eta, dim=dim)
+    g2 = compressibility_factor(eta, dim=dim)
     g = g0 + z * (-3.0 * g0 + 4.0 * g1 - g2) / 2.0 + z * z * (g0 - 2.0 * g1 + g2) / 2.0
     return g[()] if g.ndim == 0 else g
 
 
+@keyword_only(
+    "density", "radius", "tracer_radius", "tracer_mass", "temperature", "mass", "dim", "chi"
+)
 def tracer_friction(
+    *,
     density: float,
     radius: float,
     tracer_radius: float,
@@ -90,9 +96,9 @@ def tracer_friction(
     Parameters
     ----------
     density : float
-        Number density n of the gas where the tracer is (centres per area or volume).
+        Number density n of the gas where the tracer is (centres per area or volume) [L^-d].
     radius, mass : float
-        The gas particles' r and m.
+        The gas particles' r [L] and m [m].
     tracer_radius, tracer_mass : float
         The tracer's R and M.
     temperature : float
@@ -132,8 +138,8 @@ def tracer_friction(
         if not (value > 0 and math.isfinite(value)):
             raise ValueError(f"{name} must be positive and finite, got {value}")
     if chi is None:
-        eta = packing_fraction(density, radius, 1.0, dim)
-        chi = float(tracer_contact_value(eta, tracer_radius, radius, dim))
+        eta = packing_fraction(n=density, radius=radius, volume=1.0, dim=dim)
+        chi = float(tracer_contact_value(eta, tracer_radius=tracer_radius, radius=radius, dim=dim))
     mu = mass * tracer_mass / (mass + tracer_mass)
     sigma = tracer_radius + radius
     geometry = 4.0 / dim * math.pi ** ((dim - 1) / 2) / math.gamma(dim / 2)
@@ -147,7 +153,11 @@ def tracer_friction(
     )
 
 
+@keyword_only(
+    "density", "radius", "tracer_radius", "tracer_mass", "temperature", "mass", "dim", "chi"
+)
 def tracer_langevin_coefficients(
+    *,
     density: float,
     radius: float,
     tracer_radius: float,
@@ -159,5 +169,14 @@ def tracer_langevin_coefficients(
 ) -> LangevinCoefficients:
     """gamma0 = ``tracer_friction``, D0 = T / (M gamma0) (Einstein) and tau0 = inf of a heavy
     tracer in an elastic gas: the coefficients of ``msd_langevin`` for its MSD."""
-    g = tracer_friction(density, radius, tracer_radius, tracer_mass, temperature, mass, dim, chi)
+    g = tracer_friction(
+        density=density,
+        radius=radius,
+        tracer_radius=tracer_radius,
+        tracer_mass=tracer_mass,
+        temperature=temperature,
+        mass=mass,
+        dim=dim,
+        chi=chi,
+    )
     return LangevinCoefficients(g, temperature / (tracer_mass * g), math.inf)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._params import keyword_only
 from ._numerics import (
     FloatOrArray,
     _check_powerlaw,
@@ -16,7 +17,8 @@ from ._numerics import (
 )
 
 
-def udsbm_v0_sq(D0: float, gamma0: float, tau0: float) -> float:
+@keyword_only("D0", "gamma0", "tau0")
+def udsbm_v0_sq(*, D0: float, gamma0: float, tau0: float) -> float:
     """The "correct" initial mean squared velocity per component of UDSBM (App. C):
     ``(T0/m) gamma0 tau0 / (gamma0 tau0 - 1)``, the value for which the VACF is (2.111)
     from t = 0 on and the MSD is (2.113).  Needs gamma0 tau0 > 1."""
@@ -26,8 +28,15 @@ def udsbm_v0_sq(D0: float, gamma0: float, tau0: float) -> float:
     return D0 * gamma0 * a / (a - 1)
 
 
+@keyword_only("t", "D0", "gamma0", "tau0", "dim", "v0_sq")
 def msd_udsbm(
-    t: FloatOrArray, D0: float, gamma0: float, tau0: float, dim: int = 3, v0_sq: float | None = None
+    t: FloatOrArray,
+    *,
+    D0: float,
+    gamma0: float,
+    tau0: float,
+    dim: int = 3,
+    v0_sq: float | None = None,
 ) -> FloatOrArray:
     """MSD of underdamped scaled Brownian motion, total over ``dim`` dimensions.
 
@@ -47,12 +56,14 @@ def msd_udsbm(
     if v0_sq is not None:
         # int_0^t (1 + s/tau0)^-a ds = tau0 (1 - exp(-(a - 1) u)) / (a - 1)
         integral = tau0 * u * _one_minus_exp_over((a - 1) * u)
-        out = out + (v0_sq - udsbm_v0_sq(D0, gamma0, tau0)) * integral**2
+        out = out + (v0_sq - udsbm_v0_sq(D0=D0, gamma0=gamma0, tau0=tau0)) * integral**2
     return dim * out
 
 
+@keyword_only("lag", "start", "D0", "gamma0", "tau0", "dim", "v0_sq")
 def udsbm_increment_msd(
     lag: FloatOrArray,
+    *,
     start: FloatOrArray,
     D0: float,
     gamma0: float,
@@ -74,7 +85,7 @@ def udsbm_increment_msd(
     ``msd_udsbm(lag / w)``.
     """
     b = gamma0 * tau0 - 1.0
-    vc = udsbm_v0_sq(D0, gamma0, tau0)
+    vc = udsbm_v0_sq(D0=D0, gamma0=gamma0, tau0=tau0)
     v0_sq = vc if v0_sq is None else v0_sq
     start = np.asarray(start, dtype=np.float64)
     w = 1.0 + start / tau0
@@ -84,6 +95,7 @@ def udsbm_increment_msd(
     return dim * (stationary + transient)
 
 
+@keyword_only("t")
 def powerlaw_udsbm_moments(
     t: FloatOrArray,
     *,
@@ -124,6 +136,7 @@ def powerlaw_udsbm_moments(
     return xx, xv, vv
 
 
+@keyword_only("t")
 def msd_powerlaw_udsbm(
     t: FloatOrArray,
     *,
@@ -143,6 +156,7 @@ def msd_powerlaw_udsbm(
     return dim * np.asarray(xx) if np.ndim(xx) else dim * xx
 
 
+@keyword_only("t")
 def msd_powerlaw_udsbm_asymptote(
     t: FloatOrArray, *, D0: float, tau0: float, exponent: float, dim: int = 3
 ) -> FloatOrArray:
@@ -169,6 +183,7 @@ def msd_powerlaw_udsbm_asymptote(
     return 2.0 * dim * D0 * tau0 * np.expm1(b * u) / b
 
 
+@keyword_only("lag")
 def powerlaw_udsbm_increment_msd(
     lag: FloatOrArray,
     *,

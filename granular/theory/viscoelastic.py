@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .. import restitution as _restitution
+from .._params import keyword_only
 from ._numerics import FloatOrArray
 from .haff import LangevinCoefficients, collision_frequency, diffusion_d0
 
@@ -69,6 +70,7 @@ def _check_a_kappa(a_kappa: AKappa) -> float:
     return a_kappa
 
 
+@keyword_only("temperature")
 def viscoelastic_delta(
     temperature: FloatOrArray, *, a_kappa: AKappa, mass: float = 1.0
 ) -> FloatOrArray:
@@ -89,6 +91,7 @@ def viscoelastic_delta(
     return _check_a_kappa(a_kappa) * (4.0 * np.asarray(temperature, dtype=np.float64) / mass) ** 0.1
 
 
+@keyword_only("temperature")
 def viscoelastic_cooling_rate(
     temperature: FloatOrArray,
     *,
@@ -116,9 +119,11 @@ def viscoelastic_cooling_rate(
 
     Parameters
     ----------
-    temperature : T
-    a_kappa : A kappa^(2/5), or a ``restitution.Viscoelastic`` law (see ``viscoelastic_delta``)
-    density, radius, mass, dim, eta : as for ``collision_frequency``
+    temperature : T [eps]
+    a_kappa : A kappa^(2/5) [(time/L)^(1/5)], or a ``restitution.Viscoelastic`` law (see
+        ``viscoelastic_delta``)
+    density : number density N / V (N / A in 2D) [L^-d]
+    radius, mass, dim, eta : as for ``collision_frequency``
     order : 1 (zeta_1) or 2 (zeta_1 + zeta_2)
 
     Returns
@@ -141,7 +146,9 @@ def viscoelastic_cooling_rate(
     if order not in (1, 2):
         raise ValueError(f"order must be 1 or 2, got {order}")
     T = np.asarray(temperature, dtype=np.float64)
-    omega = collision_frequency(density, radius, T, mass, dim, eta)
+    omega = collision_frequency(
+        density=density, radius=radius, temperature=T, mass=mass, dim=dim, eta=eta
+    )
     delta = a_kappa * (4.0 * T / mass) ** 0.1
     zeta = 2.0 / dim * VISCOELASTIC_C1 * math.gamma(2.1) * omega * delta
     if order == 2:
@@ -150,6 +157,7 @@ def viscoelastic_cooling_rate(
     return zeta[()] if np.ndim(zeta) == 0 else zeta
 
 
+@keyword_only()
 def viscoelastic_tau0(
     *,
     a_kappa: AKappa,
@@ -166,8 +174,10 @@ def viscoelastic_tau0(
 
     Parameters
     ----------
-    a_kappa : A kappa^(2/5), or a ``restitution.Viscoelastic`` law (see ``viscoelastic_delta``)
-    density, radius, temperature0, mass, dim, eta : as for ``haff_tau0``
+    a_kappa : A kappa^(2/5) [(time/L)^(1/5)], or a ``restitution.Viscoelastic`` law (see
+        ``viscoelastic_delta``)
+    density : number density N / V (N / A in 2D) [L^-d]
+    radius, temperature0, mass, dim, eta : as for ``haff_tau0``
 
     Returns
     -------
@@ -197,6 +207,7 @@ def viscoelastic_tau0(
     return math.inf if zeta == 0.0 else 5.0 / (3.0 * zeta)
 
 
+@keyword_only("t")
 def viscoelastic_temperature(t: FloatOrArray, *, temperature0: float, tau0: float) -> FloatOrArray:
     """Leading-order cooling of viscoelastic particles, ``T0 (1 + t/tau0')^(-5/3)``
     (tau0' from ``viscoelastic_tau0``): Haff's law T0 (1 + t/tau0)^-2 with the exponent
@@ -212,6 +223,7 @@ def viscoelastic_temperature(t: FloatOrArray, *, temperature0: float, tau0: floa
     return temperature0 * (1.0 + np.asarray(t, dtype=np.float64) / tau0) ** (-5.0 / 3.0)
 
 
+@keyword_only("temperature")
 def viscoelastic_cooling_time(
     temperature: FloatOrArray,
     *,
@@ -262,6 +274,7 @@ def viscoelastic_cooling_time(
     return out[()] if out.ndim == 0 else out
 
 
+@keyword_only("t")
 def viscoelastic_temperature_second_order(
     t: FloatOrArray,
     *,
@@ -305,6 +318,7 @@ def viscoelastic_temperature_second_order(
     return out[()] if out.ndim == 0 else out
 
 
+@keyword_only("t")
 def viscoelastic_diffusion(t: FloatOrArray, *, D0: float, tau0: float) -> FloatOrArray:
     """Self-diffusion coefficient of the viscoelastic gas, ``D(t) = D0 (1 + t/tau0')^(-5/6)``.
 
@@ -323,6 +337,7 @@ def viscoelastic_diffusion(t: FloatOrArray, *, D0: float, tau0: float) -> FloatO
     return D0 * (1.0 + np.asarray(t, dtype=np.float64) / tau0) ** (-5.0 / 6.0)
 
 
+@keyword_only("t")
 def msd_viscoelastic(t: FloatOrArray, *, D0: float, tau0: float, dim: int = 3) -> FloatOrArray:
     """MSD of the viscoelastic gas, total over ``dim``, from D(t) of
     ``viscoelastic_diffusion``: ``2 d int_0^t D = 12 d D0 tau0' ((1 + t/tau0')^(1/6) - 1)``,
@@ -339,6 +354,7 @@ def msd_viscoelastic(t: FloatOrArray, *, D0: float, tau0: float, dim: int = 3) -
     return 12.0 * dim * D0 * tau0 * np.expm1(u / 6.0)
 
 
+@keyword_only("t")
 def msd_viscoelastic_asymptote(
     t: FloatOrArray, *, D0: float, tau0: float, dim: int = 3
 ) -> FloatOrArray:
@@ -349,6 +365,7 @@ def msd_viscoelastic_asymptote(
     return 12.0 * dim * D0 * tau0 ** (5.0 / 6.0) * np.asarray(t, dtype=np.float64) ** (1.0 / 6.0)
 
 
+@keyword_only("t")
 def msd_viscoelastic_second_order(
     t: FloatOrArray,
     *,
@@ -380,8 +397,9 @@ def msd_viscoelastic_second_order(
 
     Parameters
     ----------
-    t : times >= 0
-    temperature0, a_kappa, density, radius, mass, dim, eta : as for
+    t : times >= 0 [L sqrt(m/eps)]
+    density : number density N / V (N / A in 2D) [L^-d]
+    temperature0, a_kappa, radius, mass, dim, eta : as for
         ``viscoelastic_temperature_second_order``
     points : nodes of the quadrature
 
@@ -408,12 +426,24 @@ def msd_viscoelastic_second_order(
     half_loss = (
         0.5 * VISCOELASTIC_C1 * math.gamma(2.1) * viscoelastic_delta(T, a_kappa=a_kappa, mass=mass)
     )
-    D = diffusion_d0(density, radius, 1.0, T, mass, dim, eta) / (1.0 - half_loss) ** 2
+    D = (
+        diffusion_d0(
+            density=density,
+            radius=radius,
+            restitution=1.0,
+            temperature0=T,
+            mass=mass,
+            dim=dim,
+            eta=eta,
+        )
+        / (1.0 - half_loss) ** 2
+    )
     integral = np.concatenate([[0.0], np.cumsum(0.5 * (D[1:] + D[:-1]) * np.diff(grid))])
     out = 2.0 * dim * np.interp(t, grid, integral)
     return out[()] if out.ndim == 0 else out
 
 
+@keyword_only()
 def viscoelastic_langevin_coefficients(
     *,
     n: float,
@@ -430,7 +460,16 @@ def viscoelastic_langevin_coefficients(
     D gamma ~ (1 + t/tau0')^(-5/3) is the cooling law and D the D(t) of
     ``viscoelastic_diffusion`` (Bodrova et al., PCCP 17, 21791 (2015))."""
     density = n / volume
-    d0 = float(diffusion_d0(density, radius, 1.0, temperature0, mass, dim))
+    d0 = float(
+        diffusion_d0(
+            density=density,
+            radius=radius,
+            restitution=1.0,
+            temperature0=temperature0,
+            mass=mass,
+            dim=dim,
+        )
+    )
     tau0 = viscoelastic_tau0(
         a_kappa=a_kappa,
         density=density,
