@@ -459,3 +459,31 @@ def test_parameters_are_keyword_only(name, args):
     positional), so a swap cannot pass silently: the positional call is a TypeError."""
     with pytest.raises(TypeError, match="positional argument"):
         getattr(theory, name)(*args)
+
+
+def test_ergodicity_breaking_of_many_windows_is_built_from_blocks(monkeypatch):
+    """20 000 windows one step apart: the covariance is taken only on the ends of the
+    windows that overlap one another, block by block (at most 2 (256 + 5) times here, as
+    against all 20 005 ends at once, a 3 GB matrix, which made three lags of an engine run
+    take half a minute); disjoint windows come from the one-product recursion.  Checked
+    against Brownian motion's exact EB for the same windows (the velocity memory adds
+    O(1 / (gamma0 lag)) = 2e-4 here, allowed 1e-3)."""
+    from granular.theory import ergodicity
+
+    sizes = []
+    real = ergodicity._covariance_on_grid
+
+    def spy(times, *args, **kwargs):
+        sizes.append(times.size)
+        assert times.size <= 2 * (256 + 5), f"covariance on {times.size} times at once"
+        return real(times, *args, **kwargs)
+
+    monkeypatch.setattr(ergodicity, "_covariance_on_grid", spy)
+    lag, starts = 0.05, np.arange(0.0, 200.0, 0.01)
+    eb = theory.udsbm_ergodicity_breaking(lag, start=starts, D0=1.0, gamma0=1e5, dim=2)
+    assert len(sizes) == -(-starts.size // 256)
+    # Brownian motion: C_jk = 2 D (lag - |s_j - s_k|)+, only the 9 nearest neighbours overlap
+    gaps = np.arange(-4, 5) * 0.01
+    counts = starts.size - np.abs(np.arange(-4, 5))
+    want = 2 * np.sum(counts * (lag - np.abs(gaps)) ** 2) / (2 * (starts.size * lag) ** 2)
+    assert eb == pytest.approx(want, rel=1e-3)
