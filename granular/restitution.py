@@ -207,7 +207,7 @@ class Viscoelastic(RestitutionLaw):
         Raises
         ------
         ValueError
-            If a parameter is out of range.
+            If a parameter is out of range, or together they put kappa outside float64.
         """
         y = _positive(young, "young")
         r = _positive(radius, "radius")
@@ -215,7 +215,16 @@ class Viscoelastic(RestitutionLaw):
         nu = float(poisson)
         if not -1.0 < nu <= 0.5:
             raise ValueError(f"poisson must lie in (-1, 0.5], got {poisson!r}")
-        kappa = 1.5**1.5 * y * math.sqrt(r / 2) / ((m / 2) * (1 - nu * nu))
+        # each factor is a positive finite double, but their product or quotient can leave
+        # float64 (m / 2 underflows to 0 for the smallest masses): say so, not divide by 0
+        denominator = (m / 2) * (1 - nu * nu)
+        kappa = 1.5**1.5 * y * math.sqrt(r / 2) / denominator if denominator > 0 else math.inf
+        if not (kappa > 0 and math.isfinite(kappa)):
+            raise ValueError(
+                f"young = {y!r}, radius = {r!r}, mass = {m!r} and poisson = {nu!r} give the Hertz "
+                f"constant kappa = {kappa!r}, outside float64: give them in units where they "
+                "are nearer 1"
+            )
         return cls(damping, kappa)
 
     @classmethod

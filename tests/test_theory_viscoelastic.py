@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
 
-from granular import theory
+from granular import Viscoelastic, theory
 from granular.theory import _numerics
 
 from helpers import eb_reference
@@ -487,3 +487,16 @@ def test_ergodicity_breaking_of_many_windows_is_built_from_blocks(monkeypatch):
     counts = starts.size - np.abs(np.arange(-4, 5))
     want = 2 * np.sum(counts * (lag - np.abs(gaps)) ** 2) / (2 * (starts.size * lag) ** 2)
     assert eb == pytest.approx(want, rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    "young, radius, mass",
+    [(1e9, 0.01, 5e-324), (1e308, 1e300, 1e-300), (1e-300, 1e-300, 1e300)],
+)
+def test_from_material_outside_float64_is_refused_by_name(young, radius, mass):
+    """Each number positive and finite, but the Hertz constant kappa leaves float64 (the
+    smallest mass halves to 0, a huge modulus over a tiny mass overflows, the opposite
+    underflows to 0): a ValueError naming the inputs and kappa, not a ZeroDivisionError or
+    a law with kappa = inf or 0."""
+    with pytest.raises(ValueError, match=r"give the Hertz constant kappa = .*outside float64"):
+        Viscoelastic.from_material(young=young, poisson=0.3, damping=1e-4, radius=radius, mass=mass)
