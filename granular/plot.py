@@ -19,7 +19,8 @@ Ratios and counts are marked dimensionless.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import importlib
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -46,10 +47,24 @@ DIFFUSIVITY = r"diffusivity $D(t)$ [$L\sqrt{\varepsilon/m}$]"
 POSITION = r"${}$ [$L$]"
 
 
+def _matplotlib(module: str) -> Any:
+    """Import a matplotlib module, or say which extra brings it (matplotlib is not a
+    dependency of granular itself)."""
+    try:
+        return importlib.import_module(module)
+    except ModuleNotFoundError as exc:
+        if not (exc.name or "").startswith("matplotlib"):
+            raise
+        raise ModuleNotFoundError(
+            "granular.plot draws with matplotlib, which is not installed: pip install "
+            "matplotlib (or pip install 'granular[plot]')",
+            name=exc.name,
+        ) from exc
+
+
 def _axes(ax: Axes | None) -> Axes:
     if ax is None:
-        import matplotlib.pyplot as plt
-
+        plt = _matplotlib("matplotlib.pyplot")
         _, ax = plt.subplots(figsize=(5.5, 4.0), layout="constrained")
     return ax
 
@@ -270,7 +285,7 @@ def snapshot(
     color: str = "C0",
 ) -> Axes:
     """Disks of a 2D configuration drawn to scale (Fig 4.9)."""
-    from matplotlib.collections import EllipseCollection
+    EllipseCollection = _matplotlib("matplotlib.collections").EllipseCollection
 
     ax = _axes(ax)
     x = np.asarray(positions, dtype=np.float64)

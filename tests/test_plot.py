@@ -1,5 +1,7 @@
 """Every plot renders to PNG, returns its axes and labels its axes with units."""
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -103,3 +105,19 @@ def test_demo_panels_read_well():
         # the histogram's last bin ends 2% past the fastest particle; matplotlib's 5% margin
         assert ax.get_xlim()[1] < 1.1 * fastest
     plt.close("all")
+
+
+@pytest.mark.parametrize(
+    "draw",
+    [
+        lambda: plot.msd(np.arange(1.0, 4.0), np.arange(1.0, 4.0)),
+        lambda: plot.snapshot(np.zeros((1, 2)), radii=0.1, lower=[0, 0], upper=[1, 1]),
+    ],
+)
+def test_without_matplotlib_the_message_names_the_extra(monkeypatch, draw):
+    # a bare install: matplotlib (an extra, not a dependency) cannot be imported
+    for name in [m for m in sys.modules if m == "matplotlib" or m.startswith("matplotlib.")]:
+        monkeypatch.setitem(sys.modules, name, None)
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    with pytest.raises(ModuleNotFoundError, match=r"pip install 'granular\[plot\]'"):
+        draw()
