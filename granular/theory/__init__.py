@@ -7,6 +7,16 @@ Conventions: k_B = 1, so temperature is energy, ``T = 2 <E_kin> / d`` per partic
 dimensions**: the thesis derives one-dimensional MSDs and multiplies by 3 (2.56); divide
 by ``dim`` for one component.  All functions accept NumPy arrays for ``t``.
 
+Calling convention: the independent variable (``t``, ``lag``, ``speed``, the packing
+fraction ``eta``, a ``box`` size, the temperature of a viscoelastic rate) is positional,
+every other parameter keyword-only, one name per quantity across the package (``density``
+the number density N/V, ``n`` the number of particles, ``restitution`` the constant xi):
+``theory.haff_tau0(density=1000, radius=0.025, restitution=0.8, temperature0=0.66)``.
+Each argument is checked by its name (a negative radius or D0, a NaN time: a ValueError
+naming it).  The positional calls of version 0.1, and the names ``xi`` and ``starts``, still
+work with a FutureWarning that spells out the new call; they are removed in 0.2.0.  The
+names, their units and the values they accept: the table in docs/conventions.md.
+
 Validity: the kinetic-theory coefficients (collision frequency, Haff's tau0, D0, gamma0)
 are Enskog's, for a homogeneous gas (for xi < 1 the homogeneous cooling state) in the
 Maxwellian approximation -- they neglect the non-Gaussian (Sonine a2) correction of a
