@@ -214,8 +214,8 @@ def keyword_only(*old_order: str, renamed: dict[str, str] | None = None, validat
 
         wrapper.__doc__ = _with_parameters(func.__doc__, func)
         # the old convention, for tests and the tools that rewrite callers
-        wrapper.old_positional = tuple(old_order)
-        wrapper.renamed = dict(renamed)
+        wrapper.old_positional = tuple(old_order)  # type: ignore[attr-defined]
+        wrapper.renamed = dict(renamed)  # type: ignore[attr-defined]
         return wrapper
 
     return decorate
