@@ -393,7 +393,7 @@ class LangevinResult:
     def theory_ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected EB of this run's TAMSD estimator (its window starts, every
         ``sde_lag_stride`` steps) at its lags or at ``lags``:
-        ``theory.udsbm_ergodicity_breaking`` (cost: squared windows per lag).  It assumes
+        ``theory.udsbm_ergodicity_breaking`` (cost: windows x overlapping windows).  It assumes
         Gaussian initial velocities (``initial`` "thermal" or "udsbm"), as Isserlis'
         theorem there needs.
 
