@@ -1,6 +1,9 @@
 """Figures: each function draws onto the given axes (or new ones) and returns them.
 
-matplotlib is imported only when a function is called.  Animations of a trajectory:
+matplotlib (the ``plot`` extra) is imported only when a function is called.  Each function
+takes the data it draws by position, x then y as ``ax.plot(x, y)`` does, and everything else
+by keyword (``plot.haff(times, temperature, tau0=...)``); the names are the package's (the
+table in docs/conventions.md).  Animations of a trajectory:
 ``animate`` (its own page in the API reference, ``granular.plot.animate``).
 
 Units follow the package's conventions (docs/conventions.md) and every axis says which it
