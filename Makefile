@@ -73,13 +73,15 @@ ASAN_ENV   := LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file
               ASAN_OPTIONS=detect_leaks=0:allocator_may_return_null=1 \
               UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 GRANULAR_FUZZ_TIMEOUT=30
 
-$(ASAN_VENV)/.installed: pyproject.toml setup.py MANIFEST.in $(wildcard csrc/*.c csrc/*.h granular/*.py granular/cli/*.py)
+$(ASAN_VENV)/.installed: pyproject.toml setup.py MANIFEST.in $(wildcard csrc/*.c csrc/*.h granular/*.py granular/cli/*.py granular/theory/*.py)
 	$(PYTHON) -m venv $(ASAN_VENV)
 	$(ASAN_PY) -m pip install --quiet --upgrade pip
-	rm -rf $(ASAN_VENV)/src && mkdir -p $(ASAN_VENV)/src/granular/cli
+	rm -rf $(ASAN_VENV)/src && mkdir -p $(ASAN_VENV)/src/granular/cli \
+	    $(ASAN_VENV)/src/granular/theory
 	cp setup.py pyproject.toml README.md MANIFEST.in $(ASAN_VENV)/src/
 	cp -r csrc $(ASAN_VENV)/src/ && cp granular/*.py $(ASAN_VENV)/src/granular/
 	cp granular/cli/*.py $(ASAN_VENV)/src/granular/cli/
+	cp granular/theory/*.py $(ASAN_VENV)/src/granular/theory/
 	GRANULAR_ASAN=1 CFLAGS="$(ASAN_CFLAGS)" $(ASAN_PY) -m pip install --quiet --force-reinstall \
 	    "$(ASAN_VENV)/src[test]"
 	touch $@

@@ -454,7 +454,7 @@ def speed_statistics(
     speed, dim = _speeds(v)
     mass = float(np.mean(np.asarray(masses, dtype=np.float64)))
     T = float(np.mean(_snapshot_temperature(v, masses))) if temperature is None else temperature
-    mb = theory.maxwell_boltzmann_moments(T, mass, dim)
+    mb = theory.maxwell_boltzmann_moments(temperature=T, mass=mass, dim=dim)
     ours = {"mean": speed.mean(), "mean_sq": np.mean(speed**2), "std": speed.std()}
     return {
         k: {"ours": float(ours[k]), "theory": mb[k], "relative_error": float(ours[k] / mb[k] - 1)}

@@ -471,8 +471,14 @@ def _law_outlook(restitution, scene, big, radius, density, growth):
     u = np.linspace(0.0, 60.0, 1501)  # the trapezoids' relative error ~1e-4
     T = T0 * np.exp(-u)
     xi = effective_restitution(restitution, T, mass)
-    lc = np.asarray(theory.critical_box_size(density, radius, xi, d, eta=eta))
-    omega = np.asarray(theory.collision_frequency(density, radius, T, mass, d, eta))
+    lc = np.asarray(
+        theory.critical_box_size(density=density, radius=radius, restitution=xi, dim=d, eta=eta)
+    )
+    omega = np.asarray(
+        theory.collision_frequency(
+            density=density, radius=radius, temperature=T, mass=mass, dim=d, eta=eta
+        )
+    )
 
     def integral(f):
         return np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(u))])
@@ -565,7 +571,11 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
         )
     else:
         at = f"restitution xi = {float(xi):g}"
-    lc = float(theory.critical_box_size(density, radius, float(xi), scene.dim, eta=eta))
+    lc = float(
+        theory.critical_box_size(
+            density=density, radius=radius, restitution=float(xi), dim=scene.dim, eta=eta
+        )
+    )
     if not big > lc:
         return None
     d, n = scene.dim, scene.n
@@ -610,8 +620,22 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     text += "Haff's law stops describing the cooling"
     t_star = cpp = math.inf
     if xi > 0 and temperature > 0:
-        tau0 = float(theory.haff_tau0(density, radius, float(xi), temperature, mass, d, eta))
-        omega0 = float(theory.collision_frequency(density, radius, temperature, mass, d, eta))
+        tau0 = float(
+            theory.haff_tau0(
+                density=density,
+                radius=radius,
+                restitution=float(xi),
+                temperature0=temperature,
+                mass=mass,
+                dim=d,
+                eta=eta,
+            )
+        )
+        omega0 = float(
+            theory.collision_frequency(
+                density=density, radius=radius, temperature=temperature, mass=mass, dim=d, eta=eta
+            )
+        )
         exponent = 2 * (1 - (lc / big) ** 2)
         if growth > 1:
             t_star = tau0 * (growth ** (1 / exponent) - 1)

@@ -454,7 +454,9 @@ class LangevinResult:
 
         t = self.times if t is None else t
         if self.model == "langevin":
-            return theory.msd_langevin(t, self.D0, self.gamma0, self.dim, v0_sq=self.v0_sq)
+            return theory.msd_langevin(
+                t, D0=self.D0, gamma0=self.gamma0, dim=self.dim, v0_sq=self.v0_sq
+            )
         if self.exponent != 1.0:
             return theory.msd_powerlaw_udsbm(
                 t,
@@ -465,7 +467,9 @@ class LangevinResult:
                 dim=self.dim,
                 v0_sq=self.v0_sq,
             )
-        return theory.msd_udsbm(t, self.D0, self.gamma0, self.tau0, self.dim, v0_sq=self.v0_sq)
+        return theory.msd_udsbm(
+            t, D0=self.D0, gamma0=self.gamma0, tau0=self.tau0, dim=self.dim, v0_sq=self.v0_sq
+        )
 
     def theory_tamsd(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected time-averaged MSD of this run at its lags (or at ``lags``), as the
@@ -509,7 +513,7 @@ class LangevinResult:
     def theory_ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected EB of this run's TAMSD estimator (its window starts, every
         ``sde_lag_stride`` steps) at its lags or at ``lags``:
-        ``theory.udsbm_ergodicity_breaking`` (cost: squared windows per lag).  It assumes
+        ``theory.udsbm_ergodicity_breaking`` (cost: windows x overlapping windows).  It assumes
         Gaussian initial velocities (``initial`` "thermal" or "udsbm"), as Isserlis'
         theorem there needs.
 
@@ -549,7 +553,7 @@ class LangevinResult:
             out.append(
                 theory.udsbm_ergodicity_breaking(
                     k * self.dt,
-                    starts=starts,
+                    start=starts,
                     D0=self.D0,
                     gamma0=self.gamma0,
                     tau0=self.tau0,
@@ -609,7 +613,7 @@ def theory_tamsd(
                 if v0_sq is None
                 else thermal + (v0_sq - thermal) * np.exp(-2 * gamma0 * starts)
             )
-            incr = theory.msd_langevin(lag, D0, gamma0, dim, v0_sq=v_sq)
+            incr = theory.msd_langevin(lag, D0=D0, gamma0=gamma0, dim=dim, v0_sq=v_sq)
         elif exponent != 1.0:
             if v0_sq is None:
                 raise ValueError("the power-law UDSBM (exponent != 1) needs v0_sq")
@@ -624,7 +628,9 @@ def theory_tamsd(
                 v0_sq=v0_sq,
             )
         else:
-            incr = theory.udsbm_increment_msd(lag, starts, D0, gamma0, tau0, dim, v0_sq=v0_sq)
+            incr = theory.udsbm_increment_msd(
+                lag, start=starts, D0=D0, gamma0=gamma0, tau0=tau0, dim=dim, v0_sq=v0_sq
+            )
         out.append(float(np.mean(incr)))
     return np.array(out)
 
@@ -837,7 +843,7 @@ def run(
             )
         from .theory import udsbm_v0_sq
 
-        v0_sq = udsbm_v0_sq(D0, gamma0, tau0)
+        v0_sq = udsbm_v0_sq(D0=D0, gamma0=gamma0, tau0=tau0)
         v = rng.normal(scale=math.sqrt(v0_sq), size=(n, dim))
     elif initial == "fixed":
         s = math.sqrt(dim * thermal) if speed is None else _positive("speed", speed)
@@ -1019,7 +1025,13 @@ def _scene_model(scene: Scene) -> tuple[LangevinCoefficients, float]:
             "and granular.Viscoelastic (power-law UDSBM, exponent 5/6)"
         )
     c = theory.langevin_coefficients(
-        scene.n, radius, scene.volume, law, scene.temperature, mass, scene.dim
+        n=scene.n,
+        radius=radius,
+        volume=scene.volume,
+        restitution=law,
+        temperature0=scene.temperature,
+        mass=mass,
+        dim=scene.dim,
     )
     return c, 1.0
 

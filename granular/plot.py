@@ -1,6 +1,9 @@
 """Figures: each function draws onto the given axes (or new ones) and returns them.
 
-matplotlib is imported only when a function is called.  Animations of a trajectory:
+matplotlib (the ``plot`` extra) is imported only when a function is called.  Each function
+takes the data it draws by position, x then y as ``ax.plot(x, y)`` does, and everything else
+by keyword (``plot.haff(times, temperature, tau0=...)``); the names are the package's (the
+table in docs/conventions.md).  Animations of a trajectory:
 ``animate`` (its own page in the API reference, ``granular.plot.animate``).
 
 Units follow the package's conventions (docs/conventions.md) and every axis says which it
@@ -19,12 +22,14 @@ Ratios and counts are marked dimensionless.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import importlib
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ._animate import animate  # noqa: F401 (public here; animations have their own module)
+from ._params import keyword_only as _keyword_only
 
 if TYPE_CHECKING:  # matplotlib is an extra, imported only when a figure is drawn
     from matplotlib.axes import Axes
@@ -45,17 +50,33 @@ DIFFUSIVITY = r"diffusivity $D(t)$ [$L\sqrt{\varepsilon/m}$]"
 POSITION = r"${}$ [$L$]"
 
 
+def _matplotlib(module: str) -> Any:
+    """Import a matplotlib module, or say which extra brings it (matplotlib is not a
+    dependency of granular itself)."""
+    try:
+        return importlib.import_module(module)
+    except ModuleNotFoundError as exc:
+        if not (exc.name or "").startswith("matplotlib"):
+            raise
+        raise ModuleNotFoundError(
+            "granular.plot draws with matplotlib, which is not installed: pip install "
+            "matplotlib (or pip install 'granular[plot]')",
+            name=exc.name,
+        ) from exc
+
+
 def _axes(ax: Axes | None) -> Axes:
     if ax is None:
-        import matplotlib.pyplot as plt
-
+        plt = _matplotlib("matplotlib.pyplot")
         _, ax = plt.subplots(figsize=(5.5, 4.0), layout="constrained")
     return ax
 
 
+@_keyword_only("times", "kinetic_energy", "ax", "label", "relative", validate=False)
 def energy(
     times: ArrayLike,
     kinetic_energy: ArrayLike,
+    *,
     ax: Axes | None = None,
     label: str | None = None,
     relative: bool = True,
@@ -73,8 +94,9 @@ def energy(
     return ax
 
 
+@_keyword_only("times", "collisions", "ax", "label", validate=False)
 def collisions_per_particle(
-    times: ArrayLike, collisions: ArrayLike, ax: Axes | None = None, label: str | None = None
+    times: ArrayLike, collisions: ArrayLike, *, ax: Axes | None = None, label: str | None = None
 ) -> Axes:
     """Mean collisions per particle against time (thesis Figs 4.3-4.4)."""
     ax = _axes(ax)
@@ -86,8 +108,10 @@ def collisions_per_particle(
     return ax
 
 
+@_keyword_only("velocities", "temperature", "mass", "bins", "ax", "label", validate=False)
 def speed_distribution(
     velocities: ArrayLike,
+    *,
     temperature: float | None = None,
     mass: float = 1.0,
     bins: int = 40,
@@ -108,7 +132,10 @@ def speed_distribution(
     ax.bar(centres, dens, width=width, alpha=0.5, label=label, yerr=err, ecolor="0.4")
     s = np.linspace(0.0, top, 300)
     ax.plot(
-        s, theory.maxwell_boltzmann_pdf(s, T, mass, dim), "k--", label=f"Maxwell-Boltzmann ({dim}D)"
+        s,
+        theory.maxwell_boltzmann_pdf(s, temperature=T, mass=mass, dim=dim),
+        "k--",
+        label=f"Maxwell-Boltzmann ({dim}D)",
     )
     ax.set_xlabel(SPEED)
     ax.set_ylabel(SPEED_DENSITY)
@@ -116,9 +143,13 @@ def speed_distribution(
     return ax
 
 
+@_keyword_only(
+    "times", "temperature", "tau0", "temperature0", "ax", "label", "error", validate=False
+)
 def haff(
     times: ArrayLike,
     temperature: ArrayLike,
+    *,
     tau0: float,
     temperature0: float | None = None,
     ax: Axes | None = None,
@@ -140,7 +171,7 @@ def haff(
         ax.plot(t[keep], T[keep], ".", label=label)
     ax.plot(
         t[keep],
-        theory.haff_temperature(t[keep], T0, tau0),
+        theory.haff_temperature(t[keep], temperature0=T0, tau0=tau0),
         "k--",
         label=rf"Haff, $\tau_0$ = {tau0:.3g}",
     )
@@ -152,9 +183,22 @@ def haff(
     return ax
 
 
+@_keyword_only(
+    "times",
+    "values",
+    "error",
+    "theory_values",
+    "ax",
+    "label",
+    "theory_label",
+    "loglog",
+    "theory_style",
+    validate=False,
+)
 def msd(
     times: ArrayLike,
     values: ArrayLike,
+    *,
     error: ArrayLike | None = None,
     theory_values: ArrayLike | None = None,
     ax: Axes | None = None,
@@ -184,9 +228,11 @@ def msd(
     return ax
 
 
+@_keyword_only("times", "values", "theory_values", "ax", "label", validate=False)
 def diffusivity(
     times: ArrayLike,
     values: ArrayLike,
+    *,
     theory_values: ArrayLike | None = None,
     ax: Axes | None = None,
     label: str = "simulation",
@@ -206,9 +252,11 @@ def diffusivity(
     return ax
 
 
+@_keyword_only("times", "msd_values", "lags", "tamsd_values", "ax", "label", validate=False)
 def msd_vs_tamsd(
     times: ArrayLike,
     msd_values: ArrayLike,
+    *,
     lags: ArrayLike,
     tamsd_values: ArrayLike,
     ax: Axes | None = None,
@@ -229,8 +277,10 @@ def msd_vs_tamsd(
     return ax
 
 
+@_keyword_only("positions", "radii", "lower", "upper", "ax", "color", validate=False)
 def snapshot(
     positions: ArrayLike,
+    *,
     radii: ArrayLike,
     lower: ArrayLike,
     upper: ArrayLike,
@@ -238,7 +288,7 @@ def snapshot(
     color: str = "C0",
 ) -> Axes:
     """Disks of a 2D configuration drawn to scale (Fig 4.9)."""
-    from matplotlib.collections import EllipseCollection
+    EllipseCollection = _matplotlib("matplotlib.collections").EllipseCollection
 
     ax = _axes(ax)
     x = np.asarray(positions, dtype=np.float64)
@@ -271,9 +321,11 @@ STRUCTURE_FACTOR = r"$S(k, t)$ (dimensionless; 1 for an ideal gas)"
 FLOW_RATIO = r"$E_{flow} / E_{thermal}$ (dimensionless)"
 
 
+@_keyword_only("times", "result", "ax", "shells", "transverse", validate=False)
 def structure_factor(
     times: ArrayLike,
     result,
+    *,
     ax: Axes | None = None,
     shells: int = 2,
     transverse=None,
@@ -304,9 +356,11 @@ def structure_factor(
     return ax
 
 
+@_keyword_only("times", "result", "ax", "label", "threshold", validate=False)
 def flow_energy(
     times: ArrayLike,
     result,
+    *,
     ax: Axes | None = None,
     label: str | None = None,
     threshold: float | None = None,

@@ -216,7 +216,7 @@ class Viscoelastic(RestitutionLaw):
         Raises
         ------
         ValueError
-            If a parameter is out of range.
+            If a parameter is out of range, or together they put kappa outside float64.
         """
         y = _positive(young, "young")
         r = _positive(radius, "radius")
@@ -226,7 +226,18 @@ class Viscoelastic(RestitutionLaw):
             from .errors import shown
 
             raise ValueError(f"poisson must lie in (-1, 0.5], got {shown(poisson)}")
-        kappa = 1.5**1.5 * y * math.sqrt(r / 2) / ((m / 2) * (1 - nu * nu))
+        # each factor is a positive finite double, but their product or quotient can leave
+        # float64 (m / 2 underflows to 0 for the smallest masses): say so, not divide by 0
+        denominator = (m / 2) * (1 - nu * nu)
+        kappa = 1.5**1.5 * y * math.sqrt(r / 2) / denominator if denominator > 0 else math.inf
+        if not (kappa > 0 and math.isfinite(kappa)):
+            from .errors import shown
+
+            raise ValueError(
+                f"young = {shown(y)}, radius = {shown(r)}, mass = {shown(m)} and poisson = "
+                f"{shown(nu)} give the Hertz constant kappa = {shown(kappa)}, outside float64: "
+                "give them in units where they are nearer 1"
+            )
         return cls(damping, kappa)
 
     @classmethod

@@ -104,12 +104,12 @@ def test_speed_statistics_of_maxwell_boltzmann_samples():
         T, n = 0.8, 200_000
         v = rng.normal(scale=math.sqrt(T), size=(n, dim))
         st = analysis.speed_statistics(v, temperature=T)
-        mb = theory.maxwell_boltzmann_moments(T, dim=dim)
+        mb = theory.maxwell_boltzmann_moments(temperature=T, dim=dim)
         assert abs(st["mean"]["relative_error"]) < 5 * mb["std"] / math.sqrt(n) / mb["mean"]
         std_se = speed_std_standard_error(dim, T, n)
         assert abs(st["std"]["relative_error"]) < 5 * std_se / mb["std"]
         centres, dens, err = analysis.speed_histogram(v, bins=40, range=(0, 4))
-        pdf = theory.maxwell_boltzmann_pdf(centres, T, dim=dim)
+        pdf = theory.maxwell_boltzmann_pdf(centres, temperature=T, dim=dim)
         # bin-centre evaluation of a curved density: the midpoint rule's error is
         # ~ w^2 f'' / 24, a few 1e-4 here; plus 5 Poisson sigma
         assert np.all(np.abs(dens - pdf) < 5 * err + 2e-3)
@@ -118,7 +118,7 @@ def test_speed_statistics_of_maxwell_boltzmann_samples():
 
 def test_fit_haff_tau0_recovers_tau0():
     t = np.linspace(0, 50, 101)
-    T = theory.haff_temperature(t, 1.3, 2.5)
+    T = theory.haff_temperature(t, temperature0=1.3, tau0=2.5)
     tau0, err = analysis.fit_haff_tau0(t, T)
     assert tau0 == pytest.approx(2.5, rel=1e-12) and err < 1e-10
 

@@ -135,8 +135,10 @@ def test_tracer_msd_follows_langevin_with_kinetic_theory_friction():
     )
     msd = np.array([r["msd"] for r in res.runs])
     v0_sq = np.array([float(r["v0_sq"]) for r in res.runs])
-    given_start = np.array([theory.msd_langevin(times, c.D0, c.gamma0, 2, v) for v in v0_sq])
-    thermal = theory.msd_langevin(times, c.D0, c.gamma0, 2)
+    given_start = np.array(
+        [theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0, dim=2, v0_sq=v) for v in v0_sq]
+    )
+    thermal = theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0, dim=2)
     t = stats.t.ppf(1 - FALSE_ALARM / 2, k - 1)
     for j in range(1, len(times)):
         residual = (msd[:, j] - given_start[:, j]) / thermal[j]

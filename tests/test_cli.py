@@ -76,7 +76,13 @@ def _euler_maruyama_margin():
 
     cfg = reproduce.Config(quick=True)
     g = max(
-        theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, reproduce_text.THESIS_T0).gamma0
+        theory.langevin_coefficients(
+            n=cfg.n3,
+            radius=cfg.r3,
+            volume=1.0,
+            restitution=xi,
+            temperature0=reproduce_text.THESIS_T0,
+        ).gamma0
         for xi in (1.0, 0.8, 0.5)
     )
     return 2 / (2 - g * 0.01) - 1

@@ -209,7 +209,7 @@ def test_shear_viscosity_is_enskogs_at_xi_1(phi):
     (Chapman & Cowling), 2D eta0 [1 / chi + 2 phi + (1 + 8 / pi) phi^2 chi] (Gass 1971)."""
     r, temp, mass = 0.01, 1.3, 2.0
     for dim in (2, 3):
-        chi = theory.contact_value(phi, dim)
+        chi = theory.contact_value(phi, dim=dim)
         root = math.sqrt(mass * temp / math.pi)
         if dim == 3:
             eta0 = 5 / (16 * (2 * r) ** 2) * root
@@ -217,7 +217,9 @@ def test_shear_viscosity_is_enskogs_at_xi_1(phi):
         else:
             eta0 = root / (2 * 2 * r)
             enskog = 1 / chi + 2 * phi + (1 + 8 / math.pi) * phi**2 * chi
-        visc = theory.shear_viscosity(1.0, r, 1.0, temp, mass, dim, eta=phi)
+        visc = theory.shear_viscosity(
+            density=1.0, radius=r, restitution=1.0, temperature=temp, mass=mass, dim=dim, eta=phi
+        )
         assert visc == pytest.approx(eta0 * enskog, rel=1e-12)
 
 
@@ -229,10 +231,12 @@ def test_critical_box_size_dilute_against_hand_numbers():
     n, r = 1.0, 1e-4  # packing fraction 4e-12
     sigma = 2 * r
     lam = 1 / (math.sqrt(2) * math.pi * n * sigma**2)
-    assert theory.critical_box_size(n, r, 0.5) / lam == pytest.approx(14.087, rel=1e-4)
+    assert theory.critical_box_size(density=n, radius=r, restitution=0.5) / lam == pytest.approx(
+        14.087, rel=1e-4
+    )
     # L_c scales as the mean free path, 1 / n, in a dilute gas
-    assert theory.critical_box_size(2 * n, r, 0.5) == pytest.approx(
-        theory.critical_box_size(n, r, 0.5) / 2, rel=1e-6
+    assert theory.critical_box_size(density=2 * n, radius=r, restitution=0.5) == pytest.approx(
+        theory.critical_box_size(density=n, radius=r, restitution=0.5) / 2, rel=1e-6
     )
 
 
@@ -240,23 +244,26 @@ def test_critical_box_size_limits_and_consistency():
     # more elastic, more stable, from xi = 0.3 up; below, the viscosity's growth with
     # dissipation (eta* = 1 / (nu* - zeta*/2)) wins and L_c turns up again slightly
     xis = np.array([0.3, 0.5, 0.8, 0.95, 0.999])
-    lc = theory.critical_box_size(1000, 0.025, xis)
+    lc = theory.critical_box_size(density=1000, radius=0.025, restitution=xis)
     assert np.all(np.diff(lc) > 0)
     assert lc[-1] > 15 * lc[1]  # ~ 1 / sqrt(1 - xi^2) towards xi = 1
-    assert theory.critical_box_size(1000, 0.025, 1.0) == math.inf
+    assert theory.critical_box_size(density=1000, radius=0.025, restitution=1.0) == math.inf
     # the cooling rate is Haff's: zeta(T0) = 2 / tau0
-    z = theory.cooling_rate(1000, 0.025, 0.3, 0.6)
-    assert z == pytest.approx(2 / theory.haff_tau0(1000, 0.025, 0.3, 0.6), rel=1e-12)
+    z = theory.cooling_rate(density=1000, radius=0.025, restitution=0.3, temperature=0.6)
+    assert z == pytest.approx(
+        2 / theory.haff_tau0(density=1000, radius=0.025, restitution=0.3, temperature0=0.6),
+        rel=1e-12,
+    )
     # the thesis' box (N = 1000, r = 0.025, L = 1) lies just below L_c at xi = 0.5 and 0.3
-    assert 1.0 < theory.critical_box_size(1000, 0.025, 0.3) < 1.15
+    assert 1.0 < theory.critical_box_size(density=1000, radius=0.025, restitution=0.3) < 1.15
     with pytest.raises(ValueError, match="xi"):
-        theory.critical_box_size(1000, 0.025, 1.5)
-    growth = theory.shear_mode_growth(np.array([0.0, 3.0]), 1.0, 2.0, 1.0)
+        theory.critical_box_size(density=1000, radius=0.025, restitution=1.5)
+    growth = theory.shear_mode_growth(np.array([0.0, 3.0]), tau0=1.0, box=2.0, critical=1.0)
     assert growth[0] == 1.0 and growth[1] == pytest.approx(4.0**1.5)
-    assert theory.shear_mode_growth(3.0, 1.0, 1.0, 2.0) < 1  # below L_c: decays
+    assert theory.shear_mode_growth(3.0, tau0=1.0, box=1.0, critical=2.0) < 1  # below L_c: decays
     # the level the slowest shear mode settles at below L_c: 1 / (1 - 0.25) at L = L_c / 2
-    assert theory.shear_mode_level(0.5, 1.0) == pytest.approx(4 / 3)
-    assert np.all(np.isinf(theory.shear_mode_level(np.array([1.0, 1.5]), 1.0)))
+    assert theory.shear_mode_level(0.5, critical=1.0) == pytest.approx(4 / 3)
+    assert np.all(np.isinf(theory.shear_mode_level(np.array([1.0, 1.5]), critical=1.0)))
 
 
 # -- the warning --------------------------------------------------------------------------------
@@ -291,7 +298,9 @@ def test_clustering_warning_for_a_big_granular_box_once():
         warnings.simplefilter("error")
         sim.run(t_stop=1.1 * t_star)  # once per Simulation
     assert str(record[0].message) == message
-    lc = theory.critical_box_size(1000, 0.025, 0.3, eta=scene.packing_fraction)
+    lc = theory.critical_box_size(
+        density=1000, radius=0.025, restitution=0.3, eta=scene.packing_fraction
+    )
     for number in (
         f"L = {3 ** (1 / 3):.4g}",
         f"L_c = {lc:.4g}",
@@ -334,7 +343,9 @@ def test_clustering_warning_for_a_viscoelastic_gas_at_its_effective_restitution(
     is no bound for a gas whose L_c grows as it cools), with xi_eff and its L_c."""
     scene = _viscoelastic_disks(1000, 0.005)
     xi = clustering.effective_restitution(scene.restitution, scene.temperature)
-    lc = theory.critical_box_size(1000, 0.005, xi, 2, eta=scene.packing_fraction)
+    lc = theory.critical_box_size(
+        density=1000, radius=0.005, restitution=xi, dim=2, eta=scene.packing_fraction
+    )
     assert lc < 1
     with pytest.warns(granular.ClusteringWarning) as record:
         granular.Simulation(scene).run(t_stop=1e-3)

@@ -39,7 +39,7 @@ def rel_se_msd(n, dim=3):
 
 def diffusive_limit(t):
     """Langevin, thermal start: (2.68) tends to Einstein's (2.46) shifted by 1/gamma0."""
-    return theory.msd_diffusive(t, D0, gamma0=G0)
+    return theory.msd_diffusive(t, D0=D0, gamma0=G0)
 
 
 def logarithmic_limit(t):
@@ -47,7 +47,7 @@ def logarithmic_limit(t):
     gamma0 -> gamma0 - 1/tau0 and D0 -> D0 a^2 / (a - 1)^2, so it tends to the
     logarithmic limit (2.80) with those coefficients -- a slope against ln t larger than
     the granular gas' 2 d D0 tau0 by a^2 / (a - 1)^2 (27% at xi = 0.8)."""
-    return theory.msd_logarithmic(t, D0 * A**2 / (A - 1) ** 2, TAU0, gamma0=G0 - 1 / TAU0)
+    return theory.msd_logarithmic(t, D0=D0 * A**2 / (A - 1) ** 2, tau0=TAU0, gamma0=G0 - 1 / TAU0)
 
 
 @pytest.mark.parametrize(
@@ -118,7 +118,7 @@ def test_euler_maruyama_msd_matches_theory_at_small_steps():
     [
         (math.inf, "thermal", VT),
         (math.inf, "fixed", 1.5**2 / 3),
-        (TAU0, "udsbm", theory.udsbm_v0_sq(D0, G0, TAU0)),
+        (TAU0, "udsbm", theory.udsbm_v0_sq(D0=D0, gamma0=G0, tau0=TAU0)),
     ],
 )
 def test_ballistic_limit(tau0, initial, v0_sq):
@@ -144,7 +144,7 @@ def test_ballistic_limit(tau0, initial, v0_sq):
         seed=3,
     )
     assert r.v0_sq == pytest.approx(v0_sq)
-    ballistic = theory.msd_ballistic(t, v0_sq)
+    ballistic = theory.msd_ballistic(t, temperature=v0_sq)
     off_limit = np.abs(r.theory_msd(t) / ballistic - 1)
     np.testing.assert_array_less(np.abs(r.msd() / ballistic - 1), 5 * rel_se_msd(n) + off_limit)
 
@@ -249,7 +249,7 @@ def test_tamsd_equals_msd_for_langevin_but_not_for_udsbm():
         n, gamma0=G0, D0=D0, dt=0.01, t_stop=100.0, scheme="exact", tamsd_lags=lags, seed=6
     )
     se = r.tamsd_per_particle.std(0, ddof=1) / math.sqrt(n)
-    expected = theory.msd_langevin(lags, D0, G0)
+    expected = theory.msd_langevin(lags, D0=D0, gamma0=G0)
     np.testing.assert_array_less(np.abs(r.tamsd() - expected), 5 * se)
     u = langevin.run(
         n,
@@ -491,7 +491,9 @@ def test_default_samples_end_at_t_stop_for_any_step_count(monkeypatch):
 def test_from_scene_uses_the_thesis_coefficients():
     s = granular.Scene.random(1000, 0.025, restitution=0.8, seed=1)
     c = langevin.coefficients_from_scene(s)
-    ref = theory.langevin_coefficients(1000, 0.025, 1.0, 0.8, s.temperature)
+    ref = theory.langevin_coefficients(
+        n=1000, radius=0.025, volume=1.0, restitution=0.8, temperature0=s.temperature
+    )
     assert c == pytest.approx(ref)
     r = langevin.from_scene(s, dt=0.01, t_stop=1.0, n=200, seed=1)
     assert r.model == "udsbm" and r.tau0 == pytest.approx(ref.tau0)

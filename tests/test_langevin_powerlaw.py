@@ -281,9 +281,9 @@ def test_theory_refuses_bad_input():
         )
     with pytest.raises(ValueError, match="gamma0 must be positive"):
         theory.msd_powerlaw_udsbm(1.0, D0=D0, gamma0=-G0, tau0=TAU0, exponent=VISCO)
-    with pytest.raises(ValueError, match="t must be finite"):
+    with pytest.raises(ValueError, match="t must be >= 0 and finite"):
         theory.msd_powerlaw_udsbm(-1.0, D0=D0, gamma0=G0, tau0=TAU0, exponent=VISCO)
     with pytest.raises(ValueError, match="0 < exponent < 1"):
         theory.msd_powerlaw_udsbm_asymptote(1.0, D0=D0, tau0=TAU0, exponent=1.0)
     with pytest.raises(ValueError, match="lag > 0"):
-        theory.udsbm_ergodicity_breaking(0.0, starts=[0.0], D0=D0, gamma0=G0)
+        theory.udsbm_ergodicity_breaking(0.0, start=[0.0], D0=D0, gamma0=G0)

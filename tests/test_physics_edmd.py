@@ -113,7 +113,9 @@ def test_two_dimensional_enskog_collision_rate():
     s = Scene.random(n, r, dim=2, temperature=1.0, seed=25)
     sim = Simulation(s)
     sim.run(stop_when={"collisions_per_particle": 20}, store=())  # equilibrate positions
-    omega = float(theory.collision_frequency(s.density, r, s.temperature, dim=2))
+    omega = float(
+        theory.collision_frequency(density=s.density, radius=r, temperature=s.temperature, dim=2)
+    )
     t0 = sim.time
     span = 200.0 / omega  # 200 collisions per particle, 2e5 pair collisions
     tr = sim.run(t_stop=t0 + span, sample_times=[t0, t0 + span], store=())
@@ -190,7 +192,9 @@ def test_granular_gas_cools_by_haffs_law(xi):
     ratios = []
     for k in range(RUNS):
         s = thesis_gas(k).replace(restitution=xi)
-        c = theory.langevin_coefficients(s.n, THESIS_R, 1.0, xi, s.temperature)
+        c = theory.langevin_coefficients(
+            n=s.n, radius=THESIS_R, volume=1.0, restitution=xi, temperature0=s.temperature
+        )
         times = np.linspace(0, 10 * c.tau0, 41)
         tr = Simulation(s).run(t_stop=times[-1], sample_times=times, store=())
         tau0, _ = analysis.fit_haff_tau0(tr.times, tr.temperature)
@@ -207,13 +211,19 @@ def msd_margin(times, c, xi):
     from granular import theory
 
     h = 1e-6
-    base = np.log(theory.msd_granular(times, c.D0, c.gamma0, c.tau0))
+    base = np.log(theory.msd_granular(times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0))
     s_d = (
-        np.log(theory.msd_granular(times, c.D0 * (1 + h), c.gamma0 / (1 + h), c.tau0)) - base
+        np.log(
+            theory.msd_granular(times, D0=c.D0 * (1 + h), gamma0=c.gamma0 / (1 + h), tau0=c.tau0)
+        )
+        - base
     ) / h
     margin = np.abs(s_d) * diffusion_margin(xi)
     if xi < 1:  # D0 and tau0 are separate approximations: their errors add, as a bound
-        s_tau = (np.log(theory.msd_granular(times, c.D0, c.gamma0, c.tau0 * (1 + h))) - base) / h
+        s_tau = (
+            np.log(theory.msd_granular(times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0 * (1 + h)))
+            - base
+        ) / h
         margin = margin + np.abs(s_tau) * haff_margin(xi)
     return margin
 
@@ -236,11 +246,17 @@ def test_msd_follows_theory(xi, t_stop):
     for k in range(RUNS):
         s = thesis_gas(k).replace(restitution=xi)
         tr = Simulation(s).run(t_stop=t_stop, sample_times=times, store=("positions",))
-        c = theory.langevin_coefficients(s.n, THESIS_R, 1.0, xi, s.temperature)
-        ratios.append(tr.msd()[1:] / theory.msd_granular(times[1:], c.D0, c.gamma0, c.tau0))
+        c = theory.langevin_coefficients(
+            n=s.n, radius=THESIS_R, volume=1.0, restitution=xi, temperature0=s.temperature
+        )
+        ratios.append(
+            tr.msd()[1:] / theory.msd_granular(times[1:], D0=c.D0, gamma0=c.gamma0, tau0=c.tau0)
+        )
         temperatures.append(s.temperature)
     # the sensitivities at the runs' mean T0 (they barely depend on it)
-    c = theory.langevin_coefficients(THESIS_N, THESIS_R, 1.0, xi, np.mean(temperatures))
+    c = theory.langevin_coefficients(
+        n=THESIS_N, radius=THESIS_R, volume=1.0, restitution=xi, temperature0=np.mean(temperatures)
+    )
     assert_within_theory(ratios, msd_margin(times[1:], c, xi))
 
 
@@ -298,5 +314,5 @@ def test_walled_box_pressure_follows_the_equation_of_state():
     margin = r + 8 * r
     inside = np.all((tr.positions > margin) & (tr.positions < 1 - margin), axis=2).sum(axis=1)
     n_bulk = inside.mean() / (1 - 2 * margin) ** 2
-    z = theory.compressibility_factor(n_bulk * math.pi * r**2, 2)
+    z = theory.compressibility_factor(n_bulk * math.pi * r**2, dim=2)
     assert tr.pressure() / (n_bulk * s.temperature) == pytest.approx(z, rel=0.0005 + 4 * 0.001)

@@ -459,12 +459,22 @@ def test_constant_restitution_formulas_name_what_to_use_for_a_law():
     viscoelastic scene might, scene.restitution), they say what to use instead."""
     law = Viscoelastic.from_restitution(0.9, 1.0)
     calls = [
-        lambda: granular.theory.haff_tau0(1000, 0.025, law, 1.0),
-        lambda: granular.theory.diffusion_d0(1000, 0.025, law, 1.0),
-        lambda: granular.theory.langevin_coefficients(1000, 0.025, 1.0, law, 1.0),
-        lambda: granular.theory.cooling_rate(1000, 0.025, law, 1.0),
-        lambda: granular.theory.shear_viscosity(1000, 0.025, law, 1.0),
-        lambda: granular.theory.critical_box_size(1000, 0.025, law),
+        lambda: granular.theory.haff_tau0(
+            density=1000, radius=0.025, restitution=law, temperature0=1.0
+        ),
+        lambda: granular.theory.diffusion_d0(
+            density=1000, radius=0.025, restitution=law, temperature0=1.0
+        ),
+        lambda: granular.theory.langevin_coefficients(
+            n=1000, radius=0.025, volume=1.0, restitution=law, temperature0=1.0
+        ),
+        lambda: granular.theory.cooling_rate(
+            density=1000, radius=0.025, restitution=law, temperature=1.0
+        ),
+        lambda: granular.theory.shear_viscosity(
+            density=1000, radius=0.025, restitution=law, temperature=1.0
+        ),
+        lambda: granular.theory.critical_box_size(density=1000, radius=0.025, restitution=law),
     ]
     for call in calls:
         with pytest.raises(TypeError, match="viscoelastic_"):

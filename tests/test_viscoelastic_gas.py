@@ -143,7 +143,9 @@ def test_viscoelastic_gas_is_in_range_and_below_the_critical_box(cooling_runs):
     assert r["clamped"] == 0
     eq = r["eq"]
     xi_eff = clustering.effective_restitution(r["law"], eq.temperature)
-    lc = theory.critical_box_size(DENSITY, R, xi_eff, eta=eq.packing_fraction)
+    lc = theory.critical_box_size(
+        density=DENSITY, radius=R, restitution=xi_eff, eta=eq.packing_fraction
+    )
     assert eq.upper[0] - eq.lower[0] < 0.5 * lc
     assert clustering.unstable_box(eq.replace(restitution=r["law"])) is None
 
@@ -240,7 +242,7 @@ def test_msd_second_order_limits():
     """a_kappa = 0: the elastic gas' 2 d D_E t exactly (no cooling, eps = 1); small a_kappa:
     within O(delta) of the leading order msd_viscoelastic."""
     t = np.geomspace(0.01, 100.0, 9)
-    d_e = theory.diffusion_d0(DENSITY, R, 1.0, 0.5)
+    d_e = theory.diffusion_d0(density=DENSITY, radius=R, restitution=1.0, temperature0=0.5)
     elastic = theory.msd_viscoelastic_second_order(
         t, temperature0=0.5, a_kappa=0.0, density=DENSITY, radius=R
     )

@@ -48,13 +48,15 @@ times = np.concatenate([[0], np.logspace(-2, np.log10(20 if not QUICK else 5), 3
 traj = granular.Simulation(gas).run(t_stop=times[-1], sample_times=times)
 traj""",
     "md:Haff's law: the temperature against T0 / (1 + t/tau0)^2 with tau0 from (2.45).",
-    """c = theory.langevin_coefficients(n, r, 1.0, 0.8, gas.temperature)
+    """c = theory.langevin_coefficients(
+    n=n, radius=r, volume=1.0, restitution=0.8, temperature0=gas.temperature
+)
 plot.haff(traj.times, traj.temperature, tau0=c.tau0)""",
     (
         "md:The mean squared displacement against (2.79): ballistic, then logarithmic (ultraslow "
         "diffusion)."
     ),
-    """th = theory.msd_granular(traj.times, c.D0, c.gamma0, c.tau0)
+    """th = theory.msd_granular(traj.times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0)
 plot.msd(traj.times, traj.msd(), theory_values=th)""",
 ]
 
@@ -165,7 +167,7 @@ u = langevin.run(
     tamsd_lags=lags,
     seed=4,
 )
-plot.msd_vs_tamsd(u.times, u.msd(), u.tamsd_lags, u.tamsd(), label="UDSBM")""",
+plot.msd_vs_tamsd(u.times, u.msd(), lags=u.tamsd_lags, tamsd_values=u.tamsd(), label="UDSBM")""",
     "md:Ensembles of EDMD runs on all local cores (the default backend), a sweep over xi:",
     """import functools
 runs = 4 if not QUICK else 2
@@ -320,7 +322,10 @@ print(f"EDMD {slope:.3f}, UDSBM {slope_u:.3f}, theory {slope_th:.3f}", "(1/6 onl
         "measured and from theory (`theory_ergodicity_breaking`: exact, from the position "
         "covariance, for Gaussian initial velocities)."
     ),
-    """c8 = theory.langevin_coefficients(1000, 0.025, 1.0, 0.8, 2 / 3)  # the thesis' gas, xi = 0.8
+    """# the thesis' gas, xi = 0.8
+c8 = theory.langevin_coefficients(
+    n=1000, radius=0.025, volume=1.0, restitution=0.8, temperature0=2 / 3
+)
 t_sde = 100.0 if not QUICK else 10.0  # 2000 steps of dt = 0.05
 lags = np.logspace(-1, np.log10(t_sde / 4), 8 if not QUICK else 3)
 lags = np.unique(np.rint(lags / 0.05)) * 0.05  # whole steps of dt, as run() needs
@@ -338,7 +343,9 @@ for a in (1.0, 5 / 6):
         seed=4,
     )
     name = f"a = {a:.3g}"
-    plot.msd_vs_tamsd(res.times, res.msd(), res.tamsd_lags, res.tamsd(), ax=axes[0], label=name)
+    plot.msd_vs_tamsd(
+        res.times, res.msd(), lags=res.tamsd_lags, tamsd_values=res.tamsd(), ax=axes[0], label=name
+    )
     eb = res.ergodicity_breaking()
     (line,) = axes[1].loglog(res.tamsd_lags, eb, "o", label=f"measured, {name}")
     eb_theory = res.theory_ergodicity_breaking()
@@ -386,7 +393,13 @@ with warnings.catch_warnings():
 reached = vsim.stats["collisions_per_particle"]
 print(f"viscoelastic, mean eps {mean_eps(lo):.3f}: no collapse,", f"{reached:.0f} collisions each")
 fig, ax = plt.subplots(figsize=(4, 4))
-plot.snapshot(vsim.scene.positions, vsim.scene.radii, vsim.scene.lower, vsim.scene.upper, ax=ax)
+plot.snapshot(
+    vsim.scene.positions,
+    radii=vsim.scene.radii,
+    lower=vsim.scene.lower,
+    upper=vsim.scene.upper,
+    ax=ax,
+)
 ax.set_title("viscoelastic disks, the end of the run");""",
     (
         "md:The viscoelastic disks still cluster (here against the walls, where the gas is "
@@ -399,7 +412,7 @@ ax.set_title("viscoelastic disks, the end of the run");""",
         "those are averaged to beat their noise."
     ),
     """xi, density = 0.3, 1000.0
-lc = theory.critical_box_size(density, 0.025, xi)
+lc = theory.critical_box_size(density=density, radius=0.025, restitution=xi)
 big_n, small_n, small_runs = (8000, 400, 8) if not QUICK else (3000, 250, 3)
 
 
@@ -409,14 +422,16 @@ def cool(n_particles, seed):
     sim = granular.Simulation(start)
     sim.run(stop_when={"collisions_per_particle": 10}, store=())
     gas = sim.scene.replace(restitution=xi)
-    tau0 = theory.haff_tau0(density, 0.025, xi, gas.temperature)
+    tau0 = theory.haff_tau0(
+        density=density, radius=0.025, restitution=xi, temperature0=gas.temperature
+    )
     when = np.concatenate([[0], np.logspace(-1, 2.5, 30)]) * tau0
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", granular.ClusteringWarning)
         tr = granular.Simulation(gas).run(
             t_stop=when[-1], sample_times=when, store=("positions", "velocities")
         )
-    haff = theory.haff_temperature(when, gas.temperature, tau0)
+    haff = theory.haff_temperature(when, temperature0=gas.temperature, tau0=tau0)
     return box, tau0, tr, tr.temperature / haff, [str(w.message) for w in caught]
 
 
@@ -462,7 +477,9 @@ axes[2].legend();""",
 v = big.velocities[-1] - big.velocities[-1].mean(axis=0)
 slab = x[:, 2] < big.lower[2] + box / 6
 fig, ax = plt.subplots(figsize=(6, 6))
-plot.snapshot(x[slab, :2], 0.025, big.lower[:2], big.upper[:2], ax=ax, color="0.6")
+plot.snapshot(
+    x[slab, :2], radii=0.025, lower=big.lower[:2], upper=big.upper[:2], ax=ax, color="0.6"
+)
 bins = 10
 ij = np.minimum(((x[slab, :2] - big.lower[:2]) / box * bins).astype(int), bins - 1)
 flat = ij[:, 0] * bins + ij[:, 1]

@@ -73,10 +73,12 @@ def main(out="granular-demo", quick=False, runs=None, backend="processes"):
         )
         if res.failures:
             raise RuntimeError(f"{len(res.failures)} runs failed: {res.failures[0]}")
-        c = theory.langevin_coefficients(n, radius, 1.0, xi, start.temperature)
-        msd_th = theory.msd_granular(times, c.D0, c.gamma0, c.tau0)
+        c = theory.langevin_coefficients(
+            n=n, radius=radius, volume=1.0, restitution=xi, temperature0=start.temperature
+        )
+        msd_th = theory.msd_granular(times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0)
         T_th = (
-            theory.haff_temperature(times, start.temperature, c.tau0)
+            theory.haff_temperature(times, temperature0=start.temperature, tau0=c.tau0)
             if xi < 1
             else np.full_like(times, start.temperature)
         )
@@ -145,11 +147,17 @@ def tracer_theory(scene):
     area = float(np.prod(reach)) - math.pi * (big_r + r) ** 2
     perimeter = 2.0 * float(np.sum(reach))
     # n_gas = n area + wall_adsorption(n) perimeter: a quadratic in n
-    a = theory.wall_adsorption(1.0, r, dim=2) * perimeter
+    a = theory.wall_adsorption(density=1.0, radius=r, dim=2) * perimeter
     density = (-area + math.sqrt(area * area + 4 * a * n_gas)) / (2 * a)
     T = 0.5  # the scene's temperature, m <v^2> / 2 per particle in 2D
     c = theory.tracer_langevin_coefficients(
-        density, r, big_r, float(scene.masses[0]), T, float(scene.masses[1]), dim=2
+        density=density,
+        radius=r,
+        tracer_radius=big_r,
+        tracer_mass=float(scene.masses[0]),
+        temperature=T,
+        mass=float(scene.masses[1]),
+        dim=2,
     )
     return c, density
 
@@ -213,7 +221,7 @@ def brownian(out, quick=False, runs=None, backend="processes"):
     if res.failures:
         raise RuntimeError(f"{len(res.failures)} runs failed: {res.failures[0]}")
     v0_sq = float(res.mean["v0_sq"])
-    msd_th = theory.msd_langevin(times, c.D0, c.gamma0, dim=2, v0_sq=v0_sq)
+    msd_th = theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0, dim=2, v0_sq=v0_sq)
     k_free = int(np.searchsorted(times, t_free, side="right")) - 1
     ratio = res.mean["msd"][1:] / msd_th[1:]
     ratio_err = res.error["msd"][1:] / msd_th[1:]

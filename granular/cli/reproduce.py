@@ -244,7 +244,7 @@ def _fig_4_5_to_4_7(cfg, out):
         ax.set_title(f"Fig. {fig_no.replace('_', '.')}: speeds, {dim}D, N = {n}")
         names.append(_save(fig, out, f"fig{fig_no}_speeds_{dim}d.png"))
         per_run = [analysis.speed_statistics(vr, temperature=T) for vr in v]
-        mb = theory.maxwell_boltzmann_moments(T, dim=dim)
+        mb = theory.maxwell_boltzmann_moments(temperature=T, dim=dim)
         for key, label in (("mean", "<v>"), ("mean_sq", "<v^2>"), ("std", "std(v)")):
             rows.append(
                 _mean_row(
@@ -286,8 +286,15 @@ def _fig_4_8_and_4_10(cfg, out):
         )
         ax.plot(t[1:], r.mean["temperature"][1:], label=label)
         T0 = eq.temperature
-    c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, 0.8, T0)
-    ax.plot(t[1:], theory.haff_temperature(t[1:], T0, c.tau0), "k--", label="Haff, [G20] eq. 2.40")
+    c = theory.langevin_coefficients(
+        n=cfg.n3, radius=cfg.r3, volume=1.0, restitution=0.8, temperature0=T0
+    )
+    ax.plot(
+        t[1:],
+        theory.haff_temperature(t[1:], temperature0=T0, tau0=c.tau0),
+        "k--",
+        label="Haff, [G20] eq. 2.40",
+    )
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel(plot.TIME)
@@ -308,7 +315,9 @@ def _fig_4_8_and_4_10(cfg, out):
             sample_times=t,
             quantities=("temperature",),
         )
-        c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, eq.temperature)
+        c = theory.langevin_coefficients(
+            n=cfg.n3, radius=cfg.r3, volume=1.0, restitution=xi, temperature0=eq.temperature
+        )
         row = _mean_row(
             f"haff.tau0.xi{xi}",
             f"Haff tau0 fitted over t <= {t[-1]:g}, xi = {xi}; theory (2.45)",
@@ -320,7 +329,7 @@ def _fig_4_8_and_4_10(cfg, out):
         plot.haff(
             t,
             r.mean["temperature"],
-            c.tau0,
+            tau0=c.tau0,
             temperature0=eq.temperature,
             ax=ax,
             error=r.error["temperature"],
@@ -346,7 +355,9 @@ def _fig_4_9(cfg, out):
                 # the figure shows the clusters that ClusteringWarning foretells (L / L_c ~ 3.6)
                 warnings.simplefilter("ignore", ClusteringWarning)
                 sim.run(t_stop=t_snap, sample_times=[t_snap], store=())
-            plot.snapshot(sim.scene.positions, s.radii, s.lower, s.upper, ax=axes[k])
+            plot.snapshot(
+                sim.scene.positions, radii=s.radii, lower=s.lower, upper=s.upper, ax=axes[k]
+            )
             axes[k].set_title(f"{name}, t = {t_snap:g}", fontsize="medium")
             k += 1
     fig.suptitle(rf"Fig. 4.9: 2D granular gas, $\xi$ = 0.8, N = {cfg.n2}")
@@ -378,8 +389,10 @@ def _fig_4_11_to_4_16_and_F(cfg, out):
             sample_times=t,
             quantities=("msd",),
         )
-        c = theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, eq.temperature)
-        th = theory.msd_granular(t, c.D0, c.gamma0, c.tau0)
+        c = theory.langevin_coefficients(
+            n=cfg.n3, radius=cfg.r3, volume=1.0, restitution=xi, temperature0=eq.temperature
+        )
+        th = theory.msd_granular(t, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0)
         equation = "[G20] eq. 2.68" if xi == 1 else "[G20] eq. 2.79"
         fig, ax = _fig()
         plot.msd(
@@ -454,7 +467,9 @@ def _fig_4_17_to_4_23(cfg, out):
     names, rows = [], []
     v0_sq = THESIS_T0  # per component: every particle starts at speed sqrt(2), as in the thesis
     coeff = {
-        xi: theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, THESIS_T0)
+        xi: theory.langevin_coefficients(
+            n=cfg.n3, radius=cfg.r3, volume=1.0, restitution=xi, temperature0=THESIS_T0
+        )
         for xi in (1.0, 0.8, 0.5)
     }
     t_samples = np.concatenate([[0.0], np.logspace(-2, math.log10(cfg.t_long), 50)])
@@ -482,9 +497,9 @@ def _fig_4_17_to_4_23(cfg, out):
     def msd_theory(xi, t):
         c = coeff[xi]
         return (
-            theory.msd_langevin(t, c.D0, c.gamma0, v0_sq=v0_sq)
+            theory.msd_langevin(t, D0=c.D0, gamma0=c.gamma0, v0_sq=v0_sq)
             if xi == 1
-            else theory.msd_udsbm(t, c.D0, c.gamma0, c.tau0, v0_sq=v0_sq)
+            else theory.msd_udsbm(t, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0, v0_sq=v0_sq)
         )
 
     for xi, fig_no in ((1.0, "4_17"), (0.8, "4_18"), (0.5, "4_19")):
@@ -586,7 +601,7 @@ def _fig_4_17_to_4_23(cfg, out):
         ("udsbm", 0.8, udsbm[cfg.t_long], "4_22"),
     ):
         fig, ax = _fig()
-        plot.msd_vs_tamsd(r.times, r.mean["msd"], lags, r.mean["tamsd"], ax=ax)
+        plot.msd_vs_tamsd(r.times, r.mean["msd"], lags=lags, tamsd_values=r.mean["tamsd"], ax=ax)
         ax.plot(lags, tamsd_th, "k--", lw=1, label="time-averaged MSD, theory")
         ax.legend()
         ax.set_title(

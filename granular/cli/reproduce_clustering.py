@@ -90,9 +90,15 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
                 sample_times=times,
                 quantities=("temperature", "collisions_per_particle", "positions", "velocities"),
             )
-            c = theory.langevin_coefficients(n, RADIUS, side**3, xi, eq.temperature)
+            c = theory.langevin_coefficients(
+                n=n, radius=RADIUS, volume=side**3, restitution=xi, temperature0=eq.temperature
+            )
             per = [_per_run(r, times, eq, cells, c.tau0) for r in res.runs]
-            lc = float(theory.critical_box_size(DENSITY, RADIUS, xi, eta=eq.packing_fraction))
+            lc = float(
+                theory.critical_box_size(
+                    density=DENSITY, radius=RADIUS, restitution=xi, eta=eq.packing_fraction
+                )
+            )
             result[name, xi] = dict(per=per, tau0=c.tau0, T0=eq.temperature, L=side, lc=lc, n=n)
 
     # rows: the thesis' box at xi = 0.3 (and 0.5), the small box's tau0
@@ -159,7 +165,7 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
             s = times[1:] / tau0
             label = f"N = {n}, $L / L_c$ = {r['L'] / r['lc']:.2f}"
             temps = np.array([p["temperature"] for p in per])
-            haff = theory.haff_temperature(times, r["T0"], tau0)
+            haff = theory.haff_temperature(times, temperature0=r["T0"], tau0=tau0)
             dev, dev_err = analysis.ensemble_mean(temps / haff - 1)
             ax = axes[k]
             ax.plot(s, dev[1:], color=colour, label=f"{label}: $T / T_{{Haff}} - 1$")
@@ -178,7 +184,9 @@ def _fig_clustering(cfg, out, *, ensemble, save, fig, row, mean_row):
             s_k = np.mean([p["s_k"] for p in per], axis=0)
             ax2.plot(s, s_k[1:], ":", color=colour)
             if r["L"] < r["lc"]:
-                ax2.axhline(theory.shear_mode_level(r["L"], r["lc"]), color=colour, ls="--", lw=1)
+                ax2.axhline(
+                    theory.shear_mode_level(r["L"], critical=r["lc"]), color=colour, ls="--", lw=1
+                )
         ax = axes[k]
         ax.axhline(ONSET, color="0.5", lw=0.8, label=f"onset threshold, {ONSET:g}")
         ax.set_xscale("log")

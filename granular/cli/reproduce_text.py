@@ -21,7 +21,9 @@ THESIS_SLOPES = {1.0: (0.364, 0.350), 0.8: (0.420, 0.451)}
 
 def _thesis_coefficients(xi):
     """gamma0, D0, tau0 of the thesis' system (N = 1000, r = 0.025, T0 = 2/3), (2.45-2.55)."""
-    return theory.langevin_coefficients(1000, 0.025, 1.0, xi, THESIS_T0)
+    return theory.langevin_coefficients(
+        n=1000, radius=0.025, volume=1.0, restitution=xi, temperature0=THESIS_T0
+    )
 
 
 def _num(x):
@@ -153,7 +155,12 @@ def _slope_notes(cfg, by_id):
 
 def _sde_notes(cfg, by_id):
     c8 = _thesis_coefficients(0.8)
-    cq = {xi: theory.langevin_coefficients(cfg.n3, cfg.r3, 1.0, xi, THESIS_T0) for xi in (1.0, 0.8)}
+    cq = {
+        xi: theory.langevin_coefficients(
+            n=cfg.n3, radius=cfg.r3, volume=1.0, restitution=xi, temperature0=THESIS_T0
+        )
+        for xi in (1.0, 0.8)
+    }
     g_max = max(c.gamma0 for c in cq.values()) * 0.01
     g_dt1, g_thesis = cq[0.8].gamma0, c8.gamma0
     sde = [

@@ -138,7 +138,7 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
     # the box against the critical size at the gas' most inelastic moment, its start
     eps_eff = 1 - theory.VISCOELASTIC_C1 * math.gamma(2.1) * DELTA0
     l_over_lc = float(eq.upper[0] - eq.lower[0]) / float(
-        theory.critical_box_size(DENSITY, RADIUS, eps_eff, eta=eta)
+        theory.critical_box_size(density=DENSITY, radius=RADIUS, restitution=eps_eff, eta=eta)
     )
     t_slopes = [_slope(times, r["temperature"], window) for r in res.runs]
     s1, s2 = _slope(times, T1, window), _slope(times, T2, window)

@@ -122,8 +122,10 @@ def speed_accuracy_points(quick=False):
     ref_runs = 32 if not quick else 4
     points, refs = [], {}
     for xi in (1.0, 0.8):
-        c = theory.langevin_coefficients(1000, R, 1.0, xi, T0)
-        th = theory.msd_granular(times, c.D0, c.gamma0, c.tau0)
+        c = theory.langevin_coefficients(
+            n=1000, radius=R, volume=1.0, restitution=xi, temperature0=T0
+        )
+        th = theory.msd_granular(times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0)
         ref, ref_cost = _edmd_msd(1000, xi, ref_runs, times, seed=99)
         log = xi < 1
         sel = times >= t_fit
@@ -258,14 +260,14 @@ def viscoelastic_points(quick=False):
 def em_stability(quick=False):
     """MSD error of Euler-Maruyama and of the exact scheme against the Langevin theory as
     gamma0*dt grows, for the molecular gas' coefficients; EM refused at >= 2."""
-    c = theory.langevin_coefficients(1000, R, 1.0, 1.0, T0)
+    c = theory.langevin_coefficients(n=1000, radius=R, volume=1.0, restitution=1.0, temperature0=T0)
     n = 20000 if not quick else 2000
     t_max = 20.0 if not quick else 5.0
     rows = []
     for gdt in (0.01, 0.05, 0.1, 0.3, 0.5, 1.0, 1.5, 1.9, 2.0, 3.0, 10.0):
         dt = gdt / c.gamma0
         times = np.unique(np.round(np.logspace(math.log10(dt), math.log10(t_max), 20) / dt)) * dt
-        th = theory.msd_langevin(times, c.D0, c.gamma0)
+        th = theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0)
         row = dict(gamma_dt=gdt, dt=dt)
         for scheme in ("em", "exact"):
             try:

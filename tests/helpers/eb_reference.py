@@ -5,7 +5,7 @@ on the grid of window ends.  The reference the fast path is tested against."""
 
 import numpy as np
 
-from granular import theory
+from granular.theory import _numerics
 
 
 def position_covariance(t1, t2, sol, D0, gamma0, tau0, exponent):
@@ -13,7 +13,7 @@ def position_covariance(t1, t2, sol, D0, gamma0, tau0, exponent):
     m = np.minimum(t1, t2)
     times, where = np.unique(m, return_inverse=True)
     y = sol(gamma0 * times)[:, where.reshape(-1)].reshape((3, *np.shape(m)))
-    k = theory._powerlaw_propagator_integral(m, np.abs(t2 - t1), gamma0, tau0, exponent)
+    k = _numerics._powerlaw_propagator_integral(m, np.abs(t2 - t1), gamma0, tau0, exponent)
     return y[0] * D0 / gamma0 + y[1] * D0 * k
 
 
@@ -21,7 +21,9 @@ def ergodicity_breaking(lag, starts, D0, gamma0, tau0, exponent, dim, v0_sq=None
     """EB = 2 sum_jk C_jk^2 / (d (sum_j C_jj)^2), C_jk from four covariances per pair."""
     s = np.asarray(starts, dtype=np.float64).reshape(-1)
     v0 = D0 * gamma0 if v0_sq is None else float(v0_sq)
-    sol = theory._powerlaw_ode(gamma0, tau0, exponent, v0 / (D0 * gamma0), gamma0 * (s.max() + lag))
+    sol = _numerics._powerlaw_ode(
+        gamma0, tau0, exponent, v0 / (D0 * gamma0), gamma0 * (s.max() + lag)
+    )
     a, b = s[:, None], s[None, :]
 
     def cov(t1, t2):

@@ -1,0 +1,266 @@
+"""The parameters of ``granular.theory`` and ``granular.plot``: one name per quantity, with its
+meaning, unit and the values it may take, and the one decorator that enforces the calling
+convention.
+
+The convention: a function's independent variable (the time ``t``, the ``lag``, a ``speed``,
+a packing fraction ``eta``, a ``box`` size; in ``plot`` the data drawn, x then y as in
+matplotlib's ``ax.plot(x, y)``) is positional, everything after it keyword-only.  The
+coefficients are floats of similar size, so a positional call that swaps two of them would
+give a plausible wrong number without an error.
+
+Units (docs/conventions.md): ``L`` the length unit of the scene, ``m`` the particle mass
+unit, ``eps`` the energy unit (k_B = 1: a temperature is an energy), time in
+``L sqrt(m / eps)``, ``d`` the dimension.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._deprecation import deprecated
+
+TIME = "L sqrt(m/eps)"
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """What a parameter name means, its unit, and which values it accepts (``check``:
+    ``positive`` > 0 and finite, ``positive_or_inf`` > 0, ``nonnegative`` >= 0 and finite,
+    ``restitution`` in [0, 1], ``packing`` in [0, 1), ``dim`` 2 or 3, None unchecked)."""
+
+    meaning: str
+    unit: str
+    check: str | None = None
+
+
+# every parameter name of theory and plot; the table in docs/conventions.md is this one
+QUANTITIES: dict[str, Quantity] = {
+    # independent variables of theory
+    "t": Quantity("time at which a formula is evaluated", TIME, "nonnegative"),
+    "lag": Quantity("lag of a time average (a window's length)", TIME, "nonnegative"),
+    "start": Quantity("start time of a time-average window (or windows)", TIME, "nonnegative"),
+    "speed": Quantity("particle speed", "sqrt(eps/m)", "nonnegative"),
+    "eta": Quantity("packing fraction (area fraction in 2D)", "dimensionless", "packing"),
+    "box": Quantity("side length of a periodic box", "L", "positive"),
+    # the gas
+    "n": Quantity("number of particles N", "dimensionless count", "positive"),
+    "density": Quantity("number density N / V (N / A in 2D)", "L^-d", "positive"),
+    "radius": Quantity("particle radius", "L", "positive"),
+    "volume": Quantity("volume (area in 2D) of the box", "L^d", "positive"),
+    "mass": Quantity("particle mass", "m", "positive"),
+    "dim": Quantity("dimension, 2 or 3", "dimensionless", "dim"),
+    "restitution": Quantity(
+        "constant coefficient of restitution xi", "dimensionless", "restitution"
+    ),
+    "temperature": Quantity("granular temperature T (k_B = 1)", "eps", "positive"),
+    "temperature0": Quantity("temperature T0 at t = 0", "eps", "positive"),
+    "critical": Quantity("critical box size L_c of the shear instability", "L", "positive_or_inf"),
+    "a_kappa": Quantity(
+        "viscoelastic material number A kappa^(2/5), or a restitution.Viscoelastic law",
+        "(time/L)^(1/5)",
+    ),
+    "tracer_radius": Quantity("radius R of a heavy tracer", "L", "positive"),
+    "tracer_mass": Quantity("mass M of a heavy tracer", "m", "positive"),
+    "chi": Quantity("gas density at the tracer's surface over n", "dimensionless", "positive"),
+    # the models' coefficients
+    "D0": Quantity("diffusivity per dimension at t = 0", "L^2 / time", "positive"),
+    "gamma0": Quantity("friction rate at t = 0", "1 / time", "positive"),
+    "tau0": Quantity("cooling time scale (Haff's tau0; inf: no cooling)", TIME, "positive_or_inf"),
+    "exponent": Quantity(
+        "exponent a of the power-law coefficients (1 + t/tau0)^-a", "dimensionless", "positive"
+    ),
+    "v0_sq": Quantity("initial mean squared velocity per component", "eps/m", "nonnegative"),
+    "order": Quantity("order of the restitution series, 1 or 2", "dimensionless"),
+    "points": Quantity("quadrature nodes", "dimensionless count"),
+    # data drawn by plot
+    "times": Quantity("sample times of the data drawn", TIME),
+    "lags": Quantity("lags of the time-averaged MSD drawn", TIME),
+    "kinetic_energy": Quantity("total kinetic energy at each sample", "eps"),
+    "collisions": Quantity("mean collisions per particle at each sample", "dimensionless count"),
+    "velocities": Quantity("particle velocities, (..., N, d)", "sqrt(eps/m)"),
+    "positions": Quantity("particle positions, (N, 2)", "L"),
+    "radii": Quantity("particle radii, one or (N,)", "L"),
+    "lower": Quantity("lower corner of the box", "L"),
+    "upper": Quantity("upper corner of the box", "L"),
+    "values": Quantity("the measured quantity at each sample (MSD or diffusivity)", "its unit"),
+    "msd_values": Quantity("ensemble MSD at each sample time", "L^2"),
+    "tamsd_values": Quantity("time-averaged MSD at each lag", "L^2"),
+    "theory_values": Quantity("the theory's curve at each sample", "the unit of values"),
+    "error": Quantity("standard error of the data at each sample", "the data's unit"),
+    "result": Quantity("a granular.clustering result to draw", "-"),
+    "transverse": Quantity("a clustering.current_correlations result (optional)", "-"),
+    "threshold": Quantity("onset threshold above the noise level", "dimensionless"),
+    # how plot draws
+    "ax": Quantity("matplotlib axes to draw on (default: new ones)", "-"),
+    "label": Quantity("legend label of the data", "-"),
+    "theory_label": Quantity("legend label of the theory curve", "-"),
+    "theory_style": Quantity("matplotlib format string of the theory curve", "-"),
+    "relative": Quantity("draw E(t)/E(0) - 1 instead of E", "-"),
+    "loglog": Quantity("logarithmic axes", "-"),
+    "bins": Quantity("histogram bins", "dimensionless count"),
+    "shells": Quantity("number of wave-number shells drawn, smallest first", "dimensionless count"),
+    "color": Quantity("matplotlib colour", "-"),
+}
+
+
+def _number(value) -> str:
+    """A number as a user writes it (no NumPy repr)."""
+    if isinstance(value, (bool, np.bool_)):
+        return str(bool(value))
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    return "..." if np.ndim(value) else repr(value)
+
+
+_RULES = {
+    "positive": (lambda x: (x > 0) & np.isfinite(x), "must be positive and finite"),
+    "positive_or_inf": (lambda x: x > 0, "must be positive (inf allowed)"),
+    "nonnegative": (lambda x: (x >= 0) & np.isfinite(x), "must be >= 0 and finite"),
+    "restitution": (lambda x: (x >= 0) & (x <= 1), "must lie in [0, 1]"),
+    "packing": (lambda x: (x >= 0) & (x < 1), "must lie in [0, 1)"),
+}
+
+
+def check(name: str, value) -> None:
+    """Raise ValueError (TypeError for a non-number) naming the parameter, its value and what
+    is allowed, if ``value`` breaks the rule of ``QUANTITIES[name]``; None passes (a default).
+    Objects where a restitution or material number is expected are left to the function,
+    which says what to use instead."""
+    rule = QUANTITIES[name].check if name in QUANTITIES else None
+    if rule is None or value is None:
+        return
+    if rule == "dim":
+        if value not in (2, 3) or isinstance(value, bool):
+            raise ValueError(f"dim must be 2 or 3, got {_number(value)}")
+        return
+    try:
+        x = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        if name == "restitution":
+            return  # a law: the function refuses it with its own advice
+        raise TypeError(
+            f"{name} must be a number or an array of numbers, got a {type(value).__name__} "
+            f"({name}: {QUANTITIES[name].meaning})"
+        ) from None
+    ok, says = _RULES[rule]
+    good = ok(x)
+    if not np.all(good):
+        bad = x[~good].flat[0] if x.ndim else x[()]
+        where = "" if x.ndim == 0 else " in the array"
+        raise ValueError(
+            f"{name} {says}, got {_number(bad)}{where} ({name}: {QUANTITIES[name].meaning})"
+        )
+
+
+def keyword_only(*old_order: str, renamed: dict[str, str] | None = None, validate: bool = True):
+    """Decorate a function of the convention (positional independent variable, the rest
+    keyword-only), keeping its old calling convention for one release.
+
+    ``old_order`` names the parameters in the order the old signature took them by position
+    (old names); ``renamed`` maps old keyword names to new ones.  A call that passes more
+    positional arguments than the new signature takes, or an old keyword name, still works
+    and gives the same number, with a FutureWarning (shown to users, unlike a
+    DeprecationWarning) that spells out the new call and when the old one goes.  With
+    ``validate`` every argument is checked by name (``check``) before the call.
+    """
+    renamed = dict(renamed or {})
+
+    def decorate(func):
+        sig = inspect.signature(func)
+        positional = [
+            p.name
+            for p in sig.parameters.values()
+            if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)
+        ]
+        new_old = [renamed.get(name, name) for name in old_order]
+        assert new_old[: len(positional)] == positional, (func.__name__, old_order)
+        assert set(new_old) <= set(sig.parameters), (func.__name__, old_order)
+
+        @functools.wraps(func)
+        def wrapper(*args, **kwargs):
+            old_keywords = renamed.keys() & kwargs.keys()
+            if len(args) > len(positional) or old_keywords:
+                if len(args) > len(old_order):
+                    raise TypeError(
+                        f"{func.__name__}() takes {len(positional)} positional argument(s) "
+                        f"but {len(args)} were given"
+                    )
+                moved = dict(zip(new_old[len(positional) :], args[len(positional) :], strict=False))
+                for old in old_keywords:
+                    new = renamed[old]
+                    if new in kwargs:
+                        raise TypeError(f"{func.__name__}() got both {old}= and {new}=")
+                    kwargs[new] = kwargs.pop(old)
+                for name in moved.keys() & kwargs.keys():
+                    raise TypeError(f"{func.__name__}() got multiple values for {name}")
+                args = args[: len(positional)]
+                kwargs = {**moved, **kwargs}
+                _warn(wrapper, args, kwargs, moved, old_keywords, renamed)
+            if validate:
+                bound = sig.bind(*args, **kwargs)
+                for name, value in bound.arguments.items():
+                    check(name, value)
+            return func(*args, **kwargs)
+
+        wrapper.__doc__ = _with_parameters(func.__doc__, func)
+        # the old convention, for tests and the tools that rewrite callers
+        wrapper.old_positional = tuple(old_order)  # type: ignore[attr-defined]
+        wrapper.renamed = dict(renamed)  # type: ignore[attr-defined]
+        return wrapper
+
+    return decorate
+
+
+def _warn(wrapper, args, kwargs, moved, old_keywords, renamed):
+    name = f"{wrapper.__module__}.{wrapper.__name__}"
+    shown = [_number(a) if np.ndim(a) == 0 else "..." for a in args]
+    shown += [f"{k}={_number(v) if np.ndim(v) == 0 else '...'}" for k, v in kwargs.items()]
+    what = []
+    if moved:
+        what.append("passing " + ", ".join(moved) + " by position")
+    if old_keywords:
+        what.append(
+            "the keyword(s) " + ", ".join(f"{k}= (now {renamed[k]}=)" for k in old_keywords)
+        )
+    deprecated(f"{name}: {' and '.join(what)}", f"call {name}({', '.join(shown)})", stacklevel=4)
+
+
+def parameters_section(func) -> str:
+    """A numpydoc Parameters section for ``func`` from ``QUANTITIES`` (meaning and unit)."""
+    lines = ["Parameters", "----------"]
+    for p in inspect.signature(func).parameters.values():
+        q = QUANTITIES[p.name]
+        kind = p.annotation if isinstance(p.annotation, str) else ""
+        if p.default is not inspect.Parameter.empty:
+            kind = f"{kind}, optional" if kind else "optional"
+        unit = "" if q.unit == "-" else f" [{q.unit}]"
+        default = "" if p.default is inspect.Parameter.empty else f"  Default {p.default!r}."
+        lines += [
+            f"{p.name} : {kind}".rstrip(" :"),
+            f"    {q.meaning[0].upper()}{q.meaning[1:]}{unit}.{default}",
+        ]
+    return "\n".join(lines)
+
+
+def _with_parameters(doc: str | None, func) -> str:
+    """``doc`` with a generated Parameters section before its first other section, if it has
+    none (hand-written sections say more about a parameter, so they are kept)."""
+    doc = inspect.cleandoc(doc or "")
+    lines = doc.splitlines()
+    if any(
+        a.strip() == "Parameters" and b.strip().startswith("---")
+        for a, b in itertools.pairwise(lines)
+    ):
+        return doc
+    section = parameters_section(func).splitlines()
+    for i, (a, b) in enumerate(itertools.pairwise(lines)):
+        if a.strip() and set(b.strip()) == {"-"} and len(b.strip()) >= 3:
+            return "\n".join(lines[:i] + section + [""] + lines[i:])
+    return "\n".join([*lines, "", *section])
