@@ -339,6 +339,7 @@ def animate(
     elif norm is not None:
         raise ValueError("norm sets the colours of speeds: pass color_by_speed=True with it")
 
+    plot._matplotlib("matplotlib")  # a bare install: say which extra brings it
     from matplotlib import colors as mcolors
     from matplotlib.collections import EllipseCollection
     from matplotlib.patches import Rectangle

@@ -8,6 +8,7 @@ import pytest
 matplotlib = pytest.importorskip("matplotlib")
 import matplotlib.pyplot as plt  # noqa: E402
 
+import granular  # noqa: E402
 from granular import plot, theory  # noqa: E402
 
 # a call in the old positional form fails here: nothing in the repository may use it
@@ -107,11 +108,17 @@ def test_demo_panels_read_well():
     plt.close("all")
 
 
+def _small_run():
+    scene = granular.Scene.random(4, 0.05, dim=2, seed=1)
+    return granular.Simulation(scene).run(t_stop=0.1, sample_times=[0.0, 0.1])
+
+
 @pytest.mark.parametrize(
     "draw",
     [
         lambda: plot.msd(np.arange(1.0, 4.0), np.arange(1.0, 4.0)),
         lambda: plot.snapshot(np.zeros((1, 2)), radii=0.1, lower=[0, 0], upper=[1, 1]),
+        lambda: plot.animate(_small_run()),
     ],
 )
 def test_without_matplotlib_the_message_names_the_extra(monkeypatch, draw):
