@@ -61,6 +61,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._deprecation import REMOVAL_VERSION, deprecated
 from ._results import readonly
+from ._scales import SCALE_HI, SCALE_LO, check_range
 from .errors import shown
 
 if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but stay light
@@ -660,6 +661,88 @@ def _positive(name: str, value: float) -> float:
     return value
 
 
+def _check_scales(
+    gamma0: float,
+    D0: float,
+    dt: float,
+    t_stop: float,
+    tau0: float,
+    exponent: float,
+    mass: float,
+    speed_name: str,
+    speed: float,
+) -> None:
+    """Refuse coefficients whose squares and products would leave float64 over the run,
+    with the limits of granular._scales: the times dt, t_stop, tau0 and the rate gamma0
+    (multiplied by one another) each within SCALE_LO .. SCALE_HI; the products D0 (a length
+    squared per time), D0 gamma0 (the thermal speed squared) and the mass within their
+    squares.  The initial speed (``speed``, rms over the components) is bounded from above
+    only, as the scene's speeds are, and so is the largest MSD the run can reach: ballistic,
+    at most speed^2 t_stop^2, or diffusive, at most 2 dim D0 t_stop (the friction and the
+    diffusivity only decay), so speed t_stop and D0 t_stop are bounded by SCALE_HI and
+    SCALE_HI^2.  Each MSD then stays below ~1e281, and its sums over particles and windows
+    finite.  UDSBM's friction and diffusivity at t_stop, gamma0 and D0 times
+    (1 + t_stop/tau0)^-exponent, stay above the lower limits: a friction that underflows to
+    0 would divide 0 by 0 in the exact step."""
+    lo, hi = SCALE_LO, SCALE_HI
+
+    def check(name: str, value: float, low: float, high: float, advice: str = "") -> None:
+        check_range(
+            name,
+            value,
+            low,
+            high,
+            "the Langevin arithmetic (squared displacements and speeds, summed over "
+            "particles and windows)",
+            advice
+            or "choose units in which the times, D0, the speeds and the mass are nearer 1 "
+            "(e.g. 1/gamma0, the thermal speed sqrt(D0 gamma0) and the particles' mass)",
+        )
+
+    for name, value in (("dt", dt), ("t_stop", t_stop), ("gamma0", gamma0)):
+        check(name, value, lo, hi)
+    if math.isfinite(tau0):
+        check("tau0", tau0, lo, hi)
+    check("D0", D0, lo * lo, hi * hi)
+    check("mass", mass, lo * lo, hi * hi)
+    check("D0 * gamma0 (the thermal speed squared)", D0 * gamma0, lo * lo, hi * hi)
+    check(
+        "D0 * t_stop (the diffusive MSD's scale)",
+        D0 * t_stop,
+        0.0,
+        hi * hi,
+        f"D0 at most {hi * hi / t_stop:.3g} for t_stop = {shown(t_stop)}",
+    )
+    check(speed_name, speed, 0.0, hi)
+    check(
+        f"{speed_name} * t_stop (the ballistic displacement)",
+        speed * t_stop,
+        0.0,
+        hi,
+        f"{speed_name} at most {hi / t_stop:.3g} for t_stop = {shown(t_stop)}",
+    )
+    fastest = max(speed, math.sqrt(D0 * gamma0))
+    check(
+        f"mass * speed^2 (the temperature's scale, speed = {fastest:.3g})",
+        mass * fastest * fastest,
+        0.0,
+        hi * hi,
+    )
+    if math.isfinite(tau0):
+        # in logarithms: the decay factor itself may be below the smallest float64
+        decay = -exponent * math.log10(1.0 + t_stop / tau0)
+        for name, value, low in (("gamma0", gamma0, lo), ("D0", D0, lo * lo)):
+            at_end = math.log10(value) + decay
+            if at_end < math.log10(low):
+                raise ValueError(
+                    f"UDSBM's {name} at t_stop, {name} (1 + t_stop/tau0)^-exponent = "
+                    f"10^{at_end:.4g}, is below {low:g}, the range in which the Langevin "
+                    f"arithmetic stays within float64: a shorter t_stop, a longer tau0 or a "
+                    f"smaller exponent (here {name} = {shown(value)}, t_stop = "
+                    f"{shown(t_stop)}, tau0 = {shown(tau0)}, exponent = {shown(exponent)})"
+                )
+
+
 def run(
     n: int,
     *,
@@ -738,7 +821,10 @@ def run(
     Raises
     ------
     ValueError
-        For a parameter out of its range (named in the message).
+        For a parameter out of its range (named in the message), scales among them: the
+        times dt, t_stop, tau0 and the rate gamma0 within 1e-140 .. 1e140, D0, D0 gamma0
+        and the mass within 1e-280 .. 1e280, the initial speed and speed times t_stop at
+        most 1e140 (so that squared displacements and speeds stay within float64).
     UnstableStepError
         Euler-Maruyama with gamma0 dt >= 2.
     MemoryError
@@ -853,6 +939,14 @@ def run(
         v0_sq = s * s / dim
     else:
         raise ValueError(f"initial must be one of {INITIAL}, got {initial!r}")
+    if initial == "fixed" and speed is not None:
+        speed_name, rms = "speed", s
+    else:
+        speed_name, rms = (
+            f"the initial rms speed sqrt(dim v0_sq) ({initial})",
+            math.sqrt(dim * v0_sq),
+        )
+    _check_scales(gamma0, D0, dt, t_stop, tau0, exponent, mass, speed_name, rms)
 
     T, L = len(steps), len(lags)
     if store_positions:

@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _edmd
+from ._scales import SCALE_HI, SCALE_LO, check_range
 from .placement import draw_velocities, lattice_order, place_lattice, place_rsa
 from .restitution import ConstantRestitution, RestitutionLaw, engine_law
 
@@ -36,12 +37,10 @@ _MELTED_ORDER = 3.0
 BIG_RATIO: float = _core.BIG_RATIO
 
 
-# float64 holds magnitudes from 2.2e-308 to 1.8e308.  The collision arithmetic
-# (csrc/collide.h) squares lengths, speeds and length x speed (the contact-time quadratic)
-# and multiplies a squared length by a mass (the impulse); keeping each scale that gets
-# squared within 1e-140 .. 1e140 (and each product within 1e-280 .. 1e280) leaves room
-# for sums over particles and for a gas that cools or heats by many orders.
-_SCALE_LO, _SCALE_HI = 1e-140, 1e140
+# The collision arithmetic (csrc/collide.h) squares lengths, speeds and length x speed (the
+# contact-time quadratic) and multiplies a squared length by a mass (the impulse): each is
+# kept within granular._scales' range.
+_SCALE_LO, _SCALE_HI = SCALE_LO, SCALE_HI
 # Coordinates must resolve a diameter far more finely than the engine's overlap
 # tolerance (a relative 1e-10 of the contact distance, csrc/validate.c): at most this
 # fraction of the smallest diameter per float64 step at the box's farthest corner.
@@ -49,12 +48,15 @@ _RESOLUTION = 1e-11
 
 
 def _check_range(name, value, lo, hi):
-    if not lo <= value <= hi:
-        raise ValueError(
-            f"{name} = {value:.3g} is outside {lo:g} .. {hi:g}, the range in which the "
-            "collision arithmetic stays within float64: choose units in which diameters, "
-            "masses and speeds are nearer 1 (e.g. a diameter, a mass and the thermal speed)"
-        )
+    check_range(
+        name,
+        value,
+        lo,
+        hi,
+        "the collision arithmetic",
+        "choose units in which diameters, masses and speeds are nearer 1 (e.g. a diameter, "
+        "a mass and the thermal speed)",
+    )
 
 
 @np.errstate(over="ignore", under="ignore")

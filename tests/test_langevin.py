@@ -539,6 +539,85 @@ def test_bad_input(kwargs, match):
         langevin.run(10, **base)
 
 
+# Scales whose squares or products would leave float64 over the run (granular._scales):
+# refused before it, naming the parameter, its value and the range.  A speed of 1e154 used
+# to run, its squared speed summed over 8 particles an inf.
+SCALE_BASE = dict(gamma0=3.2, D0=1.78, dt=0.01, t_stop=0.5, scheme="em", dim=1, seed=1)
+
+
+@pytest.mark.parametrize(
+    "kwargs,match",
+    [
+        (dict(initial="fixed", speed=1.79e308), r"speed = 1\.79e\+308 is outside 0 \.\. 1e\+140"),
+        (dict(initial="fixed", speed=1e154), r"speed = 1e\+154 is outside 0 \.\. 1e\+140"),
+        (dict(initial="fixed", speed=1.01e140), r"speed = 1\.01e\+140 is outside"),
+        # the ballistic displacement: speed 1e100 is fine, for 1e41 time units it is not
+        (
+            dict(initial="fixed", speed=1e100, t_stop=1e41, dt=1e39, gamma0=1e-41),
+            r"speed \* t_stop \(the ballistic displacement\) = 1e\+141 is outside 0 \.\. "
+            r"1e\+140.*speed at most 1e\+99 for t_stop = 1e\+41",
+        ),
+        (dict(gamma0=1e141, scheme="exact"), r"gamma0 = 1e\+141 is outside 1e-140 \.\. 1e\+140"),
+        (dict(gamma0=1e-141), r"gamma0 = 1e-141 is outside 1e-140 \.\. 1e\+140"),
+        (dict(dt=1e-141, t_stop=1e-139), r"dt = 1e-141 is outside"),
+        (dict(dt=1e140, t_stop=1e141, gamma0=1e-141), r"t_stop = 1e\+141 is outside"),
+        (dict(D0=1e281), r"D0 = 1e\+281 is outside 1e-280 \.\. 1e\+280"),
+        (dict(D0=1e-281), r"D0 = 1e-281 is outside 1e-280 \.\. 1e\+280"),
+        (dict(D0=1e200, gamma0=1e100, scheme="exact"), r"D0 \* gamma0 .* = 1e\+300 is outside"),
+        (
+            dict(D0=1e250, gamma0=1e-100, t_stop=1e40, dt=1e38),
+            r"D0 \* t_stop .* = 1e\+290 is outside 0 \.\. 1e\+280.*D0 at most 1e\+240",
+        ),
+        (dict(mass=1e281), r"mass = 1e\+281 is outside 1e-280 \.\. 1e\+280"),
+        (dict(mass=1e-281), r"mass = 1e-281 is outside"),
+        # the temperature, mass v^2, would overflow
+        (dict(mass=1e270, initial="fixed", speed=1e10), r"mass \* speed\^2 .* = 1e\+290"),
+        (dict(model="udsbm", tau0=1e-141), r"tau0 = 1e-141 is outside"),
+        # UDSBM's friction decays below float64's range: the exact step would divide 0 by 0
+        (
+            dict(model="udsbm", tau0=1.0, exponent=100.0, t_stop=1e4, dt=1.0, scheme="exact"),
+            r"UDSBM's gamma0 at t_stop.*= 10\^-399\.5, is below 1e-140",
+        ),
+    ],
+)
+def test_scales_past_float64_are_refused_by_name(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        langevin.run(8, **dict(SCALE_BASE, **kwargs))
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        # speed at its limit, and speed * t_stop at its limit: MSDs near 1e280
+        dict(initial="fixed", speed=1e140, t_stop=1.0, dim=2, scheme="exact"),
+        dict(initial="fixed", speed=1e100, t_stop=1e40, dt=1e38, gamma0=1e-40, D0=1.0),
+        dict(initial="fixed", speed=1e140, mass=1e-1),
+    ],
+)
+@pytest.mark.filterwarnings("ignore:LangevinResult.temperature is an energy now")
+def test_scales_just_inside_the_limits_run_to_finite_results(kwargs):
+    r = langevin.run(8, **dict(SCALE_BASE, **kwargs))
+    for name in (
+        "msd_total",
+        "msd_per_dimension",
+        "v2",
+        "temperature",
+        "final_positions",
+        "final_velocities",
+    ):
+        assert np.all(np.isfinite(getattr(r, name))), name
+    # the fixed speed dominates the thermal noise (~1) by 1e100 and more: the MSD is the
+    # deterministic ballistic transient to rounding, s^2 ((1 - e^(-gamma t)) / gamma)^2
+    # (Euler-Maruyama: its discrete sum, (1 - (1 - gamma dt)^k) / gamma)
+    s, g, t = kwargs["speed"], r.gamma0, r.times
+    if r.scheme == "exact":
+        want = s**2 * (-np.expm1(-g * t) / g) ** 2
+    else:
+        want = s**2 * ((1 - (1 - g * r.dt) ** r.steps) / g) ** 2
+    np.testing.assert_allclose(r.msd_total[1:], want[1:], rtol=1e-9)
+    assert r.msd_total[-1] > 1e200
+
+
 def test_a_lag_between_two_steps_is_refused_before_the_run(monkeypatch):
     """The engine samples the path at whole steps, so tamsd_lags=[0.15] with dt = 0.1 is
     refused, naming the two lags it could have (not rounded to 0.1 unseen, as

@@ -462,6 +462,87 @@ LANGEVIN_MUTATIONS = [
 ]
 
 
+def _power(rng, lo, hi):
+    """10^u, u uniform in [lo, hi]: a scale of a random order of magnitude."""
+    return float(10.0 ** rng.uniform(lo, hi))
+
+
+def _either_end(rng, lo, hi):
+    """A scale near float64's top or bottom: 10^+-u, u uniform in [lo, hi]."""
+    return _power(rng, lo, hi) ** (1 if rng.random() < 0.5 else -1)
+
+
+def _shown(p, *keys):
+    """The label of a mutation that set these keys."""
+    return ", ".join(f"{k}={p[k]!r}" for k in keys)
+
+
+def _huge_speed(rng, p):
+    p["initial"], p["speed"] = "fixed", _power(rng, 130, 160)
+    return _shown(p, "initial", "speed")
+
+
+def _ballistic_reach(rng, p):  # speed * t_stop around the limit 1e140, speed itself inside
+    p["t_stop"] = _power(rng, 20, 60)
+    p["dt"] = p["t_stop"] / int(rng.integers(10, 200))
+    p["gamma0"] = float(rng.uniform(0.1, 10)) / p["t_stop"]
+    p["initial"], p["speed"] = "fixed", _power(rng, 80, 120)
+    return _shown(p, "initial", "speed", "gamma0", "dt", "t_stop")
+
+
+def _extreme_gamma0(rng, p):
+    p["gamma0"], p["scheme"] = _either_end(rng, 130, 150), "exact"
+    return _shown(p, "gamma0", "scheme")
+
+
+def _extreme_D0(rng, p):
+    p["D0"] = _either_end(rng, 270, 290)
+    return _shown(p, "D0")
+
+
+def _extreme_times(rng, p):  # the times and the rate scaled together
+    p["t_stop"] = _either_end(rng, 130, 150)
+    p["dt"] = p["t_stop"] / int(rng.integers(10, 200))
+    p["gamma0"] = float(rng.uniform(0.1, 10)) / p["t_stop"]
+    return _shown(p, "dt", "t_stop", "gamma0")
+
+
+def _extreme_tau0(rng, p):
+    p["model"], p["tau0"], p["initial"] = "udsbm", _either_end(rng, 130, 150), "thermal"
+    return _shown(p, "model", "tau0", "initial")
+
+
+def _extreme_mass(rng, p):
+    p["mass"] = _either_end(rng, 270, 290)
+    return _shown(p, "mass")
+
+
+def _heavy_and_fast(rng, p):  # the temperature, mass v^2, around 1e280
+    p["mass"], p["initial"], p["speed"] = _power(rng, 250, 280), "fixed", _power(rng, 0, 20)
+    return _shown(p, "mass", "initial", "speed")
+
+
+def _steep_decay(rng, p):  # UDSBM's friction at t_stop, gamma0 (1 + t/tau0)^-a, down to ~1e-600
+    p["model"], p["initial"] = "udsbm", "thermal"
+    p["tau0"], p["exponent"] = _power(rng, -2, 0), _power(rng, 0, 2.5)
+    return _shown(p, "model", "tau0", "exponent", "initial")
+
+
+# Scales around the limits of float64 (granular._scales): each accepted run must give finite
+# results, every refused one a clear error.
+LANGEVIN_SCALE_MUTATIONS = [
+    _huge_speed,
+    _ballistic_reach,
+    _extreme_gamma0,
+    _extreme_D0,
+    _extreme_times,
+    _extreme_tau0,
+    _extreme_mass,
+    _heavy_and_fast,
+    _steep_decay,
+]
+
+
 def _in_scene(mutate):
     """A scene mutation applied to the scene of a case that holds one (p["scene"])."""
 
@@ -665,6 +746,10 @@ LATER_KINDS = {
     "threads": (_langevin_params, THREADS_MUTATIONS),
 }
 LATER_SHARE = 0.2  # of the cases
+# Langevin runs whose scales are near the ends of float64, from a third stream of their own
+# (the first stream's cases stay as they were, fewer by this share).
+SCALE_KINDS = {"langevin": (_langevin_params, LANGEVIN_SCALE_MUTATIONS)}
+SCALE_SHARE = 0.06
 
 
 def _draw(rng, kinds, count, at_least_one=()):
@@ -689,9 +774,13 @@ def _draw(rng, kinds, count, at_least_one=()):
 
 def make_cases(seed, count):
     """``count`` cases as dicts {kind, params, labels}, the same for the same seed."""
-    later = int(LATER_SHARE * count)
-    first = _draw(np.random.default_rng(seed), KINDS, count - later)
-    return first + _draw(np.random.default_rng([seed, 1]), LATER_KINDS, later, ("threads",))
+    later, scales = int(LATER_SHARE * count), int(SCALE_SHARE * count)
+    first = _draw(np.random.default_rng(seed), KINDS, count - later - scales)
+    return (
+        first
+        + _draw(np.random.default_rng([seed, 1]), LATER_KINDS, later, ("threads",))
+        + _draw(np.random.default_rng([seed, 2]), SCALE_KINDS, scales, ("langevin",))
+    )
 
 
 def describe(case):
@@ -786,7 +875,18 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
 
 @_verified
 def _check_langevin(r):
-    for name in ("times", "msd_total", "v2", "tamsd_mean", "positions"):
+    for name in (
+        "times",
+        "msd_total",
+        "msd_per_dimension",
+        "v2",
+        "temperature",
+        "tamsd_mean",
+        "tamsd_per_particle",
+        "positions",
+        "final_positions",
+        "final_velocities",
+    ):
         a = getattr(r, name, None)
         _check(a is None or np.all(np.isfinite(a)), f"non-finite {name}")
     _check(np.all(r.msd() >= 0), "negative MSD")
