@@ -34,7 +34,7 @@ import os
 import stat
 import struct
 import zipfile
-from typing import TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -127,7 +127,7 @@ def dumps(sim: Simulation) -> bytes:
         "layout": str(_core.CHECKPOINT_LAYOUT),
         "knobs": {k: v if isinstance(v, str) else float(v) for k, v in sim._knobs.items()},
         "scene": {name: describe(getattr(scene, name)) for name in _SCENE_PARAMS},
-        "engine_state_sha256": hashlib.sha256(state).hexdigest(),
+        "engine_state_sha256": hashlib.sha256(state.data).hexdigest(),
     }
     arrays = {f"scene_{name}": getattr(scene, name) for name in _SCENE_ARRAYS}
     buf = io.BytesIO()
@@ -229,7 +229,9 @@ def _member_array(zf, info, dtype, shape, max_bytes, check_head=None):
     return np.frombuffer(data, dtype=got).reshape(shape)
 
 
-def _read_npz(f, where: str) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+def _read_npz(
+    f: IO[bytes] | bytes | bytearray | memoryview, where: str
+) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """(meta, arrays) from the checkpoint in the binary file ``f`` (or bytes); what is
     read is bounded by the file's size and the sizes the state's arrays must have."""
     if isinstance(f, (bytes, bytearray, memoryview)):
@@ -343,10 +345,13 @@ def _build(meta: dict[str, Any], arrays: dict[str, np.ndarray], where: str) -> S
 
     try:
         state = arrays["engine_state"]
-        if hashlib.sha256(state).hexdigest() != meta["engine_state_sha256"]:
+        if hashlib.sha256(state.data).hexdigest() != meta["engine_state_sha256"]:
             raise ValueError("the engine state does not match its checksum")
         fields = {name: arrays[f"scene_{name}"] for name in _SCENE_ARRAYS}
-        params = {name: from_description(meta["scene"][name]) for name in _SCENE_PARAMS}
+        # the boundary's string, numbers and laws: Any, to be checked by Scene
+        params: dict[str, Any] = {
+            name: from_description(meta["scene"][name]) for name in _SCENE_PARAMS
+        }
         knobs = meta["knobs"]
         scene = Scene(
             fields["positions"],

@@ -27,10 +27,14 @@ temperature.  ``unstable_box`` is the text of ``Simulation.run``'s ClusteringWar
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+if TYPE_CHECKING:
+    from .restitution import RestitutionLaw
+    from .scene import Scene
 
 # samples per chunk in the Fourier sums: bounds the (chunk, N, K) complex temporaries
 _CHUNK_ELEMENTS = 4_000_000
@@ -352,8 +356,9 @@ def flow_energy(
         pa = np.bincount(flat, (m[None, :] * u[..., a]).ravel(), size).reshape(t_count, n_cells)
         mom2 += pa**2
     occupied = mass_c > 0
-    flow = 0.5 * (mom2[occupied] / mass_c[occupied])
-    flow = np.bincount(np.nonzero(occupied)[0], flow, t_count)
+    flow_cells = 0.5 * (mom2[occupied] / mass_c[occupied])
+    # float64 (bincount's weighted sum; its annotation says integers, the unweighted count)
+    flow = np.asarray(np.bincount(np.nonzero(occupied)[0], flow_cells, t_count), np.float64)
     e_kin = 0.5 * (m[None, :, None] * u**2).sum(axis=(1, 2))
     thermal = e_kin - flow
     c = occupied.sum(axis=1)
@@ -405,7 +410,9 @@ _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(64)
 _NODES, _WEIGHTS = 0.5 * (_NODES + 1.0), 0.5 * _WEIGHTS
 
 
-def effective_restitution(restitution, temperature: ArrayLike, mass: float = 1.0):
+def effective_restitution(
+    restitution: float | RestitutionLaw, temperature: ArrayLike, mass: float = 1.0
+) -> float | NDArray[np.float64]:
     """The constant restitution xi_eff that cools a gas at temperature T as fast as a
     restitution law does: the thermal mean over the collisions of a Maxwellian gas,
     weighted by the energy each loses,
@@ -497,14 +504,14 @@ def _law_outlook(restitution, scene, big, radius, density, growth):
     return u_at, at[0], at[1], at[2]
 
 
-def unstable_box_message(scene) -> str | None:
+def unstable_box_message(scene: Scene) -> str | None:
     """Why a scene's homogeneous cooling will end, or None when theory expects it to last:
     the text of ``unstable_box(scene)``."""
     found = unstable_box(scene)
     return None if found is None else found[0]
 
 
-def unstable_box(scene) -> tuple[str, float, float] | None:
+def unstable_box(scene: Scene) -> tuple[str, float, float] | None:
     """Why a scene's homogeneous cooling will end, and when: ``(message, t_star,
     collisions_per_particle)`` with t* and its collisions per particle from the scene's
     state (inf where linear theory gives no finite onset), or None when theory expects the
@@ -544,14 +551,13 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     Goldhirsch & Zanetti 1993, Phys. Rev. Lett. 70, 1619; Garzo 2005, Phys. Rev. E 72,
     021106 (see ``theory.critical_box_size``).
     """
-    import numbers
-
     from . import theory
     from .restitution import Viscoelastic
 
-    xi = scene.restitution
-    law = isinstance(xi, Viscoelastic)
-    if scene.boundary != "periodic" or not (law or (isinstance(xi, numbers.Real) and xi < 1)):
+    law = scene.restitution if isinstance(scene.restitution, Viscoelastic) else None
+    # a constant restitution (a Scene keeps it as a float), NaN for a law
+    xi = scene.restitution if isinstance(scene.restitution, float) else math.nan
+    if scene.boundary != "periodic" or not (law is not None or xi < 1):
         return None
     lengths = scene.upper - scene.lower
     big = float(np.max(lengths))
@@ -560,10 +566,10 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
     eta = scene.packing_fraction
     temperature = float(scene.temperature)
     mass = float(np.mean(scene.masses))
-    if not 0 < eta < 1 or (law and not 0 < temperature < math.inf):
+    if not 0 < eta < 1 or (law is not None and not 0 < temperature < math.inf):
         return None
-    if law:
-        xi = effective_restitution(xi, temperature, mass)
+    if law is not None:
+        xi = float(effective_restitution(law, temperature, mass))
         at = (
             f"the effective restitution xi = {xi:.4g} of the viscoelastic law at the present "
             f"temperature T = {temperature:.4g} (the constant xi that cools as fast: "
@@ -587,14 +593,14 @@ def unstable_box(scene) -> tuple[str, float, float] | None:
         "grow from the longest wavelengths, and "
     )
     growth = _ONSET_SHARE * d * n / (2 * d * (d - 1))
-    if law:
+    if law is not None:
         text += (
             "the viscoelastic cooling law stops describing the cooling.  The gas grows more "
             "elastic as it cools, and L_c with it"
         )
-        u, t, cpp, log_growth = _law_outlook(scene.restitution, scene, big, radius, density, growth)
+        u, t, cpp, log_growth = _law_outlook(law, scene, big, radius, density, growth)
         tau0 = theory.viscoelastic_tau0(
-            a_kappa=scene.restitution,
+            a_kappa=law,
             density=density,
             radius=radius,
             temperature0=temperature,

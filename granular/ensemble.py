@@ -21,6 +21,7 @@ import traceback
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from types import FrameType
 from typing import Any
 
 import numpy as np
@@ -498,11 +499,12 @@ def _call_task(task, index, seed):
     except Exception as exc:  # noqa: BLE001
         info = (repr(exc), exc.__class__.__name__, traceback.format_exc())
         exc.__traceback__ = None  # its frames may hold the failed run's arrays
+        sent: Exception | None = exc
         try:  # the round trip: an exception may pickle and not unpickle (required args)
             pickle.loads(pickle.dumps(exc))
         except Exception:  # noqa: BLE001 (an exception that does not pickle stays behind)
-            exc = None
-        return index, "error", (*info, exc)
+            sent = None
+        return index, "error", (*info, sent)
 
 
 def _progress_bar(total, progress):
@@ -575,7 +577,9 @@ def _main_guard_lines(tree):
         return isinstance(node, ast.Constant) and node.value == "__main__"
 
     for node in ast.walk(tree):
-        test = node.test if isinstance(node, ast.If) else None
+        if not isinstance(node, ast.If):
+            continue
+        test = node.test
         if not (isinstance(test, ast.Compare) and len(test.ops) == 1):
             continue
         left, right = test.left, test.comparators[0]
@@ -603,7 +607,7 @@ def _unguarded_main_call(start_method):
         or (spec is not None and spec.name.rpartition(".")[2] == "__main__")
     ):
         return None
-    frame = sys._getframe(1)
+    frame: FrameType | None = sys._getframe(1)
     while frame is not None and not (
         frame.f_globals is vars(main)
         and frame.f_code.co_name == "<module>"
@@ -718,7 +722,7 @@ class _PointReducer:
     def __init__(self, seeds, keep_runs):
         self.seeds = seeds
         self.acc = _Accumulator()
-        self.kept = [] if keep_runs else None
+        self.kept: list[Any] | None = [] if keep_runs else None
         self.failures = []
         self.first_exception = None  # of the first failure, if it came back with it
 
@@ -877,7 +881,7 @@ def _reduce_in_order(results, reducers, runs, bar, stored=None):
     that arrive early wait in ``pending``, which the windowed submission keeps small.
     ``stored``: index -> (status, payload) of the runs a save_to directory already holds,
     read from disk only when their turn comes."""
-    pending = {}
+    pending: dict[int, tuple[str, Any]] = {}
     next_index = 0
 
     def feed():

@@ -36,8 +36,9 @@ import pickle
 import stat
 import sys
 import zipfile
+from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 
@@ -68,11 +69,17 @@ def _digest(obj: Any, what: str) -> str:
 
 def _seed_dict(seed: np.random.SeedSequence) -> dict[str, Any]:
     entropy = seed.entropy
-    entropy = [str(e) for e in entropy] if isinstance(entropy, (list, tuple)) else str(entropy)
-    return {"entropy": entropy, "spawn_key": [int(k) for k in seed.spawn_key]}
+    text = [str(e) for e in entropy] if isinstance(entropy, (list, tuple)) else str(entropy)
+    return {"entropy": text, "spawn_key": [int(k) for k in seed.spawn_key]}
 
 
-def fingerprint(models, sweep, root, run_kwargs, quantities) -> dict[str, Any]:
+def fingerprint(
+    models: Sequence[Any],
+    sweep: bool,
+    root: np.random.SeedSequence,
+    run_kwargs: dict[str, Any],
+    quantities: Iterable[str],
+) -> dict[str, Any]:
     """What an ensemble directory was made for (JSON-able)."""
     from . import __version__
 
@@ -120,7 +127,7 @@ class _DirectoryLock:
         except BaseException:
             os.close(fd)
             raise
-        self._fd = fd
+        self._fd: int | None = fd
 
     @staticmethod
     def _try_lock(fd: int) -> bool:
@@ -163,7 +170,7 @@ def _read_regular(path: Path, limit: int | None = None) -> bytes:
     return data
 
 
-def _read_npy(member: zipfile.ZipExtFile, size: int) -> np.ndarray:
+def _read_npy(member: IO[bytes], size: int) -> np.ndarray:
     """One ``.npy`` member whose header must describe exactly its ``size`` bytes."""
     version = np.lib.format.read_magic(member)
     if version == (1, 0):
@@ -291,11 +298,13 @@ class RunStore:
     def has(self, point: int, run: int) -> bool:
         return self._file(point, run).exists()
 
-    def write(self, point, run, seed, status, payload) -> None:
+    def write(
+        self, point: int, run: int, seed: np.random.SeedSequence, status: str, payload: Any
+    ) -> None:
         """Store one finished run: its arrays (status "ok") or its failure (the first
         three entries of the payload: repr, type name, traceback)."""
         meta = {"status": status, "seed": _seed_dict(seed), "ensemble": self.digest}
-        arrays = {}
+        arrays: dict[str, np.ndarray] = {}
         if status == "ok":
             arrays = {k: np.asarray(v) for k, v in payload.items()}
             if _META in arrays:
@@ -313,10 +322,12 @@ class RunStore:
                 "or text; save_to stores NumPy arrays of numbers only"
             )
         buf = io.BytesIO()
-        np.savez(buf, **{_META: np.array(json.dumps(meta))}, **arrays)
+        # Any: mypy would match the names against savez's own keywords (allow_pickle)
+        entries: dict[str, Any] = {_META: np.array(json.dumps(meta)), **arrays}
+        np.savez(buf, **entries)
         write_atomic(self._file(point, run), buf.getvalue())
 
-    def load(self, point, run, seed) -> tuple[str, Any]:
+    def load(self, point: int, run: int, seed: np.random.SeedSequence) -> tuple[str, Any]:
         """(status, payload) of a stored run, as ``_call_task`` returned it."""
         path = self._file(point, run)
         try:

@@ -96,7 +96,9 @@ def _text(value: str) -> np.ndarray:
     return np.frombuffer(value.encode("utf-8"), dtype=np.uint8).copy()
 
 
-def _wrap(positions: np.ndarray, lower: np.ndarray, upper: np.ndarray, periodic: bool):
+def _wrap(
+    positions: np.ndarray, lower: np.ndarray, upper: np.ndarray, periodic: bool
+) -> tuple[np.ndarray, np.ndarray]:
     """Positions wrapped into [lower, upper) and their integer images, float64:
     positions == wrapped + images * (upper - lower) up to rounding."""
     x = np.asarray(positions, dtype=np.float64)
@@ -407,7 +409,9 @@ def read(path: str | os.PathLike) -> Any:
         n, d = len(p["radii"]), len(p["lower"])
         has_v = f.has(0, _log("velocities"))
         still = np.zeros((n, d))
-        times, positions, velocities = [], [], []
+        times: list[float] = []
+        positions: list[np.ndarray] = []
+        velocities: list[np.ndarray] = []
         counters: dict[str, list] = {name: [] for name in _COUNTERS}
         for k in range(f.frames):
             t = f.array(k, _log("time"), (1,))[0]
@@ -432,11 +436,14 @@ def read(path: str | os.PathLike) -> Any:
             for name in _COUNTERS:
                 value = _counter(f, k, name, d, counters[name])
                 counters[name].append(value)
+    # the counters' keywords: arrays of floats or of counts (Any: mypy would match them
+    # against every keyword of Trajectory, its strings too)
+    arrays: dict[str, Any] = {name: np.array(values) for name, values in counters.items()}
     return Trajectory(
         np.array(times),
         np.array(positions).reshape(len(times), n, d),
         np.array(velocities).reshape(len(times), n, d) if has_v else None,
-        **{name: np.array(values) for name, values in counters.items()},
+        **arrays,
         **p,
     )
 
@@ -450,10 +457,10 @@ def _counter(f: _File, k: int, name: str, d: int, before: list) -> Any:
             least = before[-1] if before else 0
             raise f.error(k, _log(name), f"is {value}, below {least}: a count never decreases")
         return value
-    value = f.array(k, _log(name), (d,) if name == "momentum" else (1,))
-    if not np.all(np.isfinite(value)):
+    array = f.array(k, _log(name), (d,) if name == "momentum" else (1,))
+    if not np.all(np.isfinite(array)):
         raise f.error(k, _log(name), "contains NaN or infinity")
-    return value if name == "momentum" else float(value[0])
+    return array if name == "momentum" else float(array[0])
 
 
 def scene_from_gsd(path: str | os.PathLike, frame: int = -1, **params: Any) -> Any:

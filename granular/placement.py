@@ -165,6 +165,7 @@ def place_lattice(rng, radii, lo, hi, periodic):
                 best = (near, kx, ky, ax, ay)
             if ax < sigma:
                 break
+        assert best is not None  # n >= 1: the loop ran at least once
         nearest, kx, ky, ax, ay = best
         i, j = np.meshgrid(np.arange(kx), np.arange(ky), indexing="ij")
         sites = np.stack([(i + 0.25 + 0.5 * (j % 2)) * ax, (j + 0.25) * ay], -1).reshape(-1, 2)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import abc
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -78,7 +79,7 @@ class RestitutionLaw(abc.ABC):
         """The numbers that identify the law (equality, hashing)."""
 
     def __eq__(self, other: object) -> bool:
-        return type(other) is type(self) and self._key() == other._key()  # type: ignore[attr-defined]
+        return type(other) is type(self) and self._key() == other._key()
 
     def __hash__(self) -> int:
         return hash((type(self).__name__, self._key()))
@@ -413,7 +414,10 @@ def engine_law(restitution: float | RestitutionLaw) -> tuple | None:
 
 # -- a JSON-able description (checkpoints store a scene's parameters as JSON) -------------------
 
-_LAWS = {"Viscoelastic": Viscoelastic, "TabulatedRestitution": TabulatedRestitution}
+_LAWS: dict[str, Callable[..., RestitutionLaw]] = {
+    "Viscoelastic": Viscoelastic,
+    "TabulatedRestitution": TabulatedRestitution,
+}
 
 
 def describe(restitution: float | RestitutionLaw) -> float | dict:
@@ -430,6 +434,8 @@ def describe(restitution: float | RestitutionLaw) -> float | dict:
         }
     if isinstance(restitution, ConstantRestitution):  # (a Scene keeps it as its number)
         return restitution.value
+    if isinstance(restitution, RestitutionLaw):
+        raise TypeError(f"no description for the restitution law {restitution!r}")
     return restitution
 
 

@@ -217,6 +217,18 @@ class Scene:
     box, and no two particles overlapping (``OverlapError`` names the pair).
     """
 
+    # the fields, set once in __init__ (through _set: __setattr__ refuses)
+    positions: NDArray[np.float64]
+    velocities: NDArray[np.float64]
+    radii: NDArray[np.float64]
+    masses: NDArray[np.float64]
+    lower: NDArray[np.float64]
+    upper: NDArray[np.float64]
+    boundary: str
+    wall_restitution: float | RestitutionLaw
+    restitution: float | RestitutionLaw
+    contact_duration: float
+
     def __init__(
         self,
         positions: ArrayLike,
@@ -357,7 +369,7 @@ class Scene:
 
     def replace(self, **changes: Any) -> Scene:
         """A copy with some fields changed, e.g. ``scene.replace(restitution=0.8)``."""
-        fields = dict(
+        fields: dict[str, Any] = dict(
             positions=self.positions,
             velocities=self.velocities,
             radii=self.radii,

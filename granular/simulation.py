@@ -6,6 +6,7 @@ import contextlib
 import math
 import os
 import threading
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -156,7 +157,7 @@ class Simulation:
             return (checkpoint.loads, (checkpoint.dumps(self),))
 
     @contextlib.contextmanager
-    def _exclusive(self, instead: str = "save or copy it between runs"):
+    def _exclusive(self, instead: str = "save or copy it between runs") -> Iterator[None]:
         """Hold the run lock, or raise RuntimeError if a run holds it, saying what to do
         ``instead``."""
         if not self._running.acquire(blocking=False):
@@ -391,7 +392,8 @@ class Simulation:
             if heated is not None:
                 heated.trajectory = trajectory
                 raise heated from exc
-            exc.trajectory = trajectory
+            # the samples so far ride on the exception, whatever it is (a KeyboardInterrupt too)
+            exc.trajectory = trajectory  # type: ignore[union-attr]
             raise
         finally:
             if bar is not None:
@@ -517,7 +519,9 @@ class Simulation:
 
     def _trajectory(self, times, buf, k, reason):
         s = self._initial
-        cut = {name: (None if a is None else a[:k].copy()) for name, a in buf.items()}
+        cut: dict[str, Any] = {
+            name: (None if a is None else a[:k].copy()) for name, a in buf.items()
+        }
         return Trajectory(
             times.copy(),
             **cut,

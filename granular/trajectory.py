@@ -46,6 +46,23 @@ class Trajectory:
     tamsd_lags : (T - 1,) the lags of ``tamsd()`` by default
     """
 
+    # the fields, set once in __init__ (through object.__setattr__: __setattr__ refuses)
+    times: NDArray[np.float64]
+    positions: NDArray[np.float64] | None
+    velocities: NDArray[np.float64] | None
+    kinetic_energy: NDArray[np.float64]
+    momentum: NDArray[np.float64]
+    pair_collisions: NDArray[np.int64]
+    wall_collisions: NDArray[np.int64]
+    virial: NDArray[np.float64]
+    wall_impulse: NDArray[np.float64]
+    masses: NDArray[np.float64]
+    radii: NDArray[np.float64]
+    lower: NDArray[np.float64]
+    upper: NDArray[np.float64]
+    boundary: str
+    stop_reason: str
+
     def __init__(
         self,
         times: NDArray[np.float64],
