@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import functools
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -31,6 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 if TYPE_CHECKING:  # matplotlib is an extra, imported only when an animation is made
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
     from .trajectory import Trajectory
 
@@ -73,6 +74,7 @@ def _plane(plane, dim):
         return (0, 1), None
     if plane is None:
         plane = "xy"
+    axes: tuple[int, ...]
     if isinstance(plane, str):
         if len(plane) != 2 or any(c not in _AXES for c in plane) or plane[0] == plane[1]:
             raise ValueError(f"plane must be two different axes of 'xyz', e.g. 'xz', got {plane!r}")
@@ -150,12 +152,22 @@ def _animation_class():
         ax : Axes
         """
 
+        # set by ``animate`` after construction (``_fig``, ``_interval``: by FuncAnimation)
+        samples: NDArray[np.intp]
+        disks: Any
+        images: Any
+        trail_lines: list[Any]
+        ax: Axes
+        _update: Callable[[int], list[Any]]
+        _fig: Figure
+        _interval: float
+
         def draw(self, k: int) -> list[Any]:
             """Draw frame ``k`` (sample ``samples[k]``) now; returns the artists changed."""
             self._draw_was_started = True  # a drawn frame is a use: no "deleted unused" warning
             return self._update(k)
 
-        def _repr_html_(self) -> str | None:
+        def _repr_html_(self) -> str:
             # In a notebook the animation shows itself as JavaScript frames unless the user
             # chose another rcParams["animation.html"] ("html5" needs ffmpeg).
             import matplotlib as mpl
@@ -164,7 +176,10 @@ def _animation_class():
                 return self.to_jshtml()
             return super()._repr_html_()
 
-        def save(self, filename: str | os.PathLike, writer: Any = None, **kwargs: Any) -> None:
+        # FuncAnimation.save's parameters after writer are taken as keywords only
+        def save(  # type: ignore[override]
+            self, filename: str | os.PathLike[str], writer: Any = None, **kwargs: Any
+        ) -> None:
             """``FuncAnimation.save`` with the writer chosen by the file's ending: .gif with
             Pillow, .mp4 (.m4v, .mov, .mkv, .webm) with ffmpeg, .html as JavaScript frames.
 
@@ -196,7 +211,7 @@ def _animation_class():
             if writer == "pillow" and set(kwargs) <= {"dpi", "fps"}:
                 self._save_gif(filename, **kwargs)
             else:
-                super().save(filename, writer=writer, **kwargs)
+                super().save(os.fspath(filename), writer=writer, **kwargs)
 
         def _save_gif(self, filename, dpi=None, fps=None):
             """The GIF as matplotlib's Pillow writer makes it, but with the static parts
@@ -344,11 +359,12 @@ def animate(
     from matplotlib.collections import EllipseCollection
     from matplotlib.patches import Rectangle
 
-    own_figure = ax is None
-    if own_figure:
+    own_figure = None
+    if ax is None:
         from matplotlib.figure import Figure
 
-        ax = Figure(figsize=(5.0, 5.0), layout="constrained").add_subplot()
+        own_figure = Figure(figsize=(5.0, 5.0), layout="constrained")
+        ax = own_figure.add_subplot()
     fig = ax.figure
     lo, hi = np.asarray(traj.lower, dtype=np.float64), np.asarray(traj.upper, dtype=np.float64)
     periodic = traj.boundary == "periodic"
@@ -443,12 +459,12 @@ def animate(
         clock.set_text(f"t = {traj.times[s]:.4g}")
         return [disks, *images, outline, *lines, clock]  # in the order a full drawing has
 
-    if own_figure:
+    if own_figure is not None:
         # lay the figure out once: constrained layout would otherwise run on every frame
         # (half the time of writing a GIF), for a layout that never changes
         update(0)
-        fig.draw_without_rendering()
-        fig.set_layout_engine("none")
+        own_figure.draw_without_rendering()
+        own_figure.set_layout_engine("none")
     if blit is None:
         blit = bool(getattr(fig.canvas, "supports_blit", False))
     anim = _animation_class()(

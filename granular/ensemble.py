@@ -22,7 +22,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from types import FrameType
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -919,6 +919,39 @@ def _saving(results, store, runs, seeds):
         point, run = divmod(index, runs)
         store.write(point, run, seeds[point][run], status, payload)
         yield index, status, payload
+
+
+# one model: one result; a sweep (a list or tuple of models): a list of results
+@overload
+def ensemble(
+    model: Scene | Callable[..., Any],
+    runs: int,
+    *,
+    seed: int | np.random.SeedSequence | None = None,
+    backend: Any = "processes",
+    workers: int | None = None,
+    progress: bool | None = None,
+    keep_runs: bool = True,
+    quantities: Sequence[str] = ("msd", "temperature"),
+    save_to: str | os.PathLike | None = None,
+    **run_kwargs: Any,
+) -> EnsembleResult: ...
+
+
+@overload
+def ensemble(
+    model: Sequence[Scene | Callable[..., Any]],
+    runs: int,
+    *,
+    seed: int | np.random.SeedSequence | None = None,
+    backend: Any = "processes",
+    workers: int | None = None,
+    progress: bool | None = None,
+    keep_runs: bool = True,
+    quantities: Sequence[str] = ("msd", "temperature"),
+    save_to: str | os.PathLike | None = None,
+    **run_kwargs: Any,
+) -> list[EnsembleResult]: ...
 
 
 def ensemble(

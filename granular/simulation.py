@@ -6,7 +6,7 @@ import contextlib
 import math
 import os
 import threading
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import numpy as np
@@ -229,7 +229,7 @@ class Simulation:
         t_stop: float | None = None,
         *,
         sample_times: ArrayLike | None = None,
-        stop_when: dict[str, float] | None = None,
+        stop_when: Mapping[str, float] | None = None,
         store: tuple[str, ...] | list[str] = _STORE,
         progress: bool = False,
     ) -> Trajectory:

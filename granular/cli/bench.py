@@ -8,6 +8,7 @@ import math
 import os
 import platform
 import time
+from types import ModuleType
 
 from .. import Scene, Simulation
 from .output import write_json
@@ -110,6 +111,7 @@ def run(quick=False, large=False, langevin=True, out=print, rounds=None):
             f"events/collision{', neighbour lists' if r['shell'] > 0 else ''})"
         )
     if langevin:
+        bench_langevin: ModuleType | None
         try:
             from . import bench_langevin
         except ImportError:

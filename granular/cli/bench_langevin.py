@@ -18,6 +18,7 @@ import functools
 import os
 import time
 import tracemalloc
+from typing import Any
 
 import numpy as np
 
@@ -106,7 +107,7 @@ def _rounds(configs, rounds):
     """Each config's (last result, peak MiB, wall rates, CPU rates over the rounds): the
     configs run in turn, forwards in even rounds and backwards in odd ones, so that a
     machine whose load drifts during the bench favours none of them."""
-    got = {k: [None, 0.0, [], []] for k in configs}
+    got: dict[Any, list[Any]] = {k: [None, 0.0, [], []] for k in configs}
     for i in range(rounds):
         for k in list(configs)[:: 1 if i % 2 == 0 else -1]:
             fn, work = configs[k]
@@ -129,7 +130,9 @@ def workloads(quick=False, rounds=1):
     for n, steps in cases:
         dt = 0.01
         np_steps = max(10, steps // 20)
-        configs = {"numpy": (functools.partial(numpy_em, n, np_steps, dt), n * np_steps)}
+        configs: dict[str | tuple[str | None, int], tuple[functools.partial[Any], int]] = {
+            "numpy": (functools.partial(numpy_em, n, np_steps, dt), n * np_steps)
+        }
         for scheme in ("em", "exact"):
             for t in counts:
                 configs[scheme, t] = (

@@ -167,8 +167,9 @@ def tracer_run(seed, times):
     and its initial squared speed per component (for the Langevin MSD given the start)."""
     scene = Scene.seed_brownian_disks(seed=seed, tracer=True)
     traj = Simulation(scene).run(times[-1], sample_times=times, store=("positions", "velocities"))
-    x = traj.positions[:, 0]
-    return {"msd": np.sum((x - x[0]) ** 2, axis=1), "v0_sq": np.mean(traj.velocities[0, 0] ** 2)}
+    x = traj._need("positions")[:, 0]
+    v0 = traj._need("velocities")[0, 0]
+    return {"msd": np.sum((x - x[0]) ** 2, axis=1), "v0_sq": np.mean(v0**2)}
 
 
 def brownian(out, quick=False, runs=None, backend="processes"):

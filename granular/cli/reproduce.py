@@ -152,7 +152,7 @@ def _fig_4_1(cfg, out):
     tr = Simulation(s).run(t_stop=2.0, sample_times=t)
     fig, ax = _fig()
     for k in range(2):
-        ax.plot(t, tr.positions[:, k, 0], label=f"particle {k}")
+        ax.plot(t, tr._need("positions")[:, k, 0], label=f"particle {k}")
     ax.axvline(0.4, color="0.7", ls=":", label="contact, t = 0.4")
     ax.set_xlabel(plot.TIME)
     ax.set_ylabel(plot.POSITION.format("x"))
@@ -226,7 +226,7 @@ def _speeds_task(n, radius, dim, collisions, seed):
     `collisions` per particle; returns the final velocities."""
     s = Scene.random(n, radius, dim=dim, boundary="walls", seed=seed)
     tr = Simulation(s).run(stop_when={"collisions_per_particle": collisions}, store=("velocities",))
-    return {"velocities": tr.velocities[-1]}
+    return {"velocities": tr._need("velocities")[-1]}
 
 
 def _fig_4_5_to_4_7(cfg, out):
@@ -686,7 +686,7 @@ FIGURES = {
 # machine shared with other work -- the full run's first six experiments at a load average
 # below 2.5, its last three near 5; the quick run at 7-8.5.  Before each experiment the
 # progress line scales its time by how much slower or faster the ones done so far ran.
-ABOUT = {
+ABOUT: dict[str, tuple[str, float, float]] = {
     "4.1": ("a head-on collision of two disks between walls", 0.7, 1.6),
     "4.2-4.4": ("energy and collisions per particle, periodic and wall boxes", 4.1, 4.4),
     "4.5-4.7": ("speeds in 2D and 3D against Maxwell-Boltzmann (Table 4.1)", 24.5, 4.4),
@@ -797,7 +797,7 @@ def main(out="granular-reproduce", quick=False, runs=None, backend=None, only=No
     matplotlib.use("Agg")
     cfg = Config(quick=quick, runs=runs, backend=backend)
     started = time.perf_counter()
-    reference = {name: ABOUT[name][2 if quick else 1] for name in selected}
+    reference = {name: ABOUT[name][2] if quick else ABOUT[name][1] for name in selected}
     print(
         f"reproducing {len(selected)} experiment(s) into {out}/: ~{sum(reference.values()):.0f} s "
         "on the reference machine (2 cores), longer on a busy one",

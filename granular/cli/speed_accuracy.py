@@ -268,7 +268,7 @@ def em_stability(quick=False):
         dt = gdt / c.gamma0
         times = np.unique(np.round(np.logspace(math.log10(dt), math.log10(t_max), 20) / dt)) * dt
         th = theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0)
-        row = dict(gamma_dt=gdt, dt=dt)
+        row: dict[str, float | None] = dict(gamma_dt=gdt, dt=dt)
         for scheme in ("em", "exact"):
             try:
                 r = langevin.run(
