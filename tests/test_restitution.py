@@ -393,6 +393,27 @@ def test_scene_round_trips_the_law():
     assert sim.scene.restitution == law and sim.scene.wall_restitution == table
 
 
+def test_describe_refuses_a_law_it_cannot_write():
+    """A checkpoint stores a scene's restitution as describe() writes it (JSON): a law it has
+    no description for is refused by name, not handed back as an object JSON cannot write."""
+
+    class Halved(granular.restitution.RestitutionLaw):  # a law describe() does not know
+        loses_energy = True
+
+        def __call__(self, speed):
+            return np.full(np.shape(speed), 0.5)
+
+        def _engine(self):
+            return None
+
+        def _key(self):
+            return ()
+
+    with pytest.raises(TypeError, match="no description for the restitution law"):
+        granular.restitution.describe(Halved())
+    assert granular.restitution.describe(0.5) == 0.5
+
+
 @pytest.mark.parametrize(
     "make,match",
     [
