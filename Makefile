@@ -2,7 +2,7 @@
 #   make demo   -- set up .venv with the plot extra only and run the main job
 #   make test   -- set up .venv with the test extra and run the whole test suite (CI)
 #   make test-quick -- the same without the tests marked slow, for daily work
-#   make lint   -- ruff check, ruff format --check and mypy (CI runs it before the tests)
+#   make lint   -- ruff, mypy and its stubtest of the C extension (CI runs it before the tests)
 #   make docs   -- the documentation site into build/docs/html, failing on any warning
 # and for the C core: make test-asan (the suite against an ASan + UBSan build of it, in its own venv)
 PYTHON ?= python3
@@ -40,9 +40,11 @@ test-quick: setup
 	$(PY) -m pytest -q -m "not slow"
 
 # lint, formatting and the type hints; the configuration is pyproject.toml's [tool.ruff*]
-# and [tool.mypy] (which names the files mypy checks: the package)
+# and [tool.mypy] (which names the files mypy checks: the package). stubtest checks the C
+# extension's stub, granular/_core.pyi, against the built module: every name, no other.
 lint: setup
 	$(PY) -m ruff check . && $(PY) -m ruff format --check . && $(PY) -m mypy
+	$(PY) -m mypy.stubtest granular._core
 
 # The docs extra comes with the test extra (setup). -E: a fresh environment every time, so a
 # warning in a page that did not change is not hidden by the cache; -W --keep-going: every

@@ -10,10 +10,14 @@ from __future__ import annotations
 
 import math
 import os
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from . import _core
+
+if TYPE_CHECKING:
+    from .scene import Scene
 
 # shell="auto": neighbour lists with this shell (in largest diameters) for dense 3D
 # scenes.  Measured (pair collisions/s, N = 1e4, melted Scene.random, cells vs lists
@@ -44,7 +48,9 @@ def check_memory(need, what):
         )
 
 
-def build(scene, cell_factor=1.0, big_ratio=_core.BIG_RATIO, shell="auto"):
+def build(
+    scene: Scene, cell_factor: float = 1.0, big_ratio: float = _core.BIG_RATIO, shell: Any = "auto"
+) -> _core.EDMD:
     """A new engine (_core.EDMD) at a Scene's state; see Simulation for the knobs."""
     big = np.max(scene.radii) > _core.big_cut(scene.radii, big_ratio)
     if isinstance(shell, str) and shell == "auto":

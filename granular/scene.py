@@ -308,7 +308,9 @@ class Scene:
         """The restitution laws as keywords of ``_core.EDMD`` (None: the number)."""
         return dict(law=engine_law(self.restitution), wall_law=engine_law(self.wall_restitution))
 
-    def _engine_args(self) -> tuple:
+    def _engine_args(
+        self,
+    ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray, NDArray, bool, float, float, float]:
         """The scene as the C engine takes it (``_core.edmd_check`` and ``_core.EDMD``),
         with ``_engine_laws`` as keywords; a law's number is 1 (unused)."""
         return (

@@ -1,0 +1,127 @@
+"""Types of the C extension (csrc/_core.c), for mypy; make lint checks them against the
+built module (mypy.stubtest).  Internal: granular.Simulation, granular.langevin and the
+Scene use it.  Output arrays are C-contiguous, native-order, of the dtype named."""
+
+from typing import Any, final
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+BIG_MAX: int
+BIG_RATIO: float
+CHECKPOINT_LAYOUT: int
+HEADS_CACHED: int
+RNG_KERNEL: str
+SCAN_KERNEL: str
+SDE_BLOCK: int
+SDE_MAX_STEPS: int
+STOP_BUDGET: int
+STOP_COLLISIONS: int
+STOP_ENERGY: int
+STOP_IDLE: int
+STOP_TIME: int
+
+# a restitution law as the engine takes it (RestitutionLaw._engine): (kind, scale, v_max,
+# speeds, values), or None for a constant
+_Law = tuple[int, float, float, Any, Any] | None
+
+@final
+class EDMD:
+    def __init__(
+        self,
+        positions: ArrayLike,
+        velocities: ArrayLike,
+        radii: ArrayLike,
+        masses: ArrayLike,
+        lower: ArrayLike,
+        upper: ArrayLike,
+        periodic: bool,
+        wall_restitution: float,
+        restitution: float,
+        contact_duration: float,
+        cell_factor: float = ...,
+        big_ratio: float = ...,
+        shell: float = ...,
+        law: _Law = ...,
+        wall_law: _Law = ...,
+    ) -> None: ...
+    # The C keyword list names "kinetic_energy" twice: the criterion (third) and the samples'
+    # buffer; a keyword kinetic_energy fills the buffer, so the criterion goes by position.
+    # Returns (the STOP_* reason, the next sample's index).
+    def advance(
+        self,
+        t_stop: float,
+        collisions_per_particle: float,
+        stop_kinetic_energy: float,
+        max_events: int,
+        sample_times: ArrayLike,
+        next: int,
+        /,
+        positions: NDArray[np.float64] | None,
+        velocities: NDArray[np.float64] | None,
+        kinetic_energy: NDArray[np.float64] | None,
+        momentum: NDArray[np.float64] | None,
+        pair_collisions: NDArray[np.int64] | None,
+        wall_collisions: NDArray[np.int64] | None,
+        virial: NDArray[np.float64] | None,
+        wall_impulse: NDArray[np.float64] | None,
+    ) -> tuple[int, int]: ...
+    def state(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]: ...
+    def counters(self) -> dict[str, Any]: ...
+    def save_state(self) -> bytes: ...
+    def restore_state(
+        self, state: bytes | bytearray | memoryview | NDArray[np.uint8], /
+    ) -> None: ...
+
+def edmd_check(
+    positions: ArrayLike,
+    velocities: ArrayLike,
+    radii: ArrayLike,
+    masses: ArrayLike,
+    lower: ArrayLike,
+    upper: ArrayLike,
+    periodic: bool,
+    wall_restitution: float,
+    restitution: float,
+    contact_duration: float,
+    cell_factor: float = ...,
+    big_ratio: float = ...,
+    shell: float = ...,
+    law: _Law = ...,
+    wall_law: _Law = ...,
+) -> None: ...
+def big_cut(radii: ArrayLike, big_ratio: float, /) -> float: ...
+def big_particles(
+    radii: ArrayLike, lengths: ArrayLike, big_ratio: float, cell_factor: float, /
+) -> NDArray[np.bool_]: ...
+def edmd_bytes_per_particle(dim: int, lists: bool, /) -> int: ...
+def sde_run(
+    dim: int,
+    model: int,
+    scheme: int,
+    gamma0: float,
+    D0: float,
+    tau0: float,
+    dt: float,
+    key: int,
+    n: int,
+    first: int,
+    step_from: int,
+    step_to: int,
+    n_steps: int,
+    x: NDArray[np.float64],
+    v: NDArray[np.float64],
+    sample_steps: NDArray[np.int64],
+    x2: NDArray[np.float64],
+    v2: NDArray[np.float64],
+    positions: NDArray[np.float64] | None,
+    lags: NDArray[np.int64],
+    tamsd: NDArray[np.float64],
+    ring: NDArray[np.float64],
+    carry: NDArray[np.float64] | None = None,
+    threads: int = 1,
+    tamsd_estimator: int = 0,
+    exponent: float = 1.0,
+) -> None: ...
+def sde_lag_stride(lag: int, tamsd_estimator: int = 0, /) -> int: ...
+def sde_ring_size(dim: int, lags: ArrayLike, tamsd_estimator: int = 0, /) -> int: ...
