@@ -18,11 +18,15 @@ from __future__ import annotations
 import functools
 import inspect
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, TypeVar, cast
 
 import numpy as np
 
 from ._deprecation import deprecated
+
+_F = TypeVar("_F", bound=Callable[..., Any])
 
 TIME = "L sqrt(m/eps)"
 
@@ -108,7 +112,7 @@ QUANTITIES: dict[str, Quantity] = {
 }
 
 
-def _number(value) -> str:
+def _number(value: Any) -> str:
     """A number as a user writes it (no NumPy repr)."""
     if isinstance(value, (bool, np.bool_)):
         return str(bool(value))
@@ -128,7 +132,7 @@ _RULES = {
 }
 
 
-def check(name: str, value) -> None:
+def check(name: str, value: Any) -> None:
     """Raise ValueError (TypeError for a non-number) naming the parameter, its value and what
     is allowed, if ``value`` breaks the rule of ``QUANTITIES[name]``; None passes (a default).
     Objects where a restitution or material number is expected are left to the function,
@@ -159,7 +163,9 @@ def check(name: str, value) -> None:
         )
 
 
-def keyword_only(*old_order: str, renamed: dict[str, str] | None = None, validate: bool = True):
+def keyword_only(
+    *old_order: str, renamed: dict[str, str] | None = None, validate: bool = True
+) -> Callable[[_F], _F]:
     """Decorate a function of the convention (positional independent variable, the rest
     keyword-only), keeping its old calling convention for one release.
 
@@ -172,7 +178,7 @@ def keyword_only(*old_order: str, renamed: dict[str, str] | None = None, validat
     """
     renamed = dict(renamed or {})
 
-    def decorate(func):
+    def decorate(func: _F) -> _F:
         sig = inspect.signature(func)
         positional = [
             p.name
@@ -213,7 +219,7 @@ def keyword_only(*old_order: str, renamed: dict[str, str] | None = None, validat
         # the old convention, for tests and the tools that rewrite callers
         wrapper.old_positional = tuple(old_order)  # type: ignore[attr-defined]
         wrapper.renamed = dict(renamed)  # type: ignore[attr-defined]
-        return wrapper
+        return cast(_F, wrapper)
 
     return decorate
 
@@ -232,7 +238,7 @@ def _warn(wrapper, args, kwargs, moved, old_keywords, renamed):
     deprecated(f"{name}: {' and '.join(what)}", f"call {name}({', '.join(shown)})", stacklevel=4)
 
 
-def parameters_section(func) -> str:
+def parameters_section(func: Callable[..., Any]) -> str:
     """A numpydoc Parameters section for ``func`` from ``QUANTITIES`` (meaning and unit)."""
     lines = ["Parameters", "----------"]
     for p in inspect.signature(func).parameters.values():
@@ -249,7 +255,7 @@ def parameters_section(func) -> str:
     return "\n".join(lines)
 
 
-def _with_parameters(doc: str | None, func) -> str:
+def _with_parameters(doc: str | None, func: Callable[..., Any]) -> str:
     """``doc`` with a generated Parameters section before its first other section, if it has
     none (hand-written sections say more about a parameter, so they are kept)."""
     doc = inspect.cleandoc(doc or "")

@@ -34,6 +34,8 @@ from ._params import keyword_only as _keyword_only
 if TYPE_CHECKING:  # matplotlib is an extra, imported only when a figure is drawn
     from matplotlib.axes import Axes
 
+    from .clustering import CurrentCorrelations, FlowEnergy, StructureFactor
+
 
 # Axis labels with their units (mathtext).
 TIME = r"time $t$ [$L\sqrt{m/\varepsilon}$]"
@@ -324,11 +326,11 @@ FLOW_RATIO = r"$E_{flow} / E_{thermal}$ (dimensionless)"
 @_keyword_only("times", "result", "ax", "shells", "transverse", validate=False)
 def structure_factor(
     times: ArrayLike,
-    result,
+    result: StructureFactor,
     *,
     ax: Axes | None = None,
     shells: int = 2,
-    transverse=None,
+    transverse: CurrentCorrelations | None = None,
 ) -> Axes:
     """S(k, t) of the smallest ``|k|`` shells against time (a ``clustering.structure_factor``
     result), and, if given, the transverse current correlation of a
@@ -359,7 +361,7 @@ def structure_factor(
 @_keyword_only("times", "result", "ax", "label", "threshold", validate=False)
 def flow_energy(
     times: ArrayLike,
-    result,
+    result: FlowEnergy,
     *,
     ax: Axes | None = None,
     label: str | None = None,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -251,7 +252,9 @@ def viscoelastic_cooling_time(
     ValueError
         If zeta_2 is not smaller than zeta_1 at T0 (delta too large for the series).
     """
-    material = dict(a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta)
+    material: dict[str, Any] = dict(
+        a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta
+    )
     alpha = float(viscoelastic_cooling_rate(temperature0, **material))
     beta = alpha - float(viscoelastic_cooling_rate(temperature0, **material, order=2))
     if 0.0 < alpha <= beta:
@@ -291,7 +294,9 @@ def viscoelastic_temperature_second_order(
     with rates zeta_1 and zeta_1 + zeta_2 at T0, which bracket it).  Its difference from
     ``viscoelastic_temperature`` is relative O(delta(T0)) early and decays like delta(T(t))
     ~ t^(-1/6).  Maxwellian approximation (see ``viscoelastic_cooling_rate``)."""
-    material = dict(a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta)
+    material: dict[str, Any] = dict(
+        a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta
+    )
     alpha = float(viscoelastic_cooling_rate(temperature0, **material))
     beta = alpha - float(viscoelastic_cooling_rate(temperature0, **material, order=2))
     t = np.asarray(t, dtype=np.float64)
@@ -418,7 +423,9 @@ def msd_viscoelastic_second_order(
     t_max = float(np.max(t)) if t.size else 0.0
     if t_max == 0.0:
         return np.zeros_like(t)[()]
-    material = dict(a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta)
+    material: dict[str, Any] = dict(
+        a_kappa=a_kappa, density=density, radius=radius, mass=mass, dim=dim, eta=eta
+    )
     tau = viscoelastic_tau0(temperature0=temperature0, **material)
     start = min(1e-6 * (tau if math.isfinite(tau) else t_max), 1e-3 * t_max)
     grid = np.concatenate([[0.0], np.geomspace(start, t_max, points)])
@@ -426,7 +433,7 @@ def msd_viscoelastic_second_order(
     half_loss = (
         0.5 * VISCOELASTIC_C1 * math.gamma(2.1) * viscoelastic_delta(T, a_kappa=a_kappa, mass=mass)
     )
-    D = (
+    D = np.asarray(
         diffusion_d0(
             density=density,
             radius=radius,
