@@ -44,7 +44,7 @@ test-quick: setup
 # extension's stub, granular/_core.pyi, against the built module: every name, no other.
 lint: setup
 	$(PY) -m ruff check . && $(PY) -m ruff format --check . && $(PY) -m mypy
-	$(PY) -m mypy.stubtest granular._core
+	$(PY) -m mypy.stubtest granular._core --mypy-config-file pyproject.toml
 
 # The docs extra comes with the test extra (setup). -E: a fresh environment every time, so a
 # warning in a page that did not change is not hidden by the cache; -W --keep-going: every

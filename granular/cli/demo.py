@@ -76,9 +76,9 @@ def main(out="granular-demo", quick=False, runs=None, backend="processes"):
         c = theory.langevin_coefficients(
             n=n, radius=radius, volume=1.0, restitution=xi, temperature0=start.temperature
         )
-        msd_th = theory.msd_granular(times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0)
+        msd_th = np.asarray(theory.msd_granular(times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0))
         T_th = (
-            theory.haff_temperature(times, temperature0=start.temperature, tau0=c.tau0)
+            np.asarray(theory.haff_temperature(times, temperature0=start.temperature, tau0=c.tau0))
             if xi < 1
             else np.full_like(times, start.temperature)
         )
@@ -222,7 +222,7 @@ def brownian(out, quick=False, runs=None, backend="processes"):
     if res.failures:
         raise RuntimeError(f"{len(res.failures)} runs failed: {res.failures[0]}")
     v0_sq = float(res.mean["v0_sq"])
-    msd_th = theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0, dim=2, v0_sq=v0_sq)
+    msd_th = np.asarray(theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0, dim=2, v0_sq=v0_sq))
     k_free = int(np.searchsorted(times, t_free, side="right")) - 1
     ratio = res.mean["msd"][1:] / msd_th[1:]
     ratio_err = res.error["msd"][1:] / msd_th[1:]

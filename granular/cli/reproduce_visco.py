@@ -129,10 +129,11 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
         quantities=("temperature", "msd"),
     )  # fmt: skip
     gas = dict(temperature0=T0, a_kappa=law, density=DENSITY, radius=RADIUS, eta=eta)
-    T2 = theory.viscoelastic_temperature_second_order(times, **gas)
-    T1 = theory.viscoelastic_temperature(times, temperature0=T0, tau0=tau)
-    m2 = theory.msd_viscoelastic_second_order(times, **gas)
-    m1 = theory.msd_viscoelastic(times, D0=c.D0, tau0=tau)
+    # theory gives an array for an array of times (its annotation says float or array)
+    T2 = np.asarray(theory.viscoelastic_temperature_second_order(times, **gas))
+    T1 = np.asarray(theory.viscoelastic_temperature(times, temperature0=T0, tau0=tau))
+    m2 = np.asarray(theory.msd_viscoelastic_second_order(times, **gas))
+    m1 = np.asarray(theory.msd_viscoelastic(times, D0=c.D0, tau0=tau))
     names, rows = [], []
 
     # the box against the critical size at the gas' most inelastic moment, its start
@@ -186,8 +187,10 @@ def _fig_visco(cfg, out, *, ensemble, save, fig, row, mean_row):
     ut = ures.times
     n_u = ures.runs[0]["final_positions"].shape[0]
     u_slopes = [_slope(ut, r["msd"], u_window) for r in ures.runs]
-    u_th = theory.msd_powerlaw_udsbm(
-        ut, D0=c.D0, gamma0=c.gamma0, tau0=tau, exponent=langevin.VISCOELASTIC_EXPONENT
+    u_th = np.asarray(
+        theory.msd_powerlaw_udsbm(
+            ut, D0=c.D0, gamma0=c.gamma0, tau0=tau, exponent=langevin.VISCOELASTIC_EXPONENT
+        )
     )
     rows.append(
         mean_row(

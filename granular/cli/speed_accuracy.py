@@ -125,7 +125,7 @@ def speed_accuracy_points(quick=False):
         c = theory.langevin_coefficients(
             n=1000, radius=R, volume=1.0, restitution=xi, temperature0=T0
         )
-        th = theory.msd_granular(times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0)
+        th = np.asarray(theory.msd_granular(times, D0=c.D0, gamma0=c.gamma0, tau0=c.tau0))
         ref, ref_cost = _edmd_msd(1000, xi, ref_runs, times, seed=99)
         log = xi < 1
         sel = times >= t_fit
@@ -211,7 +211,7 @@ def viscoelastic_points(quick=False):
     )
     ref_runs = 64 if not quick else 4
     ref, ref_cost = _edmd_msd(1000, law, ref_runs, times, seed=99)
-    th = theory.msd_viscoelastic(times, D0=c.D0, tau0=c.tau0)
+    th = np.asarray(theory.msd_viscoelastic(times, D0=c.D0, tau0=c.tau0))
     # the late exponent d ln MSD / d ln t, fitted over t >= t_fit
     slope_ref = analysis.fit_power_law(times, ref, t_min=t_fit)[0]
     slope_th = analysis.fit_power_law(times, th, t_min=t_fit)[0]
@@ -267,7 +267,7 @@ def em_stability(quick=False):
     for gdt in (0.01, 0.05, 0.1, 0.3, 0.5, 1.0, 1.5, 1.9, 2.0, 3.0, 10.0):
         dt = gdt / c.gamma0
         times = np.unique(np.round(np.logspace(math.log10(dt), math.log10(t_max), 20) / dt)) * dt
-        th = theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0)
+        th = np.asarray(theory.msd_langevin(times, D0=c.D0, gamma0=c.gamma0))
         row: dict[str, float | None] = dict(gamma_dt=gdt, dt=dt)
         for scheme in ("em", "exact"):
             try:
