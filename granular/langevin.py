@@ -46,12 +46,8 @@ window per lag per step.  See docs/performance.md.
 
 from __future__ import annotations
 
-import functools
-import inspect
 import math
-import os
 import warnings
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -59,115 +55,37 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
-from ._deprecation import REMOVAL_VERSION, deprecated
+from ._deprecation import REMOVAL_VERSION, _MethodWithArrayShim
+from ._langevin_run import INITIAL as INITIAL
+from ._langevin_run import MODELS as MODELS
+from ._langevin_run import SCHEMES as SCHEMES
+from ._langevin_run import TAMSD_ESTIMATORS as TAMSD_ESTIMATORS
+from ._langevin_run import (
+    _check_scales,
+    _checked,
+    _estimator_code,
+    _initial_speed,
+    _initial_state,
+    _integrate,
+    _lag_steps,
+    _new_sums,
+    _result,
+    _sample_steps,
+    _tamsd_lag_steps,
+)
+from ._langevin_run import _threads as _threads  # the CLI's benchmark asks it for the cores
 from ._results import readonly
-from ._scales import SCALE_HI, SCALE_LO, check_range
 from .errors import shown
 
 if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but stay light
     from .scene import Scene
     from .theory import LangevinCoefficients
 
-MODELS = ("langevin", "udsbm")
-# the TAMSD's windows (csrc/tamsd.h): "strided" starts a lag's windows every power of
-# two <= max(1, lag/4) steps, "all" at every step
-TAMSD_ESTIMATORS = ("strided", "all")
-SCHEMES = ("em", "exact")
-INITIAL = ("thermal", "udsbm", "fixed")
+
 # Work per call into C, in particle-steps: a block of particles over the whole run, or one
 # particle over a segment of its steps -- at most ~0.6 s (exact UDSBM, ~60 ns a step),
 # so Ctrl-C is prompt however few the particles and many the steps.
 _CHUNK_PARTICLE_STEPS = 10_000_000
-
-
-class _ArrayAndMethod(np.ndarray):
-    """The transition from an array attribute to a method of the same name:
-    ``result.msd`` used to be the (T,) array and is now the method ``result.msd()``.
-    This object is both -- called, it runs the method; used as an array (indexing,
-    arithmetic, NumPy functions), it is the old array and warns (FutureWarning) that this
-    use goes in granular ``REMOVAL_VERSION``.  Results of array use are plain arrays.
-    ``inspect.signature`` gives the method's.  Goes in ``REMOVAL_VERSION`` with the array
-    use, leaving plain methods."""
-
-    _method: Any  # the bound method (None only on views made by NumPy itself)
-    _name: str
-
-    def __new__(
-        cls, values: NDArray[np.float64], method: Callable[..., NDArray[np.float64]], name: str
-    ) -> _ArrayAndMethod:
-        obj = np.asarray(values).view(cls)
-        obj._method, obj._name = method, name
-        return obj
-
-    def __array_finalize__(self, obj: object) -> None:
-        self._method = getattr(obj, "_method", None)
-        self._name = getattr(obj, "_name", "")
-
-    def __call__(self, *args: Any, **kwargs: Any) -> NDArray[np.float64]:
-        return self._method(*args, **kwargs)
-
-    @property
-    def __signature__(self) -> inspect.Signature:
-        return inspect.signature(self._method)
-
-    def _deprecated(self) -> None:
-        deprecated(
-            f"using result.{self._name} as an array",
-            f"call result.{self._name}() (the same numbers)",
-            stacklevel=4,
-        )
-
-    def __getitem__(self, index: Any) -> Any:
-        self._deprecated()
-        return self.view(np.ndarray)[index]
-
-    def __array_ufunc__(self, ufunc: np.ufunc, method: str, *inputs: Any, **kwargs: Any) -> Any:
-        self._deprecated()
-        plain = tuple(x.view(np.ndarray) if isinstance(x, _ArrayAndMethod) else x for x in inputs)
-        if "out" in kwargs:
-            kwargs["out"] = tuple(
-                x.view(np.ndarray) if isinstance(x, _ArrayAndMethod) else x for x in kwargs["out"]
-            )
-        return getattr(ufunc, method)(*plain, **kwargs)
-
-    def __array_function__(self, func: Any, types: Any, args: Any, kwargs: Any) -> Any:
-        self._deprecated()
-
-        def plain(x: Any) -> Any:
-            if isinstance(x, _ArrayAndMethod):
-                return x.view(np.ndarray)
-            if isinstance(x, (list, tuple)):
-                return type(x)(plain(y) for y in x)
-            return x
-
-        return func(*plain(args), **{k: plain(v) for k, v in kwargs.items()})
-
-    def __repr__(self) -> str:
-        return repr(self.view(np.ndarray))
-
-    def __reduce__(self) -> Any:  # pickles as the plain array it holds
-        return self.view(np.ndarray).__reduce__()
-
-
-class _MethodWithArrayShim:
-    """A method that, for one more release, is also the array it replaced: on the class it
-    is the plain function (so ``inspect.signature(LangevinResult.msd)`` and ``help`` work),
-    on a result an ``_ArrayAndMethod`` of the array in ``values`` (an attribute name).
-    Goes in ``REMOVAL_VERSION``: the methods then are plain methods."""
-
-    def __init__(self, values: str) -> None:
-        self.values = values
-
-    def __call__(self, method: Callable[..., Any]) -> _MethodWithArrayShim:
-        self.method = method
-        functools.update_wrapper(self, method)
-        return self
-
-    def __get__(self, result: Any, owner: type | None = None) -> Any:
-        if result is None:
-            return self.method
-        bound = self.method.__get__(result, owner)
-        return _ArrayAndMethod(getattr(result, self.values), bound, self.method.__name__)
 
 
 def _no_lags() -> ValueError:
@@ -177,33 +95,6 @@ def _no_lags() -> ValueError:
         "before the run, with langevin.run(..., tamsd_lags=[...]) -- lags in time, whole "
         "steps of dt, at most t_stop (e.g. tamsd_lags=[dt, 10 * dt, 100 * dt])"
     )
-
-
-def _lag_steps(lags: ArrayLike, dt: float, n_steps: int, name: str) -> NDArray[np.int64]:
-    """Lags in time as whole numbers of steps, 1 to ``n_steps``.  The engine samples the
-    path at whole steps only, so a lag between two steps is refused with the nearest two
-    that are whole steps, rather than rounded to one of them unseen (``Trajectory.tamsd``
-    refuses a lag off its samples in the same way)."""
-    from .analysis import _nearest_on_grid
-
-    t = np.asarray(lags, dtype=np.float64).reshape(-1)
-    k = np.rint(t / dt)
-    inside = (k >= 1) & (k <= n_steps)  # NaN fails too
-    if not np.all(inside):
-        raise ValueError(
-            f"{name} must be at least dt and at most t_stop ({shown(dt)} .. "
-            f"{shown(n_steps * dt)}), got {shown(t[~inside][0])}"
-        )
-    off = ~np.isclose(t, k * dt, rtol=1e-9, atol=0.0)
-    if np.any(off):
-        lag = float(t[off][0])
-        raise ValueError(
-            f"{name}: {shown(lag)} is not a whole number of steps of dt = {shown(dt)}, and the "
-            f"engine samples the path at whole steps only; the nearest lags that are: "
-            f"{_nearest_on_grid(lag, dt, n_steps)} (to round lags to whole steps: "
-            f"numpy.unique(numpy.rint(lags / dt)) * dt)"
-        )
-    return k.astype(np.int64)
 
 
 def _lag_indices(
@@ -637,113 +528,6 @@ def theory_tamsd(
     return np.array(out)
 
 
-def _estimator_code(name: str) -> int:
-    if name not in TAMSD_ESTIMATORS:
-        raise ValueError(f"tamsd_estimator must be one of {TAMSD_ESTIMATORS}, got {name!r}")
-    return TAMSD_ESTIMATORS.index(name)
-
-
-def _threads(threads: int | None) -> int:
-    """The number of threads asked for, checked; None: the cores this process may use."""
-    if threads is None:
-        try:
-            return max(1, len(os.sched_getaffinity(0)))
-        except AttributeError:  # not on Linux
-            return max(1, os.cpu_count() or 1)
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
-        raise ValueError(f"threads must be a whole number >= 1 or None, got {shown(threads)}")
-    return min(int(threads), 1024)
-
-
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (value > 0 and math.isfinite(value)):
-        raise ValueError(f"{name} must be positive and finite, got {value}")
-    return value
-
-
-def _check_scales(
-    gamma0: float,
-    D0: float,
-    dt: float,
-    t_stop: float,
-    tau0: float,
-    exponent: float,
-    mass: float,
-    speed_name: str,
-    speed: float,
-) -> None:
-    """Refuse coefficients whose squares and products would leave float64 over the run,
-    with the limits of granular._scales: the times dt, t_stop, tau0 and the rate gamma0
-    (multiplied by one another) each within SCALE_LO .. SCALE_HI; the products D0 (a length
-    squared per time), D0 gamma0 (the thermal speed squared) and the mass within their
-    squares.  The initial speed (``speed``, rms over the components) is bounded from above
-    only, as the scene's speeds are, and so is the largest MSD the run can reach: ballistic,
-    at most speed^2 t_stop^2, or diffusive, at most 2 dim D0 t_stop (the friction and the
-    diffusivity only decay), so speed t_stop and D0 t_stop are bounded by SCALE_HI and
-    SCALE_HI^2.  Each MSD then stays below ~1e281, and its sums over particles and windows
-    finite.  UDSBM's friction and diffusivity at t_stop, gamma0 and D0 times
-    (1 + t_stop/tau0)^-exponent, stay above the lower limits: a friction that underflows to
-    0 would divide 0 by 0 in the exact step."""
-    lo, hi = SCALE_LO, SCALE_HI
-
-    def check(name: str, value: float, low: float, high: float, advice: str = "") -> None:
-        check_range(
-            name,
-            value,
-            low,
-            high,
-            "the Langevin arithmetic (squared displacements and speeds, summed over "
-            "particles and windows)",
-            advice
-            or "choose units in which the times, D0, the speeds and the mass are nearer 1 "
-            "(e.g. 1/gamma0, the thermal speed sqrt(D0 gamma0) and the particles' mass)",
-        )
-
-    for name, value in (("dt", dt), ("t_stop", t_stop), ("gamma0", gamma0)):
-        check(name, value, lo, hi)
-    if math.isfinite(tau0):
-        check("tau0", tau0, lo, hi)
-    check("D0", D0, lo * lo, hi * hi)
-    check("mass", mass, lo * lo, hi * hi)
-    check("D0 * gamma0 (the thermal speed squared)", D0 * gamma0, lo * lo, hi * hi)
-    check(
-        "D0 * t_stop (the diffusive MSD's scale)",
-        D0 * t_stop,
-        0.0,
-        hi * hi,
-        f"D0 at most {hi * hi / t_stop:.3g} for t_stop = {shown(t_stop)}",
-    )
-    check(speed_name, speed, 0.0, hi)
-    check(
-        f"{speed_name} * t_stop (the ballistic displacement)",
-        speed * t_stop,
-        0.0,
-        hi,
-        f"{speed_name} at most {hi / t_stop:.3g} for t_stop = {shown(t_stop)}",
-    )
-    fastest = max(speed, math.sqrt(D0 * gamma0))
-    check(
-        f"mass * speed^2 (the temperature's scale, speed = {fastest:.3g})",
-        mass * fastest * fastest,
-        0.0,
-        hi * hi,
-    )
-    if math.isfinite(tau0):
-        # in logarithms: the decay factor itself may be below the smallest float64
-        decay = -exponent * math.log10(1.0 + t_stop / tau0)
-        for name, value, low in (("gamma0", gamma0, lo), ("D0", D0, lo * lo)):
-            at_end = math.log10(value) + decay
-            if at_end < math.log10(low):
-                raise ValueError(
-                    f"UDSBM's {name} at t_stop, {name} (1 + t_stop/tau0)^-exponent = "
-                    f"10^{at_end:.4g}, is below {low:g}, the range in which the Langevin "
-                    f"arithmetic stays within float64: a shorter t_stop, a longer tau0 or a "
-                    f"smaller exponent (here {name} = {shown(value)}, t_stop = "
-                    f"{shown(t_stop)}, tau0 = {shown(tau0)}, exponent = {shown(exponent)})"
-                )
-
-
 def run(
     n: int,
     *,
@@ -831,240 +615,28 @@ def run(
     MemoryError
         Stored positions or the every-window TAMSD's rings that would not fit.
     """
-    n = int(n)
-    if n < 1:
-        raise ValueError(f"n must be >= 1, got {n}")
-    threads = _threads(threads)
-    mass = _positive("mass", mass)
-    estimator = _estimator_code(tamsd_estimator)
-    if dim not in (1, 2, 3):
-        raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
-    gamma0, D0, dt, t_stop = (
-        _positive(k, v) for k, v in (("gamma0", gamma0), ("D0", D0), ("dt", dt), ("t_stop", t_stop))
-    )
-    tau0 = float(tau0)
-    if not tau0 > 0:
-        raise ValueError(f"tau0 must be positive (inf for the Langevin model), got {tau0}")
-    if model is None:
-        model = "langevin" if math.isinf(tau0) else "udsbm"
-    if model not in MODELS:
-        raise ValueError(f"model must be one of {MODELS}, got {model!r}")
-    if model == "udsbm" and math.isinf(tau0):
-        raise ValueError("UDSBM needs a finite tau0")
-    exponent = float(exponent)
-    if not (exponent > 0 and math.isfinite(exponent)):
-        raise ValueError(
-            f"exponent must be positive and finite (UDSBM's (1 + t/tau0)^-exponent), got {exponent}"
-        )
-    if model == "langevin":
-        if exponent != 1.0:
-            raise ValueError(
-                "exponent is UDSBM's (model='udsbm'); the Langevin model has constant "
-                f"coefficients, got exponent={exponent}"
-            )
-        tau0 = math.inf
-    if scheme not in SCHEMES:
-        raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
-    if scheme == "em" and gamma0 * dt >= 2.0:
-        from .errors import UnstableStepError
-
-        raise UnstableStepError(
-            f"Euler-Maruyama diverges for gamma0*dt >= 2 (here {gamma0 * dt:.4g}); take "
-            f"dt < {2 / gamma0:.4g} or scheme='exact', which is stable at any step",
-            value=gamma0 * dt,
-        )
-    n_steps_f = t_stop / dt  # in float first: it may be past any int64, or infinite
-    if not n_steps_f <= _core.SDE_MAX_STEPS:
-        raise ValueError(
-            f"t_stop / dt = {t_stop!r} / {dt!r} = {n_steps_f:.4g} steps; a run "
-            f"takes at most 2**62 = {_core.SDE_MAX_STEPS:.4g}"
-        )
-    n_steps = round(n_steps_f)
-    if n_steps < 1:
-        raise ValueError("t_stop must be at least one step")
-
-    # sample steps and lags are compared with n_steps as floats, before they become int64
-    if sample_times is None:
-        steps_f = np.minimum(np.rint(np.logspace(0, math.log10(n_steps), 60)), n_steps)
-        steps_f = np.concatenate([[0], steps_f, [n_steps]])
-    else:
-        st = np.asarray(sample_times, dtype=np.float64).reshape(-1)
-        if not np.all(np.isfinite(st)) or np.any(st < 0):
-            raise ValueError("sample_times must be finite and >= 0")
-        if np.any(np.diff(st) <= 0):
-            raise ValueError("sample_times must be strictly increasing")
-        steps_f = np.rint(st / dt)  # whole steps; times within one step merge
-        if len(steps_f) and not steps_f[-1] <= n_steps:
-            raise ValueError(f"sample_times reach past t_stop = {n_steps * dt}")
-    steps = np.unique(steps_f).astype(np.int64)
-    if tamsd_lags is None:
-        lags = np.zeros(0, dtype=np.int64)
-    else:
-        lag_t = np.asarray(tamsd_lags, dtype=np.float64).reshape(-1)
-        if np.any(np.diff(lag_t) <= 0):
-            raise ValueError("tamsd_lags must be strictly increasing")
-        lags = _lag_steps(lag_t, dt, n_steps, "tamsd_lags")
-        if np.any(np.diff(lags) == 0):  # two lags within 1e-9 of one step
-            same = int(np.argmin(np.diff(lags)))
-            raise ValueError(
-                f"tamsd_lags {float(lag_t[same])!r} and {float(lag_t[same + 1])!r} are the "
-                f"same number of steps of dt = {shown(dt)}: give each lag once"
-            )
-
-    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
-    key_seq, vel_seq = ss.spawn(2)
-    key = int(key_seq.generate_state(1, dtype=np.uint64)[0])
-    rng = np.random.default_rng(vel_seq)
-    thermal = D0 * gamma0  # T0/m (2.55)
-    if initial == "thermal":
-        v0_sq = thermal
-        v = rng.normal(scale=math.sqrt(v0_sq), size=(n, dim))
-    elif initial == "udsbm":
-        if model != "udsbm":
-            raise ValueError("initial='udsbm' is App. C's initial speed of the UDSBM model")
-        if exponent != 1.0:
-            raise ValueError(
-                "initial='udsbm' is App. C's initial speed for exponent 1; with exponent "
-                f"{exponent} start 'thermal' or 'fixed' (theory.msd_powerlaw_udsbm takes any "
-                "initial speed)"
-            )
-        from .theory import udsbm_v0_sq
-
-        v0_sq = udsbm_v0_sq(D0=D0, gamma0=gamma0, tau0=tau0)
-        v = rng.normal(scale=math.sqrt(v0_sq), size=(n, dim))
-    elif initial == "fixed":
-        s = math.sqrt(dim * thermal) if speed is None else _positive("speed", speed)
-        g = rng.normal(size=(n, dim))
-        g /= np.maximum(np.linalg.norm(g, axis=1), 1e-300)[:, None]
-        v = s * g
-        v0_sq = s * s / dim
-    else:
-        raise ValueError(f"initial must be one of {INITIAL}, got {initial!r}")
-    if initial == "fixed" and speed is not None:
-        speed_name, rms = "speed", s
-    else:
-        speed_name, rms = (
-            f"the initial rms speed sqrt(dim v0_sq) ({initial})",
-            math.sqrt(dim * v0_sq),
-        )
-    _check_scales(gamma0, D0, dt, t_stop, tau0, exponent, mass, speed_name, rms)
-
-    T, L = len(steps), len(lags)
-    if store_positions:
-        need = 8.0 * T * n * dim
-        if need > 8e9:
-            raise MemoryError(
-                f"storing positions needs {need / 2**30:.1f} GiB; sample fewer "
-                "times or leave store_positions off (the MSD is accumulated anyway)"
-            )
-    x = np.zeros((n, dim))
-    x2 = np.zeros((T, dim))
-    v2 = np.zeros((T, dim))
-    positions = np.zeros((T, n, dim)) if store_positions else None
-    tamsd_sum = np.zeros((n, L))
-    model_code = MODELS.index(model)
-    scheme_code = SCHEMES.index(scheme)
-    # Chunk by work: blocks of particles over all steps while a particle's run is short,
-    # else one particle at a time over segments of its steps (the C core carries such a
-    # particle's past positions from segment to segment in `ring`).  The same numbers to
-    # the bit either way.
-    # A call of blocks of particles takes `threads` times the work (the threads share it);
-    # a segment of one particle's steps runs on one thread.
-    work = max(1, _CHUNK_PARTICLE_STEPS)
-    steps_per_call = min(n_steps, work)
-    per_call = max(1, work * threads // n_steps) if steps_per_call == n_steps else 1
-    # whole blocks of particles for every thread (the C core gives each thread whole blocks
-    # of SDE_BLOCK, the ensemble sums' unit): 100 particles on 2 threads would be 64 + 36
-    for unit in (_core.SDE_BLOCK * threads, _core.SDE_BLOCK):
-        if per_call >= unit:
-            per_call -= per_call % unit
-            break
-    ring_size = _core.sde_ring_size(dim, lags, estimator)
-    if 8.0 * ring_size * threads > 2**31:
-        raise MemoryError(
-            f"tamsd_estimator={tamsd_estimator!r} keeps {8.0 * ring_size / 2**30:.1f} GiB of "
-            f"past positions per thread for lags up to {int(lags[-1])} steps; take "
-            "tamsd_estimator='strided' (a few kB) or fewer threads"
-        )
-    ring = np.zeros(ring_size)
-    carry = np.zeros((2, T, dim))  # the ensemble sums of a block of particles left open
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=n * n_steps, unit="particle-step", unit_scale=True, leave=False)
-    try:
-        for first in range(0, n, per_call):
-            xs = np.ascontiguousarray(x[first : first + per_call])
-            vs = np.ascontiguousarray(v[first : first + per_call])
-            for step_from in range(0, n_steps, steps_per_call):
-                step_to = min(step_from + steps_per_call, n_steps)
-                _core.sde_run(
-                    dim,
-                    model_code,
-                    scheme_code,
-                    gamma0,
-                    D0,
-                    tau0,
-                    dt,
-                    key,
-                    n,
-                    first,
-                    step_from,
-                    step_to,
-                    n_steps,
-                    xs,
-                    vs,
-                    steps,
-                    x2,
-                    v2,
-                    positions,
-                    lags,
-                    tamsd_sum,
-                    ring,
-                    carry,
-                    threads,
-                    estimator,
-                    exponent=exponent,
-                )
-                if bar is not None:
-                    bar.update(len(xs) * (step_to - step_from))
-            x[first : first + len(xs)] = xs
-            v[first : first + len(vs)] = vs
-    finally:
-        if bar is not None:
-            bar.close()
-
-    strides = np.array([_core.sde_lag_stride(int(k), estimator) for k in lags], dtype=np.int64)
-    windows = (n_steps - lags) // np.maximum(strides, 1) + 1
-    per_particle = tamsd_sum / windows if L else tamsd_sum
-    return LangevinResult(
-        times=(steps * dt).astype(np.float64, copy=False),
-        steps=steps,
-        msd_total=x2.sum(1) / n,
-        msd_per_dimension=x2 / n,
-        v2=v2.sum(1) / n,
-        tamsd_lags=(lags * dt).astype(np.float64, copy=False),
-        tamsd_mean=per_particle.mean(0) if L else np.zeros(0),
-        tamsd_per_particle=per_particle,
-        positions=positions,
-        final_positions=x,
-        final_velocities=v,
-        model=model,
-        scheme=scheme,
-        tamsd_estimator=tamsd_estimator,
+    p = _checked(
+        n,
         gamma0=gamma0,
         D0=D0,
-        tau0=tau0,
         dt=dt,
-        n=n,
+        t_stop=t_stop,
+        tau0=tau0,
+        model=model,
+        exponent=exponent,
+        scheme=scheme,
         dim=dim,
-        t_stop=n_steps * dt,
-        v0_sq=v0_sq,
-        exponent=exponent if model == "udsbm" else 1.0,
-        initial=initial,
+        threads=threads,
         mass=mass,
+        tamsd_estimator=tamsd_estimator,
     )
+    steps = _sample_steps(sample_times, p.dt, p.n_steps)
+    lags = _tamsd_lag_steps(tamsd_lags, p.dt, p.n_steps)
+    key, x, v, v0_sq = _initial_state(p, initial, speed, seed)
+    _check_scales(p, *_initial_speed(initial, speed, p.dim, v0_sq))
+    sums = _new_sums(p, steps, lags, store_positions)
+    _integrate(p, key, x, v, steps, lags, sums, progress, work=_CHUNK_PARTICLE_STEPS)
+    return _result(p, initial, steps, lags, sums, x, v, v0_sq)
 
 
 def coefficients_from_scene(scene: Scene) -> LangevinCoefficients:

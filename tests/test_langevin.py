@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import granular
-from granular import langevin, theory
+from granular import _langevin_run, langevin, theory
 
 from helpers import sde_bits, sde_reference
 
@@ -946,3 +946,18 @@ def test_every_compilation_of_the_batched_normals_gives_the_same_bits(kernel):
         pytest.skip(f"this CPU does not run the {kernel} compilation (got {out[0]})")
     want = json.loads((tests / "sde_bits.json").read_text())
     assert json.loads(out[1]) == want
+
+
+def test_the_engine_arguments_are_built_in_the_bindings_order():
+    """_core.sde_run reads most of its arguments by position (csrc/_core.c, sde_run's
+    names[] and format), so two swapped numbers (gamma0 and D0, say) would run unseen;
+    run builds them by name in one place, _sde_args, whose order must be the binding's.
+    Each argument is given its own name as value: the tuple must read the binding's names
+    in the binding's order."""
+    source = Path(__file__).resolve().parent.parent / "csrc" / "_core.c"
+    if not source.is_file():
+        pytest.skip("needs the source tree (csrc/_core.c)")
+    binding = source.read_text().split("static PyObject *sde_run(", 1)[1]
+    names = re.findall(r'"(\w+)"', re.search(r"names\[\] = \{(.*?)NULL\}", binding, re.S)[1])
+    assert names[:3] == ["dim", "model", "scheme"] and names[-1] == "exponent", names
+    assert _langevin_run._sde_args(**{k: k for k in names}) == tuple(names)
