@@ -297,7 +297,7 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
     for (int a = 0; a < dim; a++) {
         dr[a] = q[a] - p[a];
         /* contact distance < L/2, so the nearest image is the one */
-        if (s->cfg.periodic) dr[a] = nearest_image(dr[a], s->L[a]);
+        if (s->cfg.periodic) dr[a] = bd_nearest(dr[a], s->L[a]);
     }
     double xi = s->cfg.restitution;
     int64_t clamped = 0; /* 1 if xi is the law's at its range's end */
@@ -360,7 +360,8 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
     v[a] = -v[a];
     if (ew != 1.0)
         for (int k = 0; k < dim; k++) v[k] *= ew; /* law of reflection kept (2.22) */
-    p[a] = up ? s->cfg.hi[a] - RAD(p, dim) : s->cfg.lo[a] + RAD(p, dim);
+    p[a] = up ? bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim))
+              : bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim));
     for (int k = 0; k < dim; k++) {
         if (!isfinite(v[k])) {
             gr_error_set(err, GR_ERR_NONFINITE, uid(s, i), -1, t, v[k], "a velocity after a heated wall");
@@ -396,14 +397,12 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, d
     move(dyn, dim, p, t);
     int32_t old = cell_of(&s->cells, dim, c);
     int32_t q = c[a] + dir;
-    if (q >= s->cells.nc[a]) {
+    if (q >= s->cells.nc[a]) { /* out of the last cell: out of a periodic box (boundary.h) */
         q = 0;
-        p[a] -= s->L[a];
-        s->image[(size_t)i * dim + a]++;
+        bd_through_face(&p[a], s->L[a], &s->image[(size_t)i * dim + a], 1);
     } else if (q < 0) {
         q = s->cells.nc[a] - 1;
-        p[a] += s->L[a];
-        s->image[(size_t)i * dim + a]--;
+        bd_through_face(&p[a], s->L[a], &s->image[(size_t)i * dim + a], 0);
     }
     c[a] = q;
     if (!s->big.is_big[i]) {
@@ -434,17 +433,9 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
     move(dyn, dim, p, t);
     int wrapped = 0;
     if (s->cfg.periodic) {
-        for (int a = 0; a < dim; a++) {
-            if (p[a] >= s->cfg.hi[a]) {
-                p[a] -= s->L[a];
-                s->image[(size_t)i * dim + a]++;
-                wrapped = 1;
-            } else if (p[a] < s->cfg.lo[a]) {
-                p[a] += s->L[a];
-                s->image[(size_t)i * dim + a]--;
-                wrapped = 1;
-            }
-        }
+        for (int a = 0; a < dim; a++)
+            wrapped |= bd_reenter(&p[a], s->cfg.lo[a], s->cfg.hi[a], s->L[a],
+                                  &s->image[(size_t)i * dim + a]);
     }
     /* the neighbours' list lengths and rows are misses: ask for all of them first (with
      * relinking, for the few that leave; the search for new ones gives them time) */
@@ -537,8 +528,8 @@ static inline void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i)
     int32_t wall = -1;
     for (int a = 0; a < dim; a++) {
         double dt;
-        const int up = fl_wall_time(dyn, p[a], v[a], s->cfg.lo[a] + RAD(p, dim),
-                                    s->cfg.hi[a] - RAD(p, dim), &dt);
+        const int up = fl_wall_time(dyn, p[a], v[a], bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim)),
+                                    bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim)), &dt);
         if (up < 0) continue;
         if (dt < 0.0) dt = 0.0;
         if (dt < best) {
@@ -567,7 +558,7 @@ static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dyn, int dim, int3
         double dt = fl_cross_time(dyn, p[a], VEL(p, dim)[a], s->cfg.lo[a], c[a], g->w[a], &up,
                                   &open);
         if (!periodic) /* a wall has no cell behind it */
-            open &= (up & (c[a] < g->nc[a] - 1)) | (!up & (c[a] > 0));
+            open &= bd_cell_beyond(up, c[a], g->nc[a]);
         dt = open ? dt : INFINITY;
         const int32_t earlier = dt < best;
         code += earlier * (2 * a + up - code); /* arithmetic: a select compiles to a branch */

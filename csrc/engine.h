@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "big.h"
+#include "boundary.h"
 #include "calendar.h"
 #include "cells.h"
 #include "edmd.h"
@@ -96,13 +97,6 @@ static inline double *rec(const gr_edmd *s, int dim, int32_t i)
 
 /* The caller's index of internal particle i (negative codes pass through). */
 static inline int64_t uid(const gr_edmd *s, int32_t i) { return i < 0 ? -1 : s->order.id_of[i]; }
-
-/* The separation d along an axis of periodic length L seen through the nearest image
- * (|d| < 3L/2, as between particles in the box). */
-static inline double nearest_image(double d, double L)
-{
-    return d > 0.5 * L ? d - L : d < -0.5 * L ? d + L : d;
-}
 
 /* The dynamics of system s (flight.h): constant velocity, the only one so far.  A second
  * one is a config field read here, and gr_edmd_advance chooses its loop from it. */

@@ -17,8 +17,8 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
         for (int a = 0; a < dim; a++) {
             double v = fl_vel_at(dyn, VEL(p, dim)[a], dt);
             if (smp->pos)
-                smp->pos[out + a] = fl_at(dyn, p[a], VEL(p, dim)[a], dt) +
-                                    (double)s->image[(size_t)i * dim + a] * s->L[a];
+                smp->pos[out + a] = bd_unwrap(fl_at(dyn, p[a], VEL(p, dim)[a], dt),
+                                              s->image[(size_t)i * dim + a], s->L[a]);
             if (smp->vel) smp->vel[out + a] = v;
             mom[a] += m * v;
             kin += 0.5 * m * v * v;
@@ -44,11 +44,8 @@ void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image)
             double x = fl_at(dyn, p[a], VEL(p, d)[a], dt);
             int64_t img = s->image[(size_t)i * d + a];
             size_t out = (size_t)s->order.id_of[i] * d + a;
-            if (s->cfg.periodic) {
-                /* a crossing due exactly now may not have been processed yet */
-                if (x >= s->cfg.hi[a]) { x -= s->L[a]; img++; }
-                else if (x < s->cfg.lo[a]) { x += s->L[a]; img--; }
-            }
+            /* a crossing due exactly now may not have been processed yet */
+            if (s->cfg.periodic) bd_reenter(&x, s->cfg.lo[a], s->cfg.hi[a], s->L[a], &img);
             if (pos) pos[out] = x;
             if (vel) vel[out] = fl_vel_at(dyn, VEL(p, d)[a], dt);
             if (image) image[out] = img;

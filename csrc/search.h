@@ -35,7 +35,7 @@ static GR_ALWAYS_INLINE void try_pair(const gr_edmd *s, int dyn, int dim, int32_
     for (int a = 0; a < dim; a++) {
         dr[a] = fl_sep(dyn, q[a], VEL(q, dim)[a], dtj, p[a]);
         if (shift) dr[a] += shift[a];
-        if (nearest) dr[a] = nearest_image(dr[a], s->L[a]);
+        if (nearest) dr[a] = bd_nearest(dr[a], s->L[a]);
         dv[a] = fl_relvel(dyn, VEL(q, dim)[a], VEL(p, dim)[a]);
     }
     double dt;
@@ -193,7 +193,7 @@ static void scan_block(const gr_edmd *s, int dyn, int dim, int32_t i, int axis, 
         int32_t reach = (int32_t)ceil((RAD(p, dim) + s->big.r_small) / g->w[a]);
         lo[a] = a == axis ? c[a] + dir * reach : c[a] - reach;
         hi[a] = a == axis ? lo[a] : c[a] + reach;
-        if (!s->cfg.periodic) {
+        if (!s->cfg.periodic) { /* walls: the block ends at them */
             if (lo[a] < 0) lo[a] = 0;
             if (hi[a] > g->nc[a] - 1) hi[a] = g->nc[a] - 1;
             if (lo[a] > hi[a]) return; /* the layer lies beyond a wall */
@@ -202,11 +202,11 @@ static void scan_block(const gr_edmd *s, int dyn, int dim, int32_t i, int axis, 
     /* beyond dim, lo = hi = 0 and nc = 1: one pass */
     int32_t q[3] = {0, 0, 0};
     for (int32_t k2 = lo[2]; k2 <= hi[2]; k2++) {
-        q[2] = (k2 % g->nc[2] + g->nc[2]) % g->nc[2];
+        q[2] = bd_cell_wrap(k2, g->nc[2]);
         for (int32_t k1 = lo[1]; k1 <= hi[1]; k1++) {
-            q[1] = (k1 % g->nc[1] + g->nc[1]) % g->nc[1];
+            q[1] = bd_cell_wrap(k1, g->nc[1]);
             for (int32_t k0 = lo[0]; k0 <= hi[0]; k0++) {
-                q[0] = (k0 % g->nc[0] + g->nc[0]) % g->nc[0];
+                q[0] = bd_cell_wrap(k0, g->nc[0]);
                 int32_t cell = cell_of(g, dim, q);
                 if (!cell_occupied(g, cell)) continue;
                 for (int32_t j = g->head[cell]; j >= 0; j = g->next[j])
