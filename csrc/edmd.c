@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "engine.h"
+#include "rule.h"
 #include "search.h"
 
 /* Everything an event of particle i is about to read or write, requested at once.  A
@@ -271,22 +272,6 @@ static inline int streak(gr_edmd *s, int32_t i, double t)
     return e->streak > GR_COLLAPSE_STREAK;
 }
 
-/* The restitution law's eps for a pair at contact: its normal approach speed
- * |dv . dr| / |dr| (0 for a pair that does not approach: gr_pair_collide refuses it).
- * *clamped += 1 if the speed is past the law's range; the caller adds that to
- * s->law_clamped only if this eps is the one applied (not replaced by the TC model). */
-static double pair_law(const gr_edmd *s, int dim, const double *dr, const double *vi,
-                       const double *vj, int64_t *clamped)
-{
-    double b = 0.0, dr2 = 0.0;
-    for (int a = 0; a < dim; a++) {
-        b += dr[a] * (vj[a] - vi[a]);
-        dr2 += dr[a] * dr[a];
-    }
-    double vn = b < 0.0 && dr2 > 0.0 ? -b / sqrt(dr2) : 0.0;
-    return gr_law_eval(&s->cfg.law, vn, clamped);
-}
-
 static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
                                     double t, gr_error *err)
 {
@@ -299,19 +284,11 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
         /* contact distance < L/2, so the nearest image is the one */
         if (s->cfg.periodic) dr[a] = bd_nearest(dr[a], s->L[a]);
     }
-    double xi = s->cfg.restitution;
-    int64_t clamped = 0; /* 1 if xi is the law's at its range's end */
-    if (laws && s->cfg.law.kind != GR_LAW_CONSTANT)
-        xi = pair_law(s, dim, dr, VEL(p, dim), VEL(q, dim), &clamped);
-    if (s->cfg.contact_duration > 0.0 && xi < 1.0 &&
-        (t - s->sched[i].t_last < s->cfg.contact_duration ||
-         t - s->sched[j].t_last < s->cfg.contact_duration)) {
-        xi = 1.0; /* TC model: within t_c of a previous collision, collide elastically */
-        s->elastic_tc++;
-        clamped = 0; /* the clamped eps is not the one applied */
-    }
+    int64_t clamped; /* 1 if xi is the law's at its range's end */
+    const double xi = rule_pair_eps(&s->cfg, laws, dim, dr, VEL(p, dim), VEL(q, dim), t,
+                                    &s->sched[i], &s->sched[j], &clamped, &s->elastic_tc);
     double before = kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j);
-    double vir = gr_pair_collide(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
+    double vir = rule_pair_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
     if (vir < 0.0) { /* grazing: no longer approaching at contact after rounding */
         s->invalid++;
         predict(s, dyn, dim, i);
@@ -347,19 +324,10 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
     const int a = wall >> 1, up = wall & 1;
     move(dyn, dim, p, t);
     double before = kinetic_of(s, dyn, dim, i), vn = v[a];
-    double ew = s->cfg.wall_restitution;
-    int64_t clamped = 0; /* 1 if e_w is the law's at its range's end */
-    /* a law gives e_w of the same rule (2.22) from the normal impact speed |v_a| */
-    if (laws && s->cfg.wall_law.kind != GR_LAW_CONSTANT)
-        ew = gr_law_eval(&s->cfg.wall_law, fabs(vn), &clamped);
-    if (ew < 1.0 && s->cfg.contact_duration > 0.0 && t - s->sched[i].t_last < s->cfg.contact_duration) {
-        ew = 1.0;
-        clamped = 0; /* TC model: the clamped e_w is not the one applied */
-    }
+    int64_t clamped; /* 1 if e_w is the law's at its range's end */
+    const double ew = rule_wall_eps(&s->cfg, laws, vn, t, &s->sched[i], &clamped);
     s->law_clamped += clamped;
-    v[a] = -v[a];
-    if (ew != 1.0)
-        for (int k = 0; k < dim; k++) v[k] *= ew; /* law of reflection kept (2.22) */
+    rule_wall_apply(dim, v, a, ew);
     p[a] = up ? bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim))
               : bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim));
     for (int k = 0; k < dim; k++) {
