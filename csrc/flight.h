@@ -71,13 +71,14 @@ static inline double fl_vel_at(int dyn, double v, double dt)
     return v;
 }
 
-/* Advance a record (x[dim] v[dim] at its own clock *t) to time t. */
-static inline void fl_move(int dyn, int dim, double *x, double *v, double *clock, double t)
+/* Advance a particle (position x[dim], velocity v[dim], both at its own clock *t_own) to
+ * time t, and its clock with it. */
+static inline void fl_move(int dyn, int dim, double *x, double *v, double *t_own, double t)
 {
-    double dt = t - *clock;
+    double dt = t - *t_own;
     for (int a = 0; a < dim; a++) x[a] += v[a] * dt;
     (void)dyn;
-    *clock = t;
+    *t_own = t;
 }
 
 /* One axis of the separation of q from p at p's clock (see GR_FL_SEP). */
