@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "boundary.h"
 #include "cells.h"
 #include "hugemem.h"
 
@@ -85,13 +86,8 @@ int gr_cells_build(gr_cells *g, int dim, int32_t n, const double *lo, const doub
         if (!g->nb_cell[a] || !g->nb_shift[a]) return GR_ERR_NOMEM;
         for (int c = 0; c < m; c++) {
             for (int dd = -1; dd <= 1; dd++) {
-                int q = c + dd;
-                double shift = 0.0;
-                if (q < 0 || q >= m) {
-                    if (!periodic) { q = -1; }
-                    else if (q < 0) { q += m; shift = -L[a]; }
-                    else { q -= m; shift = L[a]; }
-                }
+                double shift;
+                const int q = bd_cell_step(c + dd, m, periodic, L[a], &shift);
                 g->nb_cell[a][3 * c + dd + 1] = q;
                 g->nb_shift[a][3 * c + dd + 1] = shift;
             }

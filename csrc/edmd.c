@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "engine.h"
+#include "rule.h"
 #include "search.h"
 
 /* Everything an event of particle i is about to read or write, requested at once.  A
@@ -68,7 +69,7 @@ static GR_ALWAYS_INLINE void prefetch_ahead(gr_edmd *s, int dim)
     s->foreseen[1] = ahead[2];
 }
 
-static void set_clock(gr_edmd *s, double t);
+static void set_clock(gr_edmd *s, int dyn, double t);
 static double next_sample(const gr_edmd_samples *smp);
 
 /* The collision count 2 * pair + wall at which s->kinetic is next summed anew: the next
@@ -83,20 +84,22 @@ static double next_resum(const gr_edmd *s)
 /* The events are inlined into each of the four loops (as GCC did by itself for the two
  * loops before laws came): each loop then holds its own copy, compiled for its dim and
  * laws, and the constant-restitution loops execute exactly the instructions they did. */
-static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
+static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
                                     double t, gr_error *err);
-static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall,
+static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int wall,
                                     double t, gr_error *err);
-static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t);
-static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t,
+static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, double t);
+static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i, double t,
                                           gr_error *err);
-static void predict(gr_edmd *s, int dim, int32_t i);
+static void predict(gr_edmd *s, int dyn, int dim, int32_t i);
 
-/* The loop, for dimension dim and for laws = 0 (constant restitution) or 1 (a
- * restitution law, restitution.h), constants in each of the four advance_* below: a
- * constant-xi run executes the loop compiled without any law code, not a test per
- * collision. */
-static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
+/* The loop, for dynamics dyn (flight.h: how particles move between events), dimension
+ * dim and laws = 0 (constant restitution) or 1 (a restitution law, restitution.h),
+ * constants in each of the four advance_* below: a constant-xi run executes the loop
+ * compiled without any law code, not a test per collision, and each dynamics gets its
+ * own loop the same way (constant velocity, GR_FLIGHT_LINEAR, is the only one so far: a
+ * new one adds its advance_* and its choice in gr_edmd_advance, and no line here). */
+static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, const int laws,
                                     const gr_edmd_stop *stop, gr_edmd_samples *smp,
                                     gr_error *err)
 {
@@ -141,10 +144,10 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
                    smp->times[smp->next] <= t_stop) {
                 double ts = smp->times[smp->next];
                 gr_write_sample(s, smp, ts);
-                set_clock(s, ts);
+                set_clock(s, dyn, ts);
             }
             if (te > t_stop) {
-                set_clock(s, t_stop);
+                set_clock(s, dyn, t_stop);
                 return GR_STOP_TIME;
             }
             if (te == INFINITY) return GR_STOP_IDLE;
@@ -160,7 +163,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
             s->same_instant = 0;
             s->t_prev_event = te;
         }
-        set_clock(s, te);
+        set_clock(s, dyn, te);
         s->events++;
         gr_sched *e = &s->sched[i];
         if (s->lookahead) prefetch_ahead(s, dim);
@@ -171,19 +174,19 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
         }
         int status = GR_OK;
         if (e->t_cross < e->t_coll) {
-            if (s->nl.shell > 0.0) status = do_shell_exit(s, dim, i, te, err);
-            else do_cross(s, dim, i, te);
+            if (s->nl.shell > 0.0) status = do_shell_exit(s, dyn, dim, i, te, err);
+            else do_cross(s, dyn, dim, i, te);
         } else if (e->partner >= 0) {
             if (s->sched[e->partner].count != e->pcount) { /* partner collided since: stale */
                 s->invalid++;
-                move(dim, rec(s, dim, i), te);
-                predict(s, dim, i);
+                move(dyn, dim, rec(s, dim, i), te);
+                predict(s, dyn, dim, i);
                 continue;
             }
-            status = do_pair(s, dim, laws, i, e->partner, te, err);
+            status = do_pair(s, dyn, dim, laws, i, e->partner, te, err);
             check = 1;
         } else {
-            status = do_wall(s, dim, laws, i, -2 - e->partner, te, err);
+            status = do_wall(s, dyn, dim, laws, i, -2 - e->partner, te, err);
             check = 1;
         }
         if (status != GR_OK) return status;
@@ -192,7 +195,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
             const double count = (double)(2 * s->pair + s->wall);
             if (count >= resum || s->kinetic <= kinetic) { /* rarely: resum <= collisions */
                 if (count >= collisions) return GR_STOP_COLLISIONS;
-                s->kinetic = kinetic_total(s, dim);
+                s->kinetic = kinetic_total(s, dyn, dim);
                 if (count >= resum) resum = fmin(collisions, next_resum(s));
                 if (stop->energy && s->kinetic <= kinetic) return GR_STOP_ENERGY;
             }
@@ -202,24 +205,24 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dim, const int laws,
 
 static int advance_2d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
-    return advance(s, 2, 0, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 2, 0, stop, smp, err);
 }
 
 static int advance_3d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
-    return advance(s, 3, 0, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 3, 0, stop, smp, err);
 }
 
 static int advance_2d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    return advance(s, 2, 1, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 2, 1, stop, smp, err);
 }
 
 static int advance_3d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    return advance(s, 3, 1, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err);
 }
 
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
@@ -234,12 +237,13 @@ int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, 
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
 }
 
-/* Move the system clock forward to t, integrating the kinetic energy on the way (it
- * changes only at collisions, so the integral is exact up to rounding). */
-static inline void set_clock(gr_edmd *s, double t)
+/* Move the system clock forward to t, integrating the kinetic energy on the way
+ * (flight.h: with constant velocity it changes only at collisions, so the integral is
+ * exact up to rounding). */
+static inline void set_clock(gr_edmd *s, int dyn, double t)
 {
     if (t > s->t) {
-        s->kinetic_time += s->kinetic * (t - s->t);
+        s->kinetic_time += fl_kinetic_integral(dyn, s->kinetic, t - s->t);
         s->t = t;
     }
 }
@@ -252,12 +256,9 @@ static inline double next_sample(const gr_edmd_samples *smp)
 
 /* ---- the events ---- */
 
-static inline double kinetic_of(const gr_edmd *s, int dim, int32_t i)
+static inline double kinetic_of(const gr_edmd *s, int dyn, int dim, int32_t i)
 {
-    const double *v = VEL(rec(s, dim, i), dim);
-    double v2 = 0.0;
-    for (int a = 0; a < dim; a++) v2 += v[a] * v[a];
-    return 0.5 * s->mass[i] * v2;
+    return fl_kinetic(dyn, dim, s->mass[i], VEL(rec(s, dim, i), dim));
 }
 
 /* Collapse bookkeeping for a collision of i at t: count collisions that follow the
@@ -271,54 +272,30 @@ static inline int streak(gr_edmd *s, int32_t i, double t)
     return e->streak > GR_COLLAPSE_STREAK;
 }
 
-/* The restitution law's eps for a pair at contact: its normal approach speed
- * |dv . dr| / |dr| (0 for a pair that does not approach: gr_pair_collide refuses it).
- * *clamped += 1 if the speed is past the law's range; the caller adds that to
- * s->law_clamped only if this eps is the one applied (not replaced by the TC model). */
-static double pair_law(const gr_edmd *s, int dim, const double *dr, const double *vi,
-                       const double *vj, int64_t *clamped)
-{
-    double b = 0.0, dr2 = 0.0;
-    for (int a = 0; a < dim; a++) {
-        b += dr[a] * (vj[a] - vi[a]);
-        dr2 += dr[a] * dr[a];
-    }
-    double vn = b < 0.0 && dr2 > 0.0 ? -b / sqrt(dr2) : 0.0;
-    return gr_law_eval(&s->cfg.law, vn, clamped);
-}
-
-static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
+static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
                                     double t, gr_error *err)
 {
     double *p = rec(s, dim, i), *q = rec(s, dim, j);
-    move(dim, p, t);
-    move(dim, q, t);
+    move(dyn, dim, p, t);
+    move(dyn, dim, q, t);
     double dr[3];
     for (int a = 0; a < dim; a++) {
         dr[a] = q[a] - p[a];
         /* contact distance < L/2, so the nearest image is the one */
-        if (s->cfg.periodic) dr[a] = nearest_image(dr[a], s->L[a]);
+        if (s->cfg.periodic) dr[a] = bd_nearest(dr[a], s->L[a]);
     }
-    double xi = s->cfg.restitution;
-    int64_t clamped = 0; /* 1 if xi is the law's at its range's end */
-    if (laws && s->cfg.law.kind != GR_LAW_CONSTANT)
-        xi = pair_law(s, dim, dr, VEL(p, dim), VEL(q, dim), &clamped);
-    if (s->cfg.contact_duration > 0.0 && xi < 1.0 &&
-        (t - s->sched[i].t_last < s->cfg.contact_duration ||
-         t - s->sched[j].t_last < s->cfg.contact_duration)) {
-        xi = 1.0; /* TC model: within t_c of a previous collision, collide elastically */
-        s->elastic_tc++;
-        clamped = 0; /* the clamped eps is not the one applied */
-    }
-    double before = kinetic_of(s, dim, i) + kinetic_of(s, dim, j);
-    double vir = gr_pair_collide(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
+    int64_t clamped; /* 1 if xi is the law's at its range's end */
+    const double xi = rule_pair_eps(&s->cfg, laws, dim, dr, VEL(p, dim), VEL(q, dim), t,
+                                    &s->sched[i], &s->sched[j], &clamped, &s->elastic_tc);
+    double before = kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j);
+    double vir = rule_pair_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
     if (vir < 0.0) { /* grazing: no longer approaching at contact after rounding */
         s->invalid++;
-        predict(s, dim, i);
-        predict(s, dim, j);
+        predict(s, dyn, dim, i);
+        predict(s, dyn, dim, j);
         return GR_OK;
     }
-    s->kinetic += kinetic_of(s, dim, i) + kinetic_of(s, dim, j) - before;
+    s->kinetic += kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j) - before;
     s->virial += vir;
     s->pair++;
     s->law_clamped += clamped; /* a collision that happened, with the clamped law's eps */
@@ -331,36 +308,28 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dim, int laws, int32_t i, in
         gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), uid(s, j), t, (double)GR_COLLAPSE_STREAK,
                      GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
                      "each within 1e-9 of a free-flight time of the previous");
-        predict(s, dim, i);
-        predict(s, dim, j);
+        predict(s, dyn, dim, i);
+        predict(s, dyn, dim, j);
         return GR_ERR_COLLAPSE;
     }
-    predict(s, dim, i);
-    predict(s, dim, j);
+    predict(s, dyn, dim, i);
+    predict(s, dyn, dim, j);
     return GR_OK;
 }
 
-static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, int wall,
+static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int wall,
                                     double t, gr_error *err)
 {
     double *p = rec(s, dim, i), *v = VEL(p, dim);
     const int a = wall >> 1, up = wall & 1;
-    move(dim, p, t);
-    double before = kinetic_of(s, dim, i), vn = v[a];
-    double ew = s->cfg.wall_restitution;
-    int64_t clamped = 0; /* 1 if e_w is the law's at its range's end */
-    /* a law gives e_w of the same rule (2.22) from the normal impact speed |v_a| */
-    if (laws && s->cfg.wall_law.kind != GR_LAW_CONSTANT)
-        ew = gr_law_eval(&s->cfg.wall_law, fabs(vn), &clamped);
-    if (ew < 1.0 && s->cfg.contact_duration > 0.0 && t - s->sched[i].t_last < s->cfg.contact_duration) {
-        ew = 1.0;
-        clamped = 0; /* TC model: the clamped e_w is not the one applied */
-    }
+    move(dyn, dim, p, t);
+    double before = kinetic_of(s, dyn, dim, i), vn = v[a];
+    int64_t clamped; /* 1 if e_w is the law's at its range's end */
+    const double ew = rule_wall_eps(&s->cfg, laws, vn, t, &s->sched[i], &clamped);
     s->law_clamped += clamped;
-    v[a] = -v[a];
-    if (ew != 1.0)
-        for (int k = 0; k < dim; k++) v[k] *= ew; /* law of reflection kept (2.22) */
-    p[a] = up ? s->cfg.hi[a] - RAD(p, dim) : s->cfg.lo[a] + RAD(p, dim);
+    rule_wall_apply(dim, v, a, ew);
+    p[a] = up ? bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim))
+              : bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim));
     for (int k = 0; k < dim; k++) {
         if (!isfinite(v[k])) {
             gr_error_set(err, GR_ERR_NONFINITE, uid(s, i), -1, t, v[k], "a velocity after a heated wall");
@@ -368,7 +337,7 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, in
         }
     }
     s->wall_impulse += s->mass[i] * (fabs(vn) + fabs(v[a]));
-    s->kinetic += kinetic_of(s, dim, i) - before;
+    s->kinetic += kinetic_of(s, dyn, dim, i) - before;
     s->wall++;
     s->sched[i].count++;
     s->sched[i].last = -2 - wall;
@@ -376,34 +345,32 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dim, int laws, int32_t i, in
         gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), -1, t, (double)GR_COLLAPSE_STREAK,
                      GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
                      "each within 1e-9 of a free-flight time of the previous");
-        predict(s, dim, i);
+        predict(s, dyn, dim, i);
         return GR_ERR_COLLAPSE;
     }
-    predict(s, dim, i);
+    predict(s, dyn, dim, i);
     return GR_OK;
 }
 
-static void predict_cross(gr_edmd *s, int dim, int32_t i);
+static void predict_cross(gr_edmd *s, int dyn, int dim, int32_t i);
 static void schedule(gr_edmd *s, int32_t i);
 
 /* Cell mode: i moves into the next cell, wrapping around a periodic box. */
-static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t)
+static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, double t)
 {
     double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
     int32_t *c = e->c;
     const int a = e->cross >> 1, dir = (e->cross & 1) ? 1 : -1;
-    move(dim, p, t);
+    move(dyn, dim, p, t);
     int32_t old = cell_of(&s->cells, dim, c);
     int32_t q = c[a] + dir;
-    if (q >= s->cells.nc[a]) {
+    if (q >= s->cells.nc[a]) { /* out of the last cell: out of a periodic box (boundary.h) */
         q = 0;
-        p[a] -= s->L[a];
-        s->image[(size_t)i * dim + a]++;
+        bd_through_face(&p[a], s->L[a], &s->image[(size_t)i * dim + a], 1);
     } else if (q < 0) {
         q = s->cells.nc[a] - 1;
-        p[a] += s->L[a];
-        s->image[(size_t)i * dim + a]--;
+        bd_through_face(&p[a], s->L[a], &s->image[(size_t)i * dim + a], 0);
     }
     c[a] = q;
     if (!s->big.is_big[i]) {
@@ -411,11 +378,11 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t)
         cell_insert(&s->cells, i, cell_of(&s->cells, dim, c));
     }
     s->crossings++;
-    predict_cross(s, dim, i);
+    predict_cross(s, dyn, dim, i);
     /* the key is most often the crossing: its calendar bucket is asked for before the
      * scan, which then overlaps that miss */
     if (s->lookahead) gr_cq_prefetch_key(&s->queue, e->t_cross < e->t_coll ? e->t_cross : e->t_coll);
-    scan_cells(s, dim, i, a, dir);
+    scan_cells(s, dyn, dim, i, a, dir);
     schedule(s, i);
 }
 
@@ -426,25 +393,19 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dim, int32_t i, double t)
  * Brought back, i is seen from its neighbours through other images: it is taken off
  * every neighbour's row and linked anew; otherwise only the neighbours that leave or
  * join its list change (relink, search.h). */
-static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double t,
+static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i, double t,
                                           gr_error *err)
 {
     double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
-    move(dim, p, t);
+    move(dyn, dim, p, t);
     int wrapped = 0;
     if (s->cfg.periodic) {
-        for (int a = 0; a < dim; a++) {
-            if (p[a] >= s->cfg.hi[a]) {
-                p[a] -= s->L[a];
-                s->image[(size_t)i * dim + a]++;
+        for (int a = 0; a < dim; a++) /* not wrapped |= ...: that costs the cell-crossing
+                                        * loop 5 instructions an event (cachegrind) */
+            if (bd_reenter(&p[a], s->cfg.lo[a], s->cfg.hi[a], s->L[a],
+                           &s->image[(size_t)i * dim + a]))
                 wrapped = 1;
-            } else if (p[a] < s->cfg.lo[a]) {
-                p[a] += s->L[a];
-                s->image[(size_t)i * dim + a]--;
-                wrapped = 1;
-            }
-        }
     }
     /* the neighbours' list lengths and rows are misses: ask for all of them first (with
      * relinking, for the few that leave; the search for new ones gives them time) */
@@ -468,7 +429,7 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dim, int32_t i, double
     int status = wrapped ? link_all(s, dim, i, m, err) : relink(s, dim, i, m, err);
     if (status != GR_OK) return status;
     s->shell_exits++;
-    predict(s, dim, i);
+    predict(s, dyn, dim, i);
     return GR_OK;
 }
 
@@ -492,26 +453,28 @@ const char *gr_scan_kernel(void)
     return scan_avx2 ? "avx2" : "plain";
 }
 
-static void predict_wall(gr_edmd *s, int dim, int32_t i);
+static void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i);
 
 /* Full prediction for i, whose clock must be the current time: walls, then pair
  * collisions and the next crossing (cells) or shell exit (lists). */
-static void predict(gr_edmd *s, int dim, int32_t i)
+static void predict(gr_edmd *s, int dyn, int dim, int32_t i)
 {
-    predict_wall(s, dim, i);
+    predict_wall(s, dyn, dim, i);
     if (s->nl.shell > 0.0) {
         const double *p = rec(s, dim, i);
-        s->sched[i].t_cross = TIME(p, dim) + nl_exit_time(&s->nl, dim, p, VEL(p, dim),
-                                                       s->nl.centre + (size_t)i * (dim + 1));
+        s->sched[i].t_cross = TIME(p, dim) + fl_exit_time(dyn, dim, p, VEL(p, dim),
+                                                       s->nl.centre + (size_t)i * (dim + 1),
+                                                       s->nl.exit2);
 #ifdef GR_SCAN_X86
-        if (dim == 3 && scan_avx2) scan_list_avx2(s, i);
+        /* the four-lane scan is written for straight lines (GR_FL_SEP) */
+        if (dim == 3 && dyn == GR_FLIGHT_LINEAR && scan_avx2) scan_list_avx2(s, i);
         else
 #endif
-            scan_list(s, dim, i);
+            scan_list(s, dyn, dim, i);
     } else {
-        predict_cross(s, dim, i); /* first: its bucket is asked for while the scan runs */
+        predict_cross(s, dyn, dim, i); /* first: its bucket is asked for while the scan runs */
         if (s->lookahead) gr_cq_prefetch_key(&s->queue, s->sched[i].t_cross);
-        scan_cells(s, dim, i, -1, 0);
+        scan_cells(s, dyn, dim, i, -1, 0);
     }
     schedule(s, i);
 }
@@ -524,7 +487,7 @@ static inline void schedule(gr_edmd *s, int32_t i)
 }
 
 /* i's next wall collision (none in a periodic box), replacing its prediction. */
-static inline void predict_wall(gr_edmd *s, int dim, int32_t i)
+static inline void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i)
 {
     const double *p = rec(s, dim, i), *v = VEL(p, dim);
     gr_sched *e = &s->sched[i];
@@ -535,13 +498,13 @@ static inline void predict_wall(gr_edmd *s, int dim, int32_t i)
     int32_t wall = -1;
     for (int a = 0; a < dim; a++) {
         double dt;
-        if (v[a] > 0.0) dt = (s->cfg.hi[a] - RAD(p, dim) - p[a]) / v[a];
-        else if (v[a] < 0.0) dt = (s->cfg.lo[a] + RAD(p, dim) - p[a]) / v[a];
-        else continue;
+        const int up = fl_wall_time(dyn, p[a], v[a], bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim)),
+                                    bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim)), &dt);
+        if (up < 0) continue;
         if (dt < 0.0) dt = 0.0;
         if (dt < best) {
             best = dt;
-            wall = 2 * a + (v[a] > 0.0);
+            wall = 2 * a + up;
         }
     }
     if (wall >= 0) {
@@ -551,7 +514,7 @@ static inline void predict_wall(gr_edmd *s, int dim, int32_t i)
 }
 
 /* Cell mode: next cell crossing of i from its current position, cell and velocity. */
-static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dim, int32_t i, const int periodic)
+static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dyn, int dim, int32_t i, const int periodic)
 {
     /* Without branches on the signs of the velocity: they differ from one event to the
      * next at random, and a mispredicted branch costs more than the arithmetic. */
@@ -561,14 +524,11 @@ static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dim, int32_t i, co
     double best = INFINITY;
     int32_t code = -1;
     for (int a = 0; a < dim; a++) {
-        const double v = VEL(p, dim)[a];
-        const int up = v > 0.0;
-        const double bound = s->cfg.lo[a] + (c[a] + up) * g->w[a];
-        double dt = (bound - p[a]) / (v != 0.0 ? v : 1.0);
-        dt = dt < 0.0 ? 0.0 : dt; /* rounding left it a hair past the boundary */
-        int open = v != 0.0;
+        int up, open;
+        double dt = fl_cross_time(dyn, p[a], VEL(p, dim)[a], s->cfg.lo[a], c[a], g->w[a], &up,
+                                  &open);
         if (!periodic) /* a wall has no cell behind it */
-            open &= (up & (c[a] < g->nc[a] - 1)) | (!up & (c[a] > 0));
+            open &= bd_cell_beyond(up, c[a], g->nc[a]);
         dt = open ? dt : INFINITY;
         const int32_t earlier = dt < best;
         code += earlier * (2 * a + up - code); /* arithmetic: a select compiles to a branch */
@@ -580,15 +540,15 @@ static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dim, int32_t i, co
 
 /* Compiled apart for periodic boxes, which have no walls to test for: fewer instructions
  * an event (counted in docs/performance.md). */
-static inline void predict_cross(gr_edmd *s, int dim, int32_t i)
+static inline void predict_cross(gr_edmd *s, int dyn, int dim, int32_t i)
 {
-    if (s->cfg.periodic) predict_cross_in(s, dim, i, 1);
-    else predict_cross_in(s, dim, i, 0);
+    if (s->cfg.periodic) predict_cross_in(s, dyn, dim, i, 1);
+    else predict_cross_in(s, dyn, dim, i, 0);
 }
 
 /* ---- the start ---- */
 
-static int start(gr_edmd *s, int dim, gr_error *err)
+static int start(gr_edmd *s, int dyn, int dim, gr_error *err)
 {
     if (s->nl.shell > 0.0) {
         for (int32_t i = 0; i < s->n; i++) set_centre(s, dim, i); /* the cells as filed */
@@ -599,11 +559,12 @@ static int start(gr_edmd *s, int dim, gr_error *err)
     }
     int status = gr_renumber(s);
     if (status != GR_OK) return status;
-    for (int32_t i = 0; i < s->n; i++) predict(s, dim, i);
+    for (int32_t i = 0; i < s->n; i++) predict(s, dyn, dim, i);
     return GR_OK;
 }
 
 int gr_predict_all(gr_edmd *s, gr_error *err)
 {
-    return s->dim == 2 ? start(s, 2, err) : start(s, 3, err);
+    const int dyn = dynamics_of(s);
+    return s->dim == 2 ? start(s, dyn, 2, err) : start(s, dyn, 3, err);
 }

@@ -13,7 +13,9 @@
  * The engine's files: edmd.c the event loop, the events and the predictions (read it
  * first), search.h their pair searches; engine.h the system's struct; schedstate.h a particle's scheduling state;
  * cells.c/.h the cell grid; nlist.c/.h the neighbour lists; big.c/.h big particles;
- * calendar.c/.h the queue; collide.h two-body geometry; build.c construction;
+ * calendar.c/.h the queue; collide.h two-body geometry; flight.h the motion between
+ * events, boundary.h the box's faces and images, rule.h the collision rules (the three
+ * seams a new dynamics, boundary or rule changes); build.c construction;
  * validate.c the checks of a configuration; renumber.c renumbering in cell order;
  * sample.c samples, state and counters. */
 #ifndef GR_EDMD_H

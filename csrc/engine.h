@@ -13,9 +13,11 @@
 #include <stdint.h>
 
 #include "big.h"
+#include "boundary.h"
 #include "calendar.h"
 #include "cells.h"
 #include "edmd.h"
+#include "flight.h"
 #include "nlist.h"
 #include "schedstate.h"
 
@@ -96,33 +98,30 @@ static inline double *rec(const gr_edmd *s, int dim, int32_t i)
 /* The caller's index of internal particle i (negative codes pass through). */
 static inline int64_t uid(const gr_edmd *s, int32_t i) { return i < 0 ? -1 : s->order.id_of[i]; }
 
-/* The separation d along an axis of periodic length L seen through the nearest image
- * (|d| < 3L/2, as between particles in the box). */
-static inline double nearest_image(double d, double L)
+/* The dynamics of system s (flight.h): constant velocity, the only one so far.  A second
+ * one is a config field read here, and gr_edmd_advance chooses its loop from it. */
+static inline int dynamics_of(const gr_edmd *s)
 {
-    return d > 0.5 * L ? d - L : d < -0.5 * L ? d + L : d;
+    (void)s;
+    return GR_FLIGHT_LINEAR;
 }
 
-/* Move record p along its straight line to time t. */
-static inline void move(int dim, double *p, double t)
+/* Move record p in free flight (flight.h) to time t. */
+static inline void move(int dyn, int dim, double *p, double t)
 {
-    double dt = t - TIME(p, dim);
-    for (int a = 0; a < dim; a++) p[a] += VEL(p, dim)[a] * dt;
-    TIME(p, dim) = t;
+    fl_move(dyn, dim, p, VEL(p, dim), &TIME(p, dim), t);
 }
 
 /* The total kinetic energy summed from the velocities: the event loop's (with its
  * constant dim, a loop of a few instructions a particle) and the counters' give the same
- * bits, so a run stopped on energy reads at most its target in the counters. */
-static inline double kinetic_total(const gr_edmd *s, int dim)
+ * bits, so a run stopped on energy reads at most its target in the counters.  Records
+ * hold the velocities at each particle's own clock: right for constant velocity, where
+ * they do not change in flight (a dynamics where they do brings them to s->t first). */
+static inline double kinetic_total(const gr_edmd *s, int dyn, int dim)
 {
     double k = 0.0;
-    for (int32_t i = 0; i < s->n; i++) {
-        const double *p = rec(s, dim, i);
-        double v2 = 0.0;
-        for (int a = 0; a < dim; a++) v2 += VEL(p, dim)[a] * VEL(p, dim)[a];
-        k += 0.5 * s->mass[i] * v2;
-    }
+    for (int32_t i = 0; i < s->n; i++)
+        k += fl_kinetic(dyn, dim, s->mass[i], VEL(rec(s, dim, i), dim));
     return k;
 }
 

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "boundary.h"
 #include "hugemem.h"
 #include "nlist.h"
 
@@ -20,7 +21,7 @@ int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *
     nl->mark = calloc((size_t)n, 1);
     for (int code = 0; code < 32; code++)
         for (int a = 0, k = code; a < 4; a++, k /= 3)
-            nl->img[code][a] = a < dim ? (double)(k % 3 - 1) * L[a] : 0.0;
+            nl->img[code][a] = a < dim ? bd_shift(k % 3 - 1, L[a]) : 0.0;
     return nl->centre && nl->rows && nl->near && nl->mark ? GR_OK : GR_ERR_NOMEM;
 }
 

@@ -98,24 +98,6 @@ static inline void nl_unlink(gr_nlist *nl, gr_sched *sched, int32_t j, int32_t i
         }
 }
 
-/* When a particle at x with velocity v leaves the sphere about `centre`: the time from
- * now, +inf if never. */
-static inline double nl_exit_time(const gr_nlist *nl, int dim, const double *x,
-                                  const double *v, const double *centre)
-{
-    double a = 0.0, b = 0.0, c = -nl->exit2;
-    for (int k = 0; k < dim; k++) {
-        const double d = x[k] - centre[k];
-        a += v[k] * v[k];
-        b += d * v[k];
-        c += d * d;
-    }
-    /* the larger root of a dt^2 + 2 b dt + c = 0 with c < 0, in the form without
-     * cancellation; c >= 0 is a hair outside by rounding: leave now */
-    if (!(a > 0.0)) return INFINITY;
-    if (c >= 0.0) return 0.0;
-    const double q = sqrt(b * b - a * c);
-    return b > 0.0 ? -c / (b + q) : (q - b) / a;
-}
+/* When a particle leaves its shell: fl_exit_time (flight.h), a matter of its motion. */
 
 #endif

@@ -34,10 +34,12 @@
         c3 = _mm256_permute2f128_pd(t1_, t3_, 0x31);                                    \
     } while (0)
 
-/* a separation along one axis, as try_pair forms it: ((q + vq dtj) - p) + shift */
+/* a separation along one axis, as try_pair forms it: the free flight's (flight.h,
+ * GR_FL_SEP) in four lanes, then the image shift */
 static GR_AVX2 inline __m256d sep4(__m256d q, __m256d vq, __m256d dtj, __m256d p, __m256d shift)
 {
-    return _mm256_add_pd(_mm256_sub_pd(_mm256_add_pd(q, _mm256_mul_pd(vq, dtj)), p), shift);
+    return _mm256_add_pd(GR_FL_SEP(_mm256_add_pd, _mm256_sub_pd, _mm256_mul_pd, q, vq, dtj, p),
+                         shift);
 }
 
 /* a 3-vector dot product summed as gr_pair_beats sums it: (a0 b0 + a1 b1) + a2 b2 */

@@ -26,20 +26,20 @@ static inline int rebound_now(const gr_edmd *s, int32_t i, int32_t j, double t, 
  * Keeps the earliest in *best / *partner; `best` is relative to i's clock and is also
  * the horizon for the early exit in gr_pair_beats.  Every scan calls this with constant
  * shift and nearest arguments, so each gets its own inlined copy. */
-static GR_ALWAYS_INLINE void try_pair(const gr_edmd *s, int dim, int32_t i, const double *p,
+static GR_ALWAYS_INLINE void try_pair(const gr_edmd *s, int dyn, int dim, int32_t i, const double *p,
                                       int32_t j, const double *shift, int nearest,
                                       double *best, int32_t *partner)
 {
     const double *q = rec(s, dim, j);
     double dtj = TIME(p, dim) - TIME(q, dim), dr[3], dv[3];
     for (int a = 0; a < dim; a++) {
-        dr[a] = q[a] + VEL(q, dim)[a] * dtj - p[a];
+        dr[a] = fl_sep(dyn, q[a], VEL(q, dim)[a], dtj, p[a]);
         if (shift) dr[a] += shift[a];
-        if (nearest) dr[a] = nearest_image(dr[a], s->L[a]);
-        dv[a] = VEL(q, dim)[a] - VEL(p, dim)[a];
+        if (nearest) dr[a] = bd_nearest(dr[a], s->L[a]);
+        dv[a] = fl_relvel(dyn, VEL(q, dim)[a], VEL(p, dim)[a]);
     }
     double dt;
-    if (!gr_pair_beats(dim, dr, dv, RAD(p, dim) + RAD(q, dim), *best, &dt)) return;
+    if (!fl_pair_beats(dyn, dim, dr, dv, RAD(p, dim) + RAD(q, dim), *best, &dt)) return;
     if (rebound_now(s, i, j, TIME(p, dim), dt)) return;
     *best = dt;
     *partner = j;
@@ -57,28 +57,28 @@ static inline void keep_pair(gr_edmd *s, int dim, int32_t i, double best, int32_
 }
 
 /* Pair collisions of i with the particles of one cell, seen through an image shift. */
-static inline void scan_cell(const gr_edmd *s, int dim, int32_t i, const double *p,
+static inline void scan_cell(const gr_edmd *s, int dyn, int dim, int32_t i, const double *p,
                              int32_t cell, const double *shift, double *best, int32_t *partner)
 {
     for (int32_t j = s->cells.head[cell]; j >= 0; j = s->cells.next[j])
-        if (j != i) try_pair(s, dim, i, p, j, shift, 0, best, partner);
+        if (j != i) try_pair(s, dyn, dim, i, p, j, shift, 0, best, partner);
 }
 
 /* The pair (i, j), j seen through the nearest periodic image (the one that touches:
  * contact distances are below half the box), for scans that involve a big particle. */
-static inline void scan_one(const gr_edmd *s, int dim, int32_t i, const double *p, int32_t j,
+static inline void scan_one(const gr_edmd *s, int dyn, int dim, int32_t i, const double *p, int32_t j,
                             double *best, int32_t *partner)
 {
-    if (j != i) try_pair(s, dim, i, p, j, NULL, s->cfg.periodic, best, partner);
+    if (j != i) try_pair(s, dyn, dim, i, p, j, NULL, s->cfg.periodic, best, partner);
 }
 
-static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, double *best,
+static void scan_block(const gr_edmd *s, int dyn, int dim, int32_t i, int axis, int dir, double *best,
                        int32_t *partner);
 
 /* Cell mode: pair collisions of i in all adjacent cells (axis < 0) or in the layer newly
  * adjacent after crossing along `axis` in direction `dir`, and with every big particle;
  * keep the earliest in i's prediction if it beats the one there. */
-static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
+static void scan_cells(gr_edmd *s, int dyn, int dim, int32_t i, int axis, int dir)
 {
     const gr_cells *g = &s->cells;
     const double *p = rec(s, dim, i);
@@ -87,7 +87,7 @@ static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
     double best = e->t_coll - TIME(p, dim);
     int32_t partner = -1;
     if (s->big.n && s->big.is_big[i]) {
-        scan_block(s, dim, i, axis, dir, &best, &partner);
+        scan_block(s, dyn, dim, i, axis, dir, &best, &partner);
     } else if (cell_interior(g, dim, c)) {
         const int32_t base = cell_of(g, dim, c);
         /* the occupied cells, kept or not without a branch (which are occupied is as
@@ -116,14 +116,14 @@ static void scan_cells(gr_edmd *s, int dim, int32_t i, int axis, int dir)
          * length, the number of occupied cells, is a branch mispredicted often) */
         if (g->prefetch_heads)
             for (int k = 0; k < m; k++) GR_PREFETCH(&g->head[full[k]]);
-        for (int k = 0; k < m; k++) scan_cell(s, dim, i, p, full[k], NULL, &best, &partner);
+        for (int k = 0; k < m; k++) scan_cell(s, dyn, dim, i, p, full[k], NULL, &best, &partner);
     } else {
         gr_nbr nb[27];
         int count = cell_neighbours(g, dim, c, axis, dir, nb);
         for (int k = 0; k < count; k++)
-            scan_cell(s, dim, i, p, nb[k].cell, nb[k].shift, &best, &partner);
+            scan_cell(s, dyn, dim, i, p, nb[k].cell, nb[k].shift, &best, &partner);
     }
-    for (int32_t b = 0; b < s->big.n; b++) scan_one(s, dim, i, p, s->big.idx[b], &best, &partner);
+    for (int32_t b = 0; b < s->big.n; b++) scan_one(s, dyn, dim, i, p, s->big.idx[b], &best, &partner);
     keep_pair(s, dim, i, best, partner);
 }
 
@@ -182,7 +182,7 @@ static inline void prefetch_firsts(const gr_edmd *s, int dim)
  * (axis < 0), or the layer of it newly reached after crossing along `axis` in direction
  * `dir`.  gr_big_choose keeps the block narrower than the box, so a periodic block never
  * meets itself. */
-static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, double *best,
+static void scan_block(const gr_edmd *s, int dyn, int dim, int32_t i, int axis, int dir, double *best,
                        int32_t *partner)
 {
     const gr_cells *g = &s->cells;
@@ -193,7 +193,7 @@ static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, 
         int32_t reach = (int32_t)ceil((RAD(p, dim) + s->big.r_small) / g->w[a]);
         lo[a] = a == axis ? c[a] + dir * reach : c[a] - reach;
         hi[a] = a == axis ? lo[a] : c[a] + reach;
-        if (!s->cfg.periodic) {
+        if (!s->cfg.periodic) { /* walls: the block ends at them */
             if (lo[a] < 0) lo[a] = 0;
             if (hi[a] > g->nc[a] - 1) hi[a] = g->nc[a] - 1;
             if (lo[a] > hi[a]) return; /* the layer lies beyond a wall */
@@ -202,15 +202,15 @@ static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, 
     /* beyond dim, lo = hi = 0 and nc = 1: one pass */
     int32_t q[3] = {0, 0, 0};
     for (int32_t k2 = lo[2]; k2 <= hi[2]; k2++) {
-        q[2] = (k2 % g->nc[2] + g->nc[2]) % g->nc[2];
+        q[2] = bd_cell_wrap(k2, g->nc[2]);
         for (int32_t k1 = lo[1]; k1 <= hi[1]; k1++) {
-            q[1] = (k1 % g->nc[1] + g->nc[1]) % g->nc[1];
+            q[1] = bd_cell_wrap(k1, g->nc[1]);
             for (int32_t k0 = lo[0]; k0 <= hi[0]; k0++) {
-                q[0] = (k0 % g->nc[0] + g->nc[0]) % g->nc[0];
+                q[0] = bd_cell_wrap(k0, g->nc[0]);
                 int32_t cell = cell_of(g, dim, q);
                 if (!cell_occupied(g, cell)) continue;
                 for (int32_t j = g->head[cell]; j >= 0; j = g->next[j])
-                    scan_one(s, dim, i, p, j, best, partner);
+                    scan_one(s, dyn, dim, i, p, j, best, partner);
             }
         }
     }
@@ -219,7 +219,7 @@ static void scan_block(const gr_edmd *s, int dim, int32_t i, int axis, int dir, 
 /* List mode: pair collisions of i with its listed neighbours, before its predicted wall
  * collision and its shell exit (which rebuilds and predicts afresh, so later collisions
  * need not be found now: most candidates then fail the cheap test). */
-static void scan_list(gr_edmd *s, int dim, int32_t i)
+static void scan_list(gr_edmd *s, int dyn, int dim, int32_t i)
 {
     const double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
@@ -227,7 +227,7 @@ static void scan_list(gr_edmd *s, int dim, int32_t i)
     double best = (e->t_coll < e->t_cross ? e->t_coll : e->t_cross) - TIME(p, dim);
     int32_t partner = -1;
     for (int k = 0; k < e->nn; k++)
-        try_pair(s, dim, i, p, row[k] >> GR_NL_BITS, s->nl.img[row[k] & GR_NL_CODE_MASK], 0,
+        try_pair(s, dyn, dim, i, p, row[k] >> GR_NL_BITS, s->nl.img[row[k] & GR_NL_CODE_MASK], 0,
                  &best, &partner);
     keep_pair(s, dim, i, best, partner);
 }

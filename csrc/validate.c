@@ -140,8 +140,7 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
             /* walls: the whole disk inside (a relative 1e-12 of slack for rounding);
              * periodic: the centre inside. */
             double slack = 1e-12 * (hi - lo);
-            int out = cfg->periodic ? (x < lo || x > hi)
-                                    : (x - radius[i] < lo - slack || x + radius[i] > hi + slack);
+            int out = bd_outside(cfg->periodic, x, radius[i], lo, hi, slack);
             if (out) {
                 gr_error_set(err, GR_ERR_OUTSIDE, i, -1, NAN, x,
                              cfg->periodic ? "its centre is outside [lower, upper]"
@@ -161,7 +160,7 @@ static int overlap(const double *x, const double *y, const double *shift, double
     double d2 = 0.0;
     for (int a = 0; a < dim; a++) {
         double d = y[a] + (shift ? shift[a] : 0.0) - x[a];
-        if (periodic && !shift) d = nearest_image(d, L[a]);
+        if (periodic && !shift) d = bd_nearest(d, L[a]);
         d2 += d * d;
     }
     double sigma = (ri + rj) * (1.0 - 1e-10);
