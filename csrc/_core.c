@@ -784,6 +784,15 @@ static struct PyModuleDef core_module = {
     -1, core_methods, NULL, NULL, NULL, NULL
 };
 
+/* A float constant of the module; 0, or -1 with an exception set. */
+static int add_double(PyObject *m, const char *name, double value)
+{
+    PyObject *x = PyFloat_FromDouble(value);
+    int status = x ? PyModule_AddObjectRef(m, name, x) : -1;
+    Py_XDECREF(x);
+    return status;
+}
+
 PyMODINIT_FUNC PyInit__core(void)
 {
     import_array();
@@ -817,6 +826,16 @@ PyMODINIT_FUNC PyInit__core(void)
         return NULL;
     }
     Py_DECREF(big_ratio);
+    /* ==== restitution laws (restitution.h): granular/restitution.py reads these ==== */
+    if (PyModule_AddIntConstant(m, "LAW_CONSTANT", GR_LAW_CONSTANT) < 0 ||
+        PyModule_AddIntConstant(m, "LAW_VISCOELASTIC", GR_LAW_VISCOELASTIC) < 0 ||
+        PyModule_AddIntConstant(m, "LAW_TABLE", GR_LAW_TABLE) < 0 ||
+        PyModule_AddIntConstant(m, "LAW_TABLE_MAX", GR_LAW_TABLE_MAX) < 0 ||
+        add_double(m, "VISCO_C1", GR_VISCO_C1) < 0 || add_double(m, "VISCO_C2", GR_VISCO_C2) < 0 ||
+        add_double(m, "VISCO_DELTA_MAX", GR_VISCO_DELTA_MAX) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
     /* ==== SDE constants ==== */
     PyObject *max_steps = PyLong_FromLongLong(GR_SDE_MAX_STEPS);
     if (!max_steps || PyModule_AddObjectRef(m, "SDE_MAX_STEPS", max_steps) < 0) {

@@ -11,6 +11,10 @@ BIG_MAX: int
 BIG_RATIO: float
 CHECKPOINT_LAYOUT: int
 HEADS_CACHED: int
+LAW_CONSTANT: int
+LAW_TABLE: int
+LAW_TABLE_MAX: int
+LAW_VISCOELASTIC: int
 RNG_KERNEL: str
 SCAN_KERNEL: str
 SDE_BLOCK: int
@@ -20,6 +24,9 @@ STOP_COLLISIONS: int
 STOP_ENERGY: int
 STOP_IDLE: int
 STOP_TIME: int
+VISCO_C1: float
+VISCO_C2: float
+VISCO_DELTA_MAX: float
 
 # a restitution law as the engine takes it (RestitutionLaw._engine): (kind, scale, v_max,
 # speeds, values), or None for a constant

@@ -25,22 +25,26 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-# Kinds of law as the engine numbers them (csrc/restitution.h GR_LAW_*).
-_KIND_VISCOELASTIC = 1
-_KIND_TABLE = 2
+from . import _core
+
+# The engine owns the laws (csrc/restitution.h): their kind numbers, the viscoelastic
+# series' coefficients and range and the largest table are read from it, never copied.
+_KIND_VISCOELASTIC: int = _core.LAW_VISCOELASTIC
+_KIND_TABLE: int = _core.LAW_TABLE
 
 # eps = 1 - C1 delta + C2 delta^2, delta = A kappa^(2/5) v^(1/5) (Schwager & Poeschel 1998,
 # Phys. Rev. E 57, 650; Brilliantov & Poeschel, Kinetic Theory of Granular Gases, 2004,
-# ch. 6): C1 = Gamma(3/5) sqrt(pi) / (2^(1/5) 5^(2/5) Gamma(21/10)), C2 = (3/5) C1^2.
-C1: float = math.gamma(3 / 5) * math.sqrt(math.pi) / (2**0.2 * 5**0.4 * math.gamma(21 / 10))
-C2: float = 0.6 * C1**2
-# The series is used up to this delta (csrc/restitution.h GR_VISCO_DELTA_MAX): for a
-# contact that ends where the force vanishes (Schwager & Poeschel 2008) the first dropped
-# term is +(4/15) delta^(5/2) and the error 0.0015 here (tests/test_restitution.py
-# integrates the contact); past delta = C1 / (2 C2) = 0.72 the truncated series rises again.
-DELTA_MAX: float = 0.25
-# A table of at most this many points (csrc/restitution.h GR_LAW_TABLE_MAX).
-TABLE_MAX = 1_000_000
+# ch. 6): C1 = Gamma(3/5) sqrt(pi) / (2^(1/5) 5^(2/5) Gamma(21/10)), C2 = (3/5) C1^2
+# (tests/test_restitution.py checks the engine's numbers against these formulas).
+C1: float = _core.VISCO_C1
+C2: float = _core.VISCO_C2
+# The series is used up to this delta: for a contact that ends where the force vanishes
+# (Schwager & Poeschel 2008) the first dropped term is +(4/15) delta^(5/2) and the error
+# 0.0015 here (tests/test_restitution.py integrates the contact); past delta = C1 / (2 C2)
+# = 0.72 the truncated series rises again.
+DELTA_MAX: float = _core.VISCO_DELTA_MAX
+# A table of at most this many points.
+TABLE_MAX: int = _core.LAW_TABLE_MAX
 
 
 def _positive(value: Any, name: str) -> float:

@@ -34,6 +34,39 @@ def test_series_coefficients_are_the_published_ones():
     assert 0 <= C2 - 0.7982 < 1e-4
 
 
+def test_law_constants_are_the_cores():
+    """The law kinds, C1, C2, DELTA_MAX and TABLE_MAX are read from _core (the engine owns
+    them, csrc/restitution.h), not copied: each is assigned from ``_core.NAME`` in
+    restitution.py, and the engine's series coefficients are the formulas'."""
+    import ast
+    import inspect
+
+    tree = ast.parse(inspect.getsource(granular.restitution))
+    assigned = {
+        node.target.id if isinstance(node, ast.AnnAssign) else node.targets[0].id: node.value
+        for node in tree.body
+        if isinstance(node, (ast.Assign, ast.AnnAssign))
+        and isinstance(
+            node.target if isinstance(node, ast.AnnAssign) else node.targets[0], ast.Name
+        )
+    }
+    wanted = {
+        "_KIND_VISCOELASTIC": "LAW_VISCOELASTIC",
+        "_KIND_TABLE": "LAW_TABLE",
+        "C1": "VISCO_C1",
+        "C2": "VISCO_C2",
+        "DELTA_MAX": "VISCO_DELTA_MAX",
+        "TABLE_MAX": "LAW_TABLE_MAX",
+    }
+    for name, core_name in wanted.items():
+        value = assigned[name]
+        assert ast.unparse(value) == f"_core.{core_name}", (name, ast.unparse(value))
+    c1 = math.gamma(3 / 5) * math.sqrt(math.pi) / (2**0.2 * 5**0.4 * math.gamma(21 / 10))
+    assert math.isclose(_core.VISCO_C1, c1, rel_tol=4e-16)
+    assert math.isclose(_core.VISCO_C2, 0.6 * c1 * c1, rel_tol=4e-16)
+    assert _core.LAW_CONSTANT == 0 and len({_core.LAW_VISCOELASTIC, _core.LAW_TABLE, 0}) == 3
+
+
 def contact_restitution(young, poisson, damping, radius, mass, speed, ending="force"):
     """eps of two equal spheres from Newton's equation of the compression xi during the
     contact, m_eff xi'' = -rho (xi^(3/2) + (3/2) A xi^(1/2) xi'), rho = 2 Y sqrt(R_eff) /
