@@ -151,23 +151,57 @@ static void EDMD_dealloc(EDMDObject *self)
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-/* A restitution law from None (constant: *law zeroed) or a tuple (kind, scale, v_max,
- * speeds, values) as granular/restitution.py builds it; the table arrays are returned in
- * *x, *y (new references, or NULL) and must outlive the use of *law.  Returns 0, or -1
- * with an exception set.  The engine checks the values (validate.c). */
+/* Every argument of the engine's entry points is a keyword ("|$" in the format): a wrong
+ * name is a TypeError and two numbers cannot swap places.  PyArg_ParseTupleAndKeywords
+ * cannot make a keyword-only argument required, so the first `required` of names[] are
+ * checked here, after it (which names an unknown keyword).  Returns 0, or -1 with a
+ * TypeError set. */
+static int require_keywords(PyObject *args, PyObject *kw, char **names, int required,
+                            const char *function)
+{
+    if (args && PyTuple_GET_SIZE(args) > 0) {
+        PyErr_Format(PyExc_TypeError,
+                     "%s() takes no positional arguments (%zd given): give each by name",
+                     function, PyTuple_GET_SIZE(args));
+        return -1;
+    }
+    for (int i = 0; i < required; i++) {
+        PyObject *value = kw ? PyDict_GetItemString(kw, names[i]) : NULL;
+        if (!value) {
+            PyErr_Format(PyExc_TypeError, "%s() missing required keyword argument '%s'",
+                         function, names[i]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* A restitution law from None (constant: *law zeroed) or a dict {kind, scale, v_max,
+ * speeds, values} as granular/restitution.py builds it (RestitutionLaw._engine); the table
+ * arrays are returned in *x, *y (new references, or NULL) and must outlive the use of
+ * *law.  Returns 0, or -1 with an exception set.  The engine checks the values
+ * (validate.c). */
 static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject **x,
                      PyArrayObject **y)
 {
+    static char *names[] = {"kind", "scale", "v_max", "speeds", "values", NULL};
     memset(law, 0, sizeof *law);
     *x = *y = NULL;
     if (obj == Py_None) return 0;
-    PyObject *ox, *oy;
-    if (!PyTuple_Check(obj) ||
-        !PyArg_ParseTuple(obj, "iddOO", &law->kind, &law->scale, &law->v_max, &ox, &oy)) {
-        PyErr_Format(PyExc_TypeError, "%s must be None or (kind, scale, v_max, speeds, values)",
-                     name);
+    if (!PyDict_Check(obj)) {
+        PyErr_Format(PyExc_TypeError,
+                     "%s must be None or a dict of kind, scale, v_max, speeds and values", name);
         return -1;
     }
+    char format[64];
+    snprintf(format, sizeof format, "|$iddOO:%s", name);
+    PyObject *ox, *oy, *none = PyTuple_New(0);
+    if (!none) return -1;
+    int ok = PyArg_ParseTupleAndKeywords(none, obj, format, names, &law->kind, &law->scale,
+                                         &law->v_max, &ox, &oy) &&
+             require_keywords(NULL, obj, names, 5, name) == 0;
+    Py_DECREF(none);
+    if (!ok) return -1;
     npy_intp any[1] = {-1};
     if (!(*x = as_f64(ox, "a law's speeds", 1, any))) return -1;
     npy_intp shape[1] = {PyArray_DIM(*x, 0)};
@@ -194,9 +228,12 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None;
     int periodic;
     double wall_e, xi, tc, cell_factor = 1.0, big_ratio = GR_BIG_RATIO, shell = 0.0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpddd|dddOO", names, &opos, &ovel, &orad,
-                                     &omass, &olo, &ohi, &periodic, &wall_e, &xi, &tc,
-                                     &cell_factor, &big_ratio, &shell, &olaw, &owall))
+    if (!PyArg_ParseTupleAndKeywords(args, kw,
+                                     sim ? "|$OOOOOOpddddddOO:EDMD" : "|$OOOOOOpddddddOO:edmd_check",
+                                     names, &opos, &ovel, &orad, &omass, &olo, &ohi, &periodic,
+                                     &wall_e, &xi, &tc, &cell_factor, &big_ratio, &shell, &olaw,
+                                     &owall) ||
+        require_keywords(args, kw, names, 10, sim ? "EDMD" : "edmd_check") < 0)
         return -1;
     gr_law law, wall_law;
     PyArrayObject *law_x = NULL, *law_y = NULL, *wall_x = NULL, *wall_y = NULL;
@@ -382,18 +419,22 @@ static int out_buffer(PyObject *obj, const char *name, int type, npy_intp size, 
 
 static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
 {
-    static char *names[] = {"t_stop", "collisions_per_particle", "kinetic_energy",
+    /* the stop criteria and the chunk's budget, then the sample times and the buffers
+     * (None: not sampled) */
+    static char *names[] = {"t_stop", "collisions_per_particle", "stop_kinetic_energy",
                             "max_events", "sample_times", "next", "positions", "velocities",
                             "kinetic_energy", "momentum", "pair_collisions", "wall_collisions",
                             "virial", "wall_impulse",
                             NULL};
     gr_edmd_stop stop;
     long long max_events, next;
-    PyObject *otimes, *opos, *ovel, *okin, *omom, *opair, *owall, *ovir, *oimp;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "dddLOLOOOOOOOO", names, &stop.t_stop,
+    PyObject *otimes, *opos = Py_None, *ovel = Py_None, *okin = Py_None, *omom = Py_None,
+             *opair = Py_None, *owall = Py_None, *ovir = Py_None, *oimp = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$dddLOLOOOOOOOO:advance", names, &stop.t_stop,
                                      &stop.collisions_per_particle, &stop.kinetic_energy,
                                      &max_events, &otimes, &next, &opos, &ovel, &okin, &omom,
-                                     &opair, &owall, &ovir, &oimp))
+                                     &opair, &owall, &ovir, &oimp) ||
+        require_keywords(args, kw, names, 6, "advance") < 0)
         return NULL;
     if (!check_ready(self)) return NULL;
     if (max_events <= 0) {
@@ -401,7 +442,7 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         return NULL;
     }
     if (stop.t_stop != stop.t_stop || stop.kinetic_energy != stop.kinetic_energy) {
-        PyErr_SetString(PyExc_ValueError, "t_stop and kinetic_energy must not be NaN");
+        PyErr_SetString(PyExc_ValueError, "t_stop and stop_kinetic_energy must not be NaN");
         return NULL;
     }
     stop.energy = stop.kinetic_energy >= 0.0; /* negative: no energy criterion */
@@ -525,10 +566,11 @@ static PyObject *EDMD_restore_state(EDMDObject *self, PyObject *arg)
 
 static PyMethodDef EDMD_methods[] = {
     {"advance", (PyCFunction)(void (*)(void))EDMD_advance, METH_VARARGS | METH_KEYWORDS,
-     "advance(t_stop, collisions_per_particle, kinetic_energy, max_events, sample_times, next,"
-     " positions, velocities, kinetic, momentum, pair, wall, virial, wall_impulse)"
-     " -> (reason, next).  Process events, writing samples into the given arrays"
-     " (kinetic_energy: the mean to stop at, negative for none)."},
+     "advance(*, t_stop, collisions_per_particle, stop_kinetic_energy, max_events,"
+     " sample_times, next, positions=None, velocities=None, kinetic_energy=None,"
+     " momentum=None, pair_collisions=None, wall_collisions=None, virial=None,"
+     " wall_impulse=None) -> (reason, next).  Process events, writing samples into the"
+     " arrays given (stop_kinetic_energy: the mean to stop at, negative for none)."},
     {"state", (PyCFunction)EDMD_state, METH_NOARGS,
      "state() -> (positions wrapped in the box, velocities, image counters) at the current time"},
     {"counters", (PyCFunction)EDMD_counters, METH_NOARGS, "counters() -> dict"},
@@ -546,7 +588,11 @@ static PyTypeObject EDMDType = {
     .tp_basicsize = sizeof(EDMDObject),
     .tp_dealloc = (destructor)EDMD_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Event-driven MD engine (internal: use granular.Simulation).",
+    /* the signature line (before "--") is what inspect and stubtest read */
+    .tp_doc = "EDMD(*, positions, velocities, radii, masses, lower, upper, periodic, "
+              "wall_restitution, restitution, contact_duration, cell_factor=1.0, "
+              "big_ratio=BIG_RATIO, shell=0.0, law=None, wall_law=None)\n--\n\n"
+              "Event-driven MD engine (internal: use granular.Simulation).",
     .tp_methods = EDMD_methods,
     .tp_init = (initproc)EDMD_init,
     .tp_new = PyType_GenericNew,
@@ -752,7 +798,7 @@ static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *args)
 static PyMethodDef core_methods[] = {
     /* the event-driven engine's rules, owned by the C core */
     {"edmd_check", (PyCFunction)(void (*)(void))edmd_check, METH_VARARGS | METH_KEYWORDS,
-     "edmd_check(same arguments as EDMD): the checks of EDMD() without building it"},
+     "edmd_check(*, same keywords as EDMD): the checks of EDMD() without building it"},
     {"big_cut", big_cut, METH_VARARGS,
      "big_cut(radii, big_ratio): particles wider than this are big"},
     {"big_particles", big_particles, METH_VARARGS,

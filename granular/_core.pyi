@@ -28,14 +28,16 @@ VISCO_C1: float
 VISCO_C2: float
 VISCO_DELTA_MAX: float
 
-# a restitution law as the engine takes it (RestitutionLaw._engine): (kind, scale, v_max,
-# speeds, values), or None for a constant
-_Law = tuple[int, float, float, Any, Any] | None
+# a restitution law as the engine takes it (RestitutionLaw._engine): a dict of kind,
+# scale, v_max, speeds and values, or None for a constant
+_Law = dict[str, Any] | None
 
 @final
 class EDMD:
+    # every argument a keyword (so are advance's and edmd_check's)
     def __init__(
         self,
+        *,
         positions: ArrayLike,
         velocities: ArrayLike,
         radii: ArrayLike,
@@ -52,26 +54,25 @@ class EDMD:
         law: _Law = ...,
         wall_law: _Law = ...,
     ) -> None: ...
-    # The C keyword list names "kinetic_energy" twice: the criterion (third) and the samples'
-    # buffer; a keyword kinetic_energy fills the buffer, so the criterion goes by position.
-    # Returns (the STOP_* reason, the next sample's index).
+    # Returns (the STOP_* reason, the next sample's index).  stop_kinetic_energy < 0: no
+    # energy criterion; a buffer left None is not sampled.
     def advance(
         self,
+        *,
         t_stop: float,
         collisions_per_particle: float,
         stop_kinetic_energy: float,
         max_events: int,
         sample_times: ArrayLike,
         next: int,
-        /,
-        positions: NDArray[np.float64] | None,
-        velocities: NDArray[np.float64] | None,
-        kinetic_energy: NDArray[np.float64] | None,
-        momentum: NDArray[np.float64] | None,
-        pair_collisions: NDArray[np.int64] | None,
-        wall_collisions: NDArray[np.int64] | None,
-        virial: NDArray[np.float64] | None,
-        wall_impulse: NDArray[np.float64] | None,
+        positions: NDArray[np.float64] | None = ...,
+        velocities: NDArray[np.float64] | None = ...,
+        kinetic_energy: NDArray[np.float64] | None = ...,
+        momentum: NDArray[np.float64] | None = ...,
+        pair_collisions: NDArray[np.int64] | None = ...,
+        wall_collisions: NDArray[np.int64] | None = ...,
+        virial: NDArray[np.float64] | None = ...,
+        wall_impulse: NDArray[np.float64] | None = ...,
     ) -> tuple[int, int]: ...
     def state(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]: ...
     def counters(self) -> dict[str, Any]: ...
@@ -81,6 +82,7 @@ class EDMD:
     ) -> None: ...
 
 def edmd_check(
+    *,
     positions: ArrayLike,
     velocities: ArrayLike,
     radii: ArrayLike,

@@ -74,9 +74,10 @@ class RestitutionLaw(abc.ABC):
         """Whether some collision loses kinetic energy under this law (eps < 1)."""
 
     @abc.abstractmethod
-    def _engine(self) -> tuple | None:
-        """The law as the engine takes it: (kind, scale, v_max, speeds, values), or None
-        for a constant (the engine's own loop)."""
+    def _engine(self) -> dict[str, Any] | None:
+        """The law as the engine takes it (``_core.EDMD``'s ``law``, ``wall_law``): a dict
+        of kind, scale, v_max, speeds and values, or None for a constant (the engine's
+        own loop)."""
 
     @abc.abstractmethod
     def _key(self) -> tuple:
@@ -311,8 +312,14 @@ class Viscoelastic(RestitutionLaw):
     def loses_energy(self) -> bool:
         return True
 
-    def _engine(self) -> tuple:
-        return (_KIND_VISCOELASTIC, self.scale, self.max_speed, np.empty(0), np.empty(0))
+    def _engine(self) -> dict[str, Any]:
+        return dict(
+            kind=_KIND_VISCOELASTIC,
+            scale=self.scale,
+            v_max=self.max_speed,
+            speeds=np.empty(0),
+            values=np.empty(0),
+        )
 
     def _key(self) -> tuple:
         return (self.damping, self.kappa)
@@ -380,8 +387,8 @@ class TabulatedRestitution(RestitutionLaw):
     def loses_energy(self) -> bool:
         return bool(np.any(self.values < 1.0))
 
-    def _engine(self) -> tuple:
-        return (_KIND_TABLE, 0.0, 0.0, self.speeds, self.values)
+    def _engine(self) -> dict[str, Any]:
+        return dict(kind=_KIND_TABLE, scale=0.0, v_max=0.0, speeds=self.speeds, values=self.values)
 
     def _key(self) -> tuple:
         return (self.speeds.tobytes(), self.values.tobytes())
@@ -411,7 +418,7 @@ def heats(restitution: float | RestitutionLaw) -> bool:
     return not isinstance(restitution, RestitutionLaw) and restitution > 1.0
 
 
-def engine_law(restitution: float | RestitutionLaw) -> tuple | None:
+def engine_law(restitution: float | RestitutionLaw) -> dict[str, Any] | None:
     """The law as the engine takes it, or None for a number."""
     return restitution._engine() if isinstance(restitution, RestitutionLaw) else None
 

@@ -286,7 +286,7 @@ class Scene:
             raise ValueError(f"contact_duration must be finite and >= 0, got {contact_duration}")
         # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
         # the engine's own rules in O(N) through a cell grid, without building an engine.
-        _core.edmd_check(*self._engine_args(), **self._engine_laws())
+        _core.edmd_check(**self._engine_keywords())
 
     def __setattr__(self, name: str, value: Any) -> None:
         # a field set after the checks would skip them (a restitution of 7.5, an overlap)
@@ -304,26 +304,24 @@ class Scene:
     def __delattr__(self, name: str) -> None:
         raise AttributeError(f"a Scene is immutable: {name} cannot be deleted")
 
-    def _engine_laws(self) -> dict[str, Any]:
-        """The restitution laws as keywords of ``_core.EDMD`` (None: the number)."""
-        return dict(law=engine_law(self.restitution), wall_law=engine_law(self.wall_restitution))
-
-    def _engine_args(
-        self,
-    ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray, NDArray, bool, float, float, float]:
-        """The scene as the C engine takes it (``_core.edmd_check`` and ``_core.EDMD``),
-        with ``_engine_laws`` as keywords; a law's number is 1 (unused)."""
-        return (
-            self.positions,
-            self.velocities,
-            self.radii,
-            self.masses,
-            self.lower,
-            self.upper,
-            self.boundary == "periodic",
-            1.0 if isinstance(self.wall_restitution, RestitutionLaw) else self.wall_restitution,
-            1.0 if isinstance(self.restitution, RestitutionLaw) else self.restitution,
-            self.contact_duration,
+    def _engine_keywords(self) -> dict[str, Any]:
+        """The scene as the C engine takes it: the keywords of ``_core.edmd_check`` and
+        ``_core.EDMD`` (a law's number is 1, unused; None for a number's law)."""
+        return dict(
+            positions=self.positions,
+            velocities=self.velocities,
+            radii=self.radii,
+            masses=self.masses,
+            lower=self.lower,
+            upper=self.upper,
+            periodic=self.boundary == "periodic",
+            wall_restitution=1.0
+            if isinstance(self.wall_restitution, RestitutionLaw)
+            else self.wall_restitution,
+            restitution=1.0 if isinstance(self.restitution, RestitutionLaw) else self.restitution,
+            contact_duration=self.contact_duration,
+            law=engine_law(self.restitution),
+            wall_law=engine_law(self.wall_restitution),
         )
 
     # -- derived quantities ---------------------------------------------------------

@@ -371,7 +371,15 @@ class Simulation:
             self._check_not_frozen(start, frozen, moving)
             while budget - done > 0:
                 chunk = int(min(_CHUNK, budget - done))
-                code, nxt = self._engine.advance(t_end, cpp, kin, chunk, times, nxt, **views)
+                code, nxt = self._engine.advance(
+                    t_stop=t_end,
+                    collisions_per_particle=cpp,
+                    stop_kinetic_energy=kin,
+                    max_events=chunk,
+                    sample_times=times,
+                    next=nxt,
+                    **views,
+                )
                 after = self._engine.counters()
                 done += after["events"] - events
                 events = after["events"]
