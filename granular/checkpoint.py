@@ -40,6 +40,7 @@ import numpy as np
 
 from . import _core
 from ._files import WHAT_READS, kind_of, write_atomic
+from ._scene_params import PARAMETERS, shape_of
 from .errors import CheckpointError, GranularError
 from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
 from .scene import Scene
@@ -50,11 +51,11 @@ if TYPE_CHECKING:
 FORMAT = "granular-checkpoint"
 FORMAT_VERSION = 1
 
-# The Scene as stored: its arrays, and its other constructor keywords as JSON.  A new
-# Scene parameter (e.g. a restitution law) is one more name in _SCENE_PARAMS, with a
-# JSON-able value.
-_SCENE_ARRAYS = ("positions", "velocities", "radii", "masses", "lower", "upper")
-_SCENE_PARAMS = ("boundary", "wall_restitution", "restitution", "contact_duration")
+# The Scene as stored, as its declaration (granular/_scene_params.py) says: an array
+# parameter as a member scene_<attribute> each (the box as its corners lower and upper),
+# the others in the meta JSON (restitution.describe: numbers, strings and laws).
+_SCENE_ARRAYS = tuple(a for p in PARAMETERS if p.is_array for a in p.fields)
+_SCENE_PARAMS = tuple(p.name for p in PARAMETERS if not p.is_array)
 
 
 # Collisions without heated walls never add kinetic energy, elastic ones keep it, and
@@ -291,14 +292,7 @@ def _read_members(zf, f, where):
         raise ValueError(f"its scene positions have shape {n_d}, not (N, 2) or (N, 3)")
     n, d = n_d
     f8 = np.dtype(np.float64)  # native, as np.savez wrote the Scene's arrays
-    shapes = {
-        "positions": (n, d),
-        "velocities": (n, d),
-        "radii": (n,),
-        "masses": (n,),
-        "lower": (d,),
-        "upper": (d,),
-    }
+    shapes = {a: shape_of(p, n, d) for p in PARAMETERS if p.is_array for a in p.fields}
     arrays = {
         f"scene_{name}": _member_array(zf, names[f"scene_{name}.npy"], f8, shape, size)
         for name, shape in shapes.items()
@@ -347,20 +341,17 @@ def _build(meta: dict[str, Any], arrays: dict[str, np.ndarray], where: str) -> S
         state = arrays["engine_state"]
         if hashlib.sha256(state.data).hexdigest() != meta["engine_state_sha256"]:
             raise ValueError("the engine state does not match its checksum")
-        fields = {name: arrays[f"scene_{name}"] for name in _SCENE_ARRAYS}
-        # the boundary's string, numbers and laws: Any, to be checked by Scene
+        # the arrays; the boundary's string, numbers and laws: Any, to be checked by Scene
         params: dict[str, Any] = {
-            name: from_description(meta["scene"][name]) for name in _SCENE_PARAMS
+            p.name: tuple(arrays[f"scene_{a}"] for a in p.fields)
+            if p.attributes
+            else arrays[f"scene_{p.name}"]
+            for p in PARAMETERS
+            if p.is_array
         }
+        params.update({name: from_description(meta["scene"][name]) for name in _SCENE_PARAMS})
         knobs = meta["knobs"]
-        scene = Scene(
-            fields["positions"],
-            fields["velocities"],
-            fields["radii"],
-            fields["masses"],
-            box=(fields["lower"], fields["upper"]),
-            **params,
-        )
+        scene = Scene(**params)
         sim = Simulation(scene, **knobs)
         sim._engine.restore_state(state)
     except (KeyError, TypeError, ValueError, OverflowError) as exc:

@@ -204,18 +204,7 @@ class Simulation:
     def scene(self) -> Scene:
         """The current state as a new Scene (positions wrapped into a periodic box)."""
         pos, vel, _ = self._engine.state()
-        s = self._initial
-        return Scene(
-            pos,
-            vel,
-            s.radii,
-            s.masses,
-            box=(s.lower, s.upper),
-            boundary=s.boundary,
-            wall_restitution=s.wall_restitution,
-            restitution=s.restitution,
-            contact_duration=s.contact_duration,
-        )
+        return self._initial.replace(positions=pos, velocities=vel)
 
     @property
     def unwrapped_positions(self) -> NDArray[np.float64]:
