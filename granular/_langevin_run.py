@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -19,9 +19,6 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._scales import SCALE_HI, SCALE_LO, check_range
 from .errors import shown
-
-if TYPE_CHECKING:  # for the hints only: langevin imports this module
-    from . import langevin
 
 MODELS = ("langevin", "udsbm")
 # the TAMSD's windows (csrc/tamsd.h): "strided" starts a lag's windows every power of
@@ -543,51 +540,3 @@ def _integrate(
     finally:
         if bar is not None:
             bar.close()
-
-
-def _result(
-    p: _Run,
-    initial: str,
-    steps: NDArray[np.int64],
-    lags: NDArray[np.int64],
-    sums: _Sums,
-    x: NDArray[np.float64],
-    v: NDArray[np.float64],
-    v0_sq: float,
-) -> langevin.LangevinResult:
-    """The result of a run: the engine's sums divided into means (the TAMSD by each lag's
-    number of windows), with what the run was given."""
-    from .langevin import LangevinResult
-
-    n, L = p.n, len(lags)
-    estimator = _estimator_code(p.tamsd_estimator)
-    strides = np.array([_core.sde_lag_stride(int(k), estimator) for k in lags], dtype=np.int64)
-    windows = (p.n_steps - lags) // np.maximum(strides, 1) + 1
-    per_particle = sums.tamsd / windows if L else sums.tamsd
-    return LangevinResult(
-        times=(steps * p.dt).astype(np.float64, copy=False),
-        steps=steps,
-        msd_total=sums.x2.sum(1) / n,
-        msd_per_dimension=sums.x2 / n,
-        v2=sums.v2.sum(1) / n,
-        tamsd_lags=(lags * p.dt).astype(np.float64, copy=False),
-        tamsd_mean=per_particle.mean(0) if L else np.zeros(0),
-        tamsd_per_particle=per_particle,
-        positions=sums.positions,
-        final_positions=x,
-        final_velocities=v,
-        model=p.model,
-        scheme=p.scheme,
-        tamsd_estimator=p.tamsd_estimator,
-        gamma0=p.gamma0,
-        D0=p.D0,
-        tau0=p.tau0,
-        dt=p.dt,
-        n=n,
-        dim=p.dim,
-        t_stop=p.n_steps * p.dt,
-        v0_sq=v0_sq,
-        exponent=p.exponent if p.model == "udsbm" else 1.0,
-        initial=initial,
-        mass=p.mass,
-    )

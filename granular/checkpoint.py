@@ -34,7 +34,8 @@ import os
 import stat
 import struct
 import zipfile
-from typing import IO, TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import IO, Any, Protocol, TypeVar
 
 import numpy as np
 
@@ -45,8 +46,21 @@ from .errors import CheckpointError, GranularError
 from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
 from .scene import Scene
 
-if TYPE_CHECKING:
-    from .simulation import Simulation
+
+class _Run(Protocol):
+    """What a checkpoint takes from a granular.Simulation and gives back (named here by
+    what it offers: simulation imports this module, so this one does not import it)."""
+
+    _initial: Scene
+    _knobs: dict[str, Any]
+    _engine: Any  # _core.EDMD
+
+    @property
+    def scene(self) -> Scene: ...
+
+
+_S = TypeVar("_S", bound=_Run)
+
 
 FORMAT = "granular-checkpoint"
 FORMAT_VERSION = 1
@@ -73,7 +87,7 @@ def _version() -> str:
     return __version__
 
 
-def _fault(sim: Simulation) -> str | None:
+def _fault(sim: _Run) -> str | None:
     """What makes ``sim``'s current state one its run cannot have reached or cannot go on
     from, or None: its positions and velocities must make a valid Scene (the scale limits,
     inside the walls, no overlaps: the checks of a new scene, scene.py and
@@ -111,7 +125,7 @@ def _fault(sim: Simulation) -> str | None:
     return None
 
 
-def dumps(sim: Simulation) -> bytes:
+def dumps(sim: _Run) -> bytes:
     """The checkpoint of ``sim`` as the bytes of an ``.npz`` file (see ``Simulation.save``)."""
     fault = _fault(sim)
     if fault:
@@ -136,14 +150,15 @@ def dumps(sim: Simulation) -> bytes:
     return buf.getvalue()
 
 
-def save(sim: Simulation, path: str | os.PathLike) -> None:
+def save(sim: _Run, path: str | os.PathLike) -> None:
     """Write ``sim``'s checkpoint to ``path`` atomically (``_files.write_atomic``): an older
     checkpoint at ``path`` survives until the new one is complete."""
     write_atomic(path, dumps(sim), suffix=".npz")
 
 
-def load(path: str | os.PathLike) -> Simulation:
-    """The Simulation saved in ``path`` (see ``Simulation.load``)."""
+def load(path: str | os.PathLike, make: Callable[..., _S]) -> _S:
+    """The Simulation saved in ``path`` (see ``Simulation.load``), built by
+    ``make(scene, **knobs)`` (the Simulation class) and given the saved state."""
     where = repr(os.fspath(path))
     try:
         f = open(path, "rb")  # closed by the with below, after the checks on it
@@ -160,7 +175,7 @@ def load(path: str | os.PathLike) -> Simulation:
                 "is a file written by Simulation.save"
             )
         meta, arrays = _read_npz(f, where)
-    return _build(meta, arrays, where)
+    return _build(meta, arrays, where, make)
 
 
 # The members of a checkpoint's zip archive, each an .npy array.
@@ -327,16 +342,20 @@ def _check_version(meta: dict, where: str) -> None:
         )
 
 
-def loads(data: bytes, where: str = "the checkpoint") -> Simulation:
-    """The Simulation in checkpoint bytes made by ``dumps`` (also what unpickling calls)."""
+def loads(data: bytes, make: Callable[..., _S], where: str = "the checkpoint") -> _S:
+    """The Simulation in checkpoint bytes made by ``dumps`` (also what unpickling calls),
+    built by ``make`` as in ``load``."""
     meta, arrays = _read_npz(bytes(data), where)
-    return _build(meta, arrays, where)
+    return _build(meta, arrays, where, make)
 
 
-def _build(meta: dict[str, Any], arrays: dict[str, np.ndarray], where: str) -> Simulation:
+def _build(
+    meta: dict[str, Any],
+    arrays: dict[str, np.ndarray],
+    where: str,
+    make: Callable[..., _S],
+) -> _S:
     """The Simulation of a checkpoint's parts, read and checked for their sizes."""
-    from .simulation import Simulation
-
     try:
         state = arrays["engine_state"]
         if hashlib.sha256(state.data).hexdigest() != meta["engine_state_sha256"]:
@@ -352,7 +371,7 @@ def _build(meta: dict[str, Any], arrays: dict[str, np.ndarray], where: str) -> S
         params.update({name: from_description(meta["scene"][name]) for name in _SCENE_PARAMS})
         knobs = meta["knobs"]
         scene = Scene(**params)
-        sim = Simulation(scene, **knobs)
+        sim = make(scene, **knobs)
         sim._engine.restore_state(state)
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise CheckpointError(f"{where} is corrupt: {exc}") from exc

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _edmd
+from . import _core, _edmd, gsd_io
 from ._scales import SCALE_HI, SCALE_LO, check_range
 from ._scene_params import BOUNDARIES, NAMES, PARAMETERS, SIGNATURE, engine_keywords, real
 from ._scene_params import box_corners as _box_corners
@@ -261,12 +261,10 @@ class Scene:
     def from_gsd(cls, path: str | os.PathLike, frame: int = -1, **params: Any) -> Scene:
         """The scene at one frame (default the last) of a GSD file: exact float64 positions
         (wrapped into the box), velocities, radii, masses and box when granular wrote it
-        (``Trajectory.write``), else from the float32 HOOMD fields.  ``params`` are the
-        other Scene keywords (restitution, wall_restitution, contact_duration), which a
-        trajectory does not record."""
-        from . import gsd_io
-
-        return gsd_io.scene_from_gsd(path, frame, **params)
+        (``Trajectory.write``), else from the float32 HOOMD fields.  ``params`` are Scene
+        parameters to set (as ``replace`` does): those a trajectory does not record, such
+        as the restitutions."""
+        return gsd_io.scene_from_gsd(path, frame, cls, **params)
 
     @classmethod
     def random(

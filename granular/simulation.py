@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _edmd
+from . import _core, _edmd, checkpoint
 from . import restitution as _restitution
 from ._edmd import check_memory as _check_memory
 from .errors import (
@@ -116,8 +116,6 @@ class Simulation:
             ``NonFiniteError`` leaves them, or anything else ``load`` would refuse):
             nothing is written.
         """
-        from . import checkpoint
-
         with self._exclusive():
             checkpoint.save(self, path)
 
@@ -144,17 +142,18 @@ class Simulation:
             momentum), or was written by another granular version or engine layout (a
             run continues bit for bit only in the version that saved it).
         """
-        from . import checkpoint
+        return checkpoint.load(path, cls)
 
-        return checkpoint.load(path)
+    @classmethod
+    def _loads(cls, data: bytes) -> Simulation:
+        """The Simulation in checkpoint bytes (``checkpoint.dumps``): what unpickling calls."""
+        return checkpoint.loads(data, cls)
 
     def __reduce__(self):
         # pickling (and copy.copy / copy.deepcopy, Dask) goes through a checkpoint: the
         # copy gets its own engine with the same state, never a shared one
-        from . import checkpoint
-
         with self._exclusive():
-            return (checkpoint.loads, (checkpoint.dumps(self),))
+            return (type(self)._loads, (checkpoint.dumps(self),))
 
     @contextlib.contextmanager
     def _exclusive(self, instead: str = "save or copy it between runs") -> Iterator[None]:
