@@ -16,6 +16,7 @@
 #include "common.h"
 #include "edmd.h"
 #include "rng.h"
+#include "scene_params.h"
 #include "sde.h"
 
 /* ------------------------------------------------------------------------------------ */
@@ -218,23 +219,39 @@ static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
  * exception set. */
+/* EDMD's keywords: the particles' arrays, the box, the boundary, the scene's numbers
+ * (scene_params.h, in its order), the engine knobs and the laws.  The first
+ * EDMD_REQUIRED are required.  _core.EDMD_KEYWORDS is this list. */
+#define NAME_OF(field) #field,
+#define FORMAT_OF(field) "d"
+#define COUNT_OF(field) +1
+static char *edmd_names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
+                             "periodic", GR_SCENE_DOUBLES(NAME_OF) "cell_factor", "big_ratio",
+                             "shell", "law", "wall_law", NULL};
+#define EDMD_REQUIRED (7 GR_SCENE_DOUBLES(COUNT_OF))
+#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOO"
+
+/* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
+ * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
+ * exception set. */
 static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_out,
                           npy_intp *n_out)
 {
-    static char *names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
-                            "periodic", "wall_restitution", "restitution",
-                            "contact_duration", "cell_factor", "big_ratio", "shell",
-                            "law", "wall_law", NULL};
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None;
-    int periodic;
-    double wall_e, xi, tc, cell_factor = 1.0, big_ratio = GR_BIG_RATIO, shell = 0.0;
+    gr_edmd_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.cell_factor = 1.0;
+    cfg.big_ratio = GR_BIG_RATIO;
+    cfg.shell = 0.0;
+#define ADDRESS_OF(field) &cfg.field,
     if (!PyArg_ParseTupleAndKeywords(args, kw,
-                                     sim ? "|$OOOOOOpddddddOO:EDMD" : "|$OOOOOOpddddddOO:edmd_check",
-                                     names, &opos, &ovel, &orad, &omass, &olo, &ohi, &periodic,
-                                     &wall_e, &xi, &tc, &cell_factor, &big_ratio, &shell, &olaw,
-                                     &owall) ||
-        require_keywords(args, kw, names, 10, sim ? "EDMD" : "edmd_check") < 0)
+                                     sim ? EDMD_FORMAT ":EDMD" : EDMD_FORMAT ":edmd_check",
+                                     edmd_names, &opos, &ovel, &orad, &omass, &olo, &ohi,
+                                     &cfg.periodic, GR_SCENE_DOUBLES(ADDRESS_OF) &cfg.cell_factor,
+                                     &cfg.big_ratio, &cfg.shell, &olaw, &owall) ||
+        require_keywords(args, kw, edmd_names, EDMD_REQUIRED, sim ? "EDMD" : "edmd_check") < 0)
         return -1;
+#undef ADDRESS_OF
     gr_law law, wall_law;
     PyArrayObject *law_x = NULL, *law_y = NULL, *wall_x = NULL, *wall_y = NULL;
     if (parse_law(olaw, "law", &law, &law_x, &law_y) < 0) return -1;
@@ -259,21 +276,12 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
         !(mass = as_f64(omass, "masses", 1, shn)) || !(lo = as_f64(olo, "lower", 1, shd)) ||
         !(hi = as_f64(ohi, "upper", 1, shd)))
         goto done;
-    gr_edmd_config cfg;
-    memset(&cfg, 0, sizeof cfg);
     cfg.dim = (int)d;
     cfg.n = n;
     for (int a = 0; a < d; a++) {
         cfg.lo[a] = ((double *)PyArray_DATA(lo))[a];
         cfg.hi[a] = ((double *)PyArray_DATA(hi))[a];
     }
-    cfg.periodic = periodic;
-    cfg.wall_restitution = wall_e;
-    cfg.restitution = xi;
-    cfg.contact_duration = tc;
-    cfg.cell_factor = cell_factor;
-    cfg.big_ratio = big_ratio;
-    cfg.shell = shell;
     cfg.law = law;
     cfg.wall_law = wall_law;
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
@@ -872,6 +880,24 @@ PyMODINIT_FUNC PyInit__core(void)
         return NULL;
     }
     Py_DECREF(big_ratio);
+    /* EDMD's keywords (edmd_names): granular/_scene_params.py's test reads them */
+    Py_ssize_t count = 0;
+    while (edmd_names[count]) count++;
+    PyObject *keywords = PyTuple_New(count);
+    for (Py_ssize_t i = 0; keywords && i < count; i++) {
+        PyObject *name = PyUnicode_FromString(edmd_names[i]);
+        if (!name) {
+            Py_CLEAR(keywords);
+            break;
+        }
+        PyTuple_SET_ITEM(keywords, i, name);
+    }
+    if (!keywords || PyModule_AddObjectRef(m, "EDMD_KEYWORDS", keywords) < 0) {
+        Py_XDECREF(keywords);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_DECREF(keywords);
     /* ==== restitution laws (restitution.h): granular/restitution.py reads these ==== */
     if (PyModule_AddIntConstant(m, "LAW_CONSTANT", GR_LAW_CONSTANT) < 0 ||
         PyModule_AddIntConstant(m, "LAW_VISCOELASTIC", GR_LAW_VISCOELASTIC) < 0 ||

@@ -10,6 +10,7 @@ from numpy.typing import ArrayLike, NDArray
 BIG_MAX: int
 BIG_RATIO: float
 CHECKPOINT_LAYOUT: int
+EDMD_KEYWORDS: tuple[str, ...]
 HEADS_CACHED: int
 LAW_CONSTANT: int
 LAW_TABLE: int
