@@ -597,10 +597,9 @@ static PyTypeObject EDMDType = {
     .tp_dealloc = (destructor)EDMD_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
     /* the signature line (before "--") is what inspect and stubtest read */
-    .tp_doc = "EDMD(*, positions, velocities, radii, masses, lower, upper, periodic, "
-              "wall_restitution, restitution, contact_duration, cell_factor=1.0, "
-              "big_ratio=BIG_RATIO, shell=0.0, law=None, wall_law=None)\n--\n\n"
-              "Event-driven MD engine (internal: use granular.Simulation).",
+    .tp_doc = "EDMD(*, cell_factor=1.0, big_ratio=BIG_RATIO, shell=0.0, **scene)\n--\n\n"
+              "Event-driven MD engine (internal: use granular.Simulation).  The scene's "
+              "keywords are EDMD_KEYWORDS (Scene._engine_keywords gives them).",
     .tp_methods = EDMD_methods,
     .tp_init = (initproc)EDMD_init,
     .tp_new = PyType_GenericNew,

@@ -29,31 +29,17 @@ VISCO_C1: float
 VISCO_C2: float
 VISCO_DELTA_MAX: float
 
-# a restitution law as the engine takes it (RestitutionLaw._engine): a dict of kind,
-# scale, v_max, speeds and values, or None for a constant
-_Law = dict[str, Any] | None
-
 @final
 class EDMD:
-    # every argument a keyword (so are advance's and edmd_check's)
+    # every argument a keyword (so are advance's and edmd_check's); the scene's are
+    # EDMD_KEYWORDS, made by granular/_scene_params.py (Scene._engine_keywords)
     def __init__(
         self,
         *,
-        positions: ArrayLike,
-        velocities: ArrayLike,
-        radii: ArrayLike,
-        masses: ArrayLike,
-        lower: ArrayLike,
-        upper: ArrayLike,
-        periodic: bool,
-        wall_restitution: float,
-        restitution: float,
-        contact_duration: float,
         cell_factor: float = ...,
         big_ratio: float = ...,
         shell: float = ...,
-        law: _Law = ...,
-        wall_law: _Law = ...,
+        **scene: Any,
     ) -> None: ...
     # Returns (the STOP_* reason, the next sample's index).  stop_kinetic_energy < 0: no
     # energy criterion; a buffer left None is not sampled.
@@ -83,22 +69,7 @@ class EDMD:
     ) -> None: ...
 
 def edmd_check(
-    *,
-    positions: ArrayLike,
-    velocities: ArrayLike,
-    radii: ArrayLike,
-    masses: ArrayLike,
-    lower: ArrayLike,
-    upper: ArrayLike,
-    periodic: bool,
-    wall_restitution: float,
-    restitution: float,
-    contact_duration: float,
-    cell_factor: float = ...,
-    big_ratio: float = ...,
-    shell: float = ...,
-    law: _Law = ...,
-    wall_law: _Law = ...,
+    *, cell_factor: float = ..., big_ratio: float = ..., shell: float = ..., **scene: Any
 ) -> None: ...
 def big_cut(radii: ArrayLike, big_ratio: float, /) -> float: ...
 def big_particles(
