@@ -4,10 +4,12 @@ stores it.  That one declaration (``PARAMETERS``) drives Scene's constructor (it
 and checks), ``replace``, ``repr``, the engine's arguments (``engine_keywords``), the
 checkpoints (arrays or JSON) and the GSD reader's keywords.
 
-Adding a parameter: one ``SceneParameter`` here, its field in the engine's config (csrc/edmd.h
-``gr_edmd_config``, with its name in ``names[]`` of ``edmd_from_args`` in csrc/_core.c and its
-check in csrc/validate.c) and the physics that uses it.  tests/test_scene_params.py checks
-that every parameter reaches the engine by name and survives a checkpoint.
+Adding a parameter (docs/engine.md, "Adding a scene parameter"): one ``SceneParameter``
+here, its field in the engine's config (csrc/edmd.h ``gr_edmd_config``; a number is also
+one line of csrc/scene_params.h, which gives the binding its keyword and a checkpoint its
+bytes), its check in csrc/validate.c, and the physics that uses it.
+tests/test_scene_params.py checks that every parameter reaches the engine by name
+(``_core.EDMD_KEYWORDS``), goes through ``replace`` and survives a checkpoint.
 
 Units as in docs/conventions.md: ``L`` the length unit, ``m`` the mass unit, speeds in
 ``sqrt(eps/m)``, time in ``L sqrt(m/eps)``.
