@@ -658,11 +658,14 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     long long n, first, step_from, step_to, n_steps;
     PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring, *ocarry = Py_None;
     int threads = 1, estimator = GR_TAMSD_STRIDED;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO|Oiid", names, &cfg.dim,
-                                     &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0, &cfg.tau0,
-                                     &cfg.dt, &key, &n, &first, &step_from, &step_to, &n_steps,
-                                     &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags, &otamsd,
-                                     &oring, &ocarry, &threads, &estimator, &cfg.exponent))
+    /* every argument a keyword, the first 22 required (see require_keywords) */
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$iiiddddKLLLLLOOOOOOOOOOiid:sde_run", names,
+                                     &cfg.dim, &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0,
+                                     &cfg.tau0, &cfg.dt, &key, &n, &first, &step_from, &step_to,
+                                     &n_steps, &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags,
+                                     &otamsd, &oring, &ocarry, &threads, &estimator,
+                                     &cfg.exponent) ||
+        require_keywords(args, kw, names, 22, "sde_run") < 0)
         return NULL;
     if (!(cfg.exponent > 0.0 && cfg.exponent < INFINITY)) {
         PyErr_SetString(PyExc_ValueError, "exponent must be positive and finite");
@@ -814,7 +817,7 @@ static PyMethodDef core_methods[] = {
      "edmd_bytes_per_particle(dim, lists): what the engine allocates per particle"},
     /* ==== SDE methods begin ==== */
     {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
-     "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
+     "sde_run(*, dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
      " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring, carry=None,"
      " threads=1, tamsd_estimator=0, exponent=1.0): advance particles first..first+len(x)"
      " over the steps [step_from, step_to) of a run of n_steps on `threads` threads,"

@@ -77,6 +77,7 @@ def big_particles(
 ) -> NDArray[np.bool_]: ...
 def edmd_bytes_per_particle(dim: int, lists: bool, /) -> int: ...
 def sde_run(
+    *,
     dim: int,
     model: int,
     scheme: int,

@@ -1,8 +1,8 @@
 """The steps of ``granular.langevin.run``, one job each: check and normalise the arguments
 (``_checked``, ``_sample_steps``, ``_tamsd_lag_steps``, ``_check_scales``), draw the start
-(``_initial_state``), allocate what the engine accumulates into (``_new_sums``), step the
-particles in chunks through the C engine (``_integrate``, its arguments built by name in
-``_sde_args``) and make the result (``_result``).  The lag grid's checks (``_lag_steps``)
+(``_initial_state``), allocate what the engine accumulates into (``_new_sums``) and step the
+particles in chunks through the C engine (``_integrate``, every argument by name); the
+result is made in granular.langevin (``_result``).  The lag grid's checks (``_lag_steps``)
 and the names of the models, schemes and estimators are here too, where the run needs
 them first; ``granular.langevin`` shows them to users."""
 
@@ -412,69 +412,6 @@ def _chunks(n_steps: int, threads: int, work: int) -> tuple[int, int]:
     return per_call, steps_per_call
 
 
-def _sde_args(
-    *,
-    dim: int,
-    model: int,
-    scheme: int,
-    gamma0: float,
-    D0: float,
-    tau0: float,
-    dt: float,
-    key: int,
-    n: int,
-    first: int,
-    step_from: int,
-    step_to: int,
-    n_steps: int,
-    x: NDArray[np.float64],
-    v: NDArray[np.float64],
-    sample_steps: NDArray[np.int64],
-    x2: NDArray[np.float64],
-    v2: NDArray[np.float64],
-    positions: NDArray[np.float64] | None,
-    lags: NDArray[np.int64],
-    tamsd: NDArray[np.float64],
-    ring: NDArray[np.float64],
-    carry: NDArray[np.float64],
-    threads: int,
-    tamsd_estimator: int,
-    exponent: float,
-) -> tuple[Any, ...]:
-    """``_core.sde_run``'s arguments, taken by name and put in the binding's order, that of
-    ``names[]`` and the format "iiiddddKLLLLLOOOOOOOOO|Oiid" of ``sde_run`` in
-    csrc/_core.c: they are passed by position, where two swapped numbers of one type would
-    run unseen (tests/test_langevin.py checks that the two orders agree)."""
-    return (
-        dim,
-        model,
-        scheme,
-        gamma0,
-        D0,
-        tau0,
-        dt,
-        key,
-        n,
-        first,
-        step_from,
-        step_to,
-        n_steps,
-        x,
-        v,
-        sample_steps,
-        x2,
-        v2,
-        positions,
-        lags,
-        tamsd,
-        ring,
-        carry,
-        threads,
-        tamsd_estimator,
-        exponent,
-    )
-
-
 def _integrate(
     p: _Run,
     key: int,
@@ -504,7 +441,7 @@ def _integrate(
             vs = np.ascontiguousarray(v[first : first + per_call])
             for step_from in range(0, p.n_steps, steps_per_call):
                 step_to = min(step_from + steps_per_call, p.n_steps)
-                args = _sde_args(
+                _core.sde_run(
                     dim=p.dim,
                     model=model,
                     scheme=scheme,
@@ -532,7 +469,6 @@ def _integrate(
                     tamsd_estimator=estimator,
                     exponent=p.exponent,
                 )
-                _core.sde_run(*args)
                 if bar is not None:
                     bar.update(len(xs) * (step_to - step_from))
             x[first : first + len(xs)] = xs
