@@ -16,6 +16,7 @@
 #include "common.h"
 #include "edmd.h"
 #include "rng.h"
+#include "scene_params.h"
 #include "sde.h"
 
 /* ------------------------------------------------------------------------------------ */
@@ -151,23 +152,57 @@ static void EDMD_dealloc(EDMDObject *self)
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-/* A restitution law from None (constant: *law zeroed) or a tuple (kind, scale, v_max,
- * speeds, values) as granular/restitution.py builds it; the table arrays are returned in
- * *x, *y (new references, or NULL) and must outlive the use of *law.  Returns 0, or -1
- * with an exception set.  The engine checks the values (validate.c). */
+/* Every argument of the engine's entry points is a keyword ("|$" in the format): a wrong
+ * name is a TypeError and two numbers cannot swap places.  PyArg_ParseTupleAndKeywords
+ * cannot make a keyword-only argument required, so the first `required` of names[] are
+ * checked here, after it (which names an unknown keyword).  Returns 0, or -1 with a
+ * TypeError set. */
+static int require_keywords(PyObject *args, PyObject *kw, char **names, int required,
+                            const char *function)
+{
+    if (args && PyTuple_GET_SIZE(args) > 0) {
+        PyErr_Format(PyExc_TypeError,
+                     "%s() takes no positional arguments (%zd given): give each by name",
+                     function, PyTuple_GET_SIZE(args));
+        return -1;
+    }
+    for (int i = 0; i < required; i++) {
+        PyObject *value = kw ? PyDict_GetItemString(kw, names[i]) : NULL;
+        if (!value) {
+            PyErr_Format(PyExc_TypeError, "%s() missing required keyword argument '%s'",
+                         function, names[i]);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* A restitution law from None (constant: *law zeroed) or a dict {kind, scale, v_max,
+ * speeds, values} as granular/restitution.py builds it (RestitutionLaw._engine); the table
+ * arrays are returned in *x, *y (new references, or NULL) and must outlive the use of
+ * *law.  Returns 0, or -1 with an exception set.  The engine checks the values
+ * (validate.c). */
 static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject **x,
                      PyArrayObject **y)
 {
+    static char *names[] = {"kind", "scale", "v_max", "speeds", "values", NULL};
     memset(law, 0, sizeof *law);
     *x = *y = NULL;
     if (obj == Py_None) return 0;
-    PyObject *ox, *oy;
-    if (!PyTuple_Check(obj) ||
-        !PyArg_ParseTuple(obj, "iddOO", &law->kind, &law->scale, &law->v_max, &ox, &oy)) {
-        PyErr_Format(PyExc_TypeError, "%s must be None or (kind, scale, v_max, speeds, values)",
-                     name);
+    if (!PyDict_Check(obj)) {
+        PyErr_Format(PyExc_TypeError,
+                     "%s must be None or a dict of kind, scale, v_max, speeds and values", name);
         return -1;
     }
+    char format[64];
+    snprintf(format, sizeof format, "|$iddOO:%s", name);
+    PyObject *ox, *oy, *none = PyTuple_New(0);
+    if (!none) return -1;
+    int ok = PyArg_ParseTupleAndKeywords(none, obj, format, names, &law->kind, &law->scale,
+                                         &law->v_max, &ox, &oy) &&
+             require_keywords(NULL, obj, names, 5, name) == 0;
+    Py_DECREF(none);
+    if (!ok) return -1;
     npy_intp any[1] = {-1};
     if (!(*x = as_f64(ox, "a law's speeds", 1, any))) return -1;
     npy_intp shape[1] = {PyArray_DIM(*x, 0)};
@@ -184,20 +219,39 @@ static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
  * exception set. */
+/* EDMD's keywords: the particles' arrays, the box, the boundary, the scene's numbers
+ * (scene_params.h, in its order), the engine knobs and the laws.  The first
+ * EDMD_REQUIRED are required.  _core.EDMD_KEYWORDS is this list. */
+#define NAME_OF(field) #field,
+#define FORMAT_OF(field) "d"
+#define COUNT_OF(field) +1
+static char *edmd_names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
+                             "periodic", GR_SCENE_DOUBLES(NAME_OF) "cell_factor", "big_ratio",
+                             "shell", "law", "wall_law", NULL};
+#define EDMD_REQUIRED (7 GR_SCENE_DOUBLES(COUNT_OF))
+#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOO"
+
+/* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
+ * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
+ * exception set. */
 static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_out,
                           npy_intp *n_out)
 {
-    static char *names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
-                            "periodic", "wall_restitution", "restitution",
-                            "contact_duration", "cell_factor", "big_ratio", "shell",
-                            "law", "wall_law", NULL};
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None;
-    int periodic;
-    double wall_e, xi, tc, cell_factor = 1.0, big_ratio = GR_BIG_RATIO, shell = 0.0;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOOOOOpddd|dddOO", names, &opos, &ovel, &orad,
-                                     &omass, &olo, &ohi, &periodic, &wall_e, &xi, &tc,
-                                     &cell_factor, &big_ratio, &shell, &olaw, &owall))
+    gr_edmd_config cfg;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.cell_factor = 1.0;
+    cfg.big_ratio = GR_BIG_RATIO;
+    cfg.shell = 0.0;
+#define ADDRESS_OF(field) &cfg.field,
+    if (!PyArg_ParseTupleAndKeywords(args, kw,
+                                     sim ? EDMD_FORMAT ":EDMD" : EDMD_FORMAT ":edmd_check",
+                                     edmd_names, &opos, &ovel, &orad, &omass, &olo, &ohi,
+                                     &cfg.periodic, GR_SCENE_DOUBLES(ADDRESS_OF) &cfg.cell_factor,
+                                     &cfg.big_ratio, &cfg.shell, &olaw, &owall) ||
+        require_keywords(args, kw, edmd_names, EDMD_REQUIRED, sim ? "EDMD" : "edmd_check") < 0)
         return -1;
+#undef ADDRESS_OF
     gr_law law, wall_law;
     PyArrayObject *law_x = NULL, *law_y = NULL, *wall_x = NULL, *wall_y = NULL;
     if (parse_law(olaw, "law", &law, &law_x, &law_y) < 0) return -1;
@@ -222,21 +276,12 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
         !(mass = as_f64(omass, "masses", 1, shn)) || !(lo = as_f64(olo, "lower", 1, shd)) ||
         !(hi = as_f64(ohi, "upper", 1, shd)))
         goto done;
-    gr_edmd_config cfg;
-    memset(&cfg, 0, sizeof cfg);
     cfg.dim = (int)d;
     cfg.n = n;
     for (int a = 0; a < d; a++) {
         cfg.lo[a] = ((double *)PyArray_DATA(lo))[a];
         cfg.hi[a] = ((double *)PyArray_DATA(hi))[a];
     }
-    cfg.periodic = periodic;
-    cfg.wall_restitution = wall_e;
-    cfg.restitution = xi;
-    cfg.contact_duration = tc;
-    cfg.cell_factor = cell_factor;
-    cfg.big_ratio = big_ratio;
-    cfg.shell = shell;
     cfg.law = law;
     cfg.wall_law = wall_law;
     gr_error err = {0, -1, -1, NAN, NAN, NULL};
@@ -382,18 +427,22 @@ static int out_buffer(PyObject *obj, const char *name, int type, npy_intp size, 
 
 static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
 {
-    static char *names[] = {"t_stop", "collisions_per_particle", "kinetic_energy",
+    /* the stop criteria and the chunk's budget, then the sample times and the buffers
+     * (None: not sampled) */
+    static char *names[] = {"t_stop", "collisions_per_particle", "stop_kinetic_energy",
                             "max_events", "sample_times", "next", "positions", "velocities",
                             "kinetic_energy", "momentum", "pair_collisions", "wall_collisions",
                             "virial", "wall_impulse",
                             NULL};
     gr_edmd_stop stop;
     long long max_events, next;
-    PyObject *otimes, *opos, *ovel, *okin, *omom, *opair, *owall, *ovir, *oimp;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "dddLOLOOOOOOOO", names, &stop.t_stop,
+    PyObject *otimes, *opos = Py_None, *ovel = Py_None, *okin = Py_None, *omom = Py_None,
+             *opair = Py_None, *owall = Py_None, *ovir = Py_None, *oimp = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$dddLOLOOOOOOOO:advance", names, &stop.t_stop,
                                      &stop.collisions_per_particle, &stop.kinetic_energy,
                                      &max_events, &otimes, &next, &opos, &ovel, &okin, &omom,
-                                     &opair, &owall, &ovir, &oimp))
+                                     &opair, &owall, &ovir, &oimp) ||
+        require_keywords(args, kw, names, 6, "advance") < 0)
         return NULL;
     if (!check_ready(self)) return NULL;
     if (max_events <= 0) {
@@ -401,7 +450,7 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         return NULL;
     }
     if (stop.t_stop != stop.t_stop || stop.kinetic_energy != stop.kinetic_energy) {
-        PyErr_SetString(PyExc_ValueError, "t_stop and kinetic_energy must not be NaN");
+        PyErr_SetString(PyExc_ValueError, "t_stop and stop_kinetic_energy must not be NaN");
         return NULL;
     }
     stop.energy = stop.kinetic_energy >= 0.0; /* negative: no energy criterion */
@@ -525,10 +574,11 @@ static PyObject *EDMD_restore_state(EDMDObject *self, PyObject *arg)
 
 static PyMethodDef EDMD_methods[] = {
     {"advance", (PyCFunction)(void (*)(void))EDMD_advance, METH_VARARGS | METH_KEYWORDS,
-     "advance(t_stop, collisions_per_particle, kinetic_energy, max_events, sample_times, next,"
-     " positions, velocities, kinetic, momentum, pair, wall, virial, wall_impulse)"
-     " -> (reason, next).  Process events, writing samples into the given arrays"
-     " (kinetic_energy: the mean to stop at, negative for none)."},
+     "advance(*, t_stop, collisions_per_particle, stop_kinetic_energy, max_events,"
+     " sample_times, next, positions=None, velocities=None, kinetic_energy=None,"
+     " momentum=None, pair_collisions=None, wall_collisions=None, virial=None,"
+     " wall_impulse=None) -> (reason, next).  Process events, writing samples into the"
+     " arrays given (stop_kinetic_energy: the mean to stop at, negative for none)."},
     {"state", (PyCFunction)EDMD_state, METH_NOARGS,
      "state() -> (positions wrapped in the box, velocities, image counters) at the current time"},
     {"counters", (PyCFunction)EDMD_counters, METH_NOARGS, "counters() -> dict"},
@@ -546,7 +596,10 @@ static PyTypeObject EDMDType = {
     .tp_basicsize = sizeof(EDMDObject),
     .tp_dealloc = (destructor)EDMD_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Event-driven MD engine (internal: use granular.Simulation).",
+    /* the signature line (before "--") is what inspect and stubtest read */
+    .tp_doc = "EDMD(*, cell_factor=1.0, big_ratio=BIG_RATIO, shell=0.0, **scene)\n--\n\n"
+              "Event-driven MD engine (internal: use granular.Simulation).  The scene's "
+              "keywords are EDMD_KEYWORDS (Scene._engine_keywords gives them).",
     .tp_methods = EDMD_methods,
     .tp_init = (initproc)EDMD_init,
     .tp_new = PyType_GenericNew,
@@ -605,11 +658,14 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     long long n, first, step_from, step_to, n_steps;
     PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring, *ocarry = Py_None;
     int threads = 1, estimator = GR_TAMSD_STRIDED;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "iiiddddKLLLLLOOOOOOOOO|Oiid", names, &cfg.dim,
-                                     &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0, &cfg.tau0,
-                                     &cfg.dt, &key, &n, &first, &step_from, &step_to, &n_steps,
-                                     &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags, &otamsd,
-                                     &oring, &ocarry, &threads, &estimator, &cfg.exponent))
+    /* every argument a keyword, the first 22 required (see require_keywords) */
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$iiiddddKLLLLLOOOOOOOOOOiid:sde_run", names,
+                                     &cfg.dim, &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0,
+                                     &cfg.tau0, &cfg.dt, &key, &n, &first, &step_from, &step_to,
+                                     &n_steps, &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags,
+                                     &otamsd, &oring, &ocarry, &threads, &estimator,
+                                     &cfg.exponent) ||
+        require_keywords(args, kw, names, 22, "sde_run") < 0)
         return NULL;
     if (!(cfg.exponent > 0.0 && cfg.exponent < INFINITY)) {
         PyErr_SetString(PyExc_ValueError, "exponent must be positive and finite");
@@ -752,7 +808,7 @@ static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *args)
 static PyMethodDef core_methods[] = {
     /* the event-driven engine's rules, owned by the C core */
     {"edmd_check", (PyCFunction)(void (*)(void))edmd_check, METH_VARARGS | METH_KEYWORDS,
-     "edmd_check(same arguments as EDMD): the checks of EDMD() without building it"},
+     "edmd_check(*, same keywords as EDMD): the checks of EDMD() without building it"},
     {"big_cut", big_cut, METH_VARARGS,
      "big_cut(radii, big_ratio): particles wider than this are big"},
     {"big_particles", big_particles, METH_VARARGS,
@@ -761,7 +817,7 @@ static PyMethodDef core_methods[] = {
      "edmd_bytes_per_particle(dim, lists): what the engine allocates per particle"},
     /* ==== SDE methods begin ==== */
     {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
-     "sde_run(dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
+     "sde_run(*, dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
      " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring, carry=None,"
      " threads=1, tamsd_estimator=0, exponent=1.0): advance particles first..first+len(x)"
      " over the steps [step_from, step_to) of a run of n_steps on `threads` threads,"
@@ -783,6 +839,15 @@ static struct PyModuleDef core_module = {
     "The C core of granular: event-driven MD and SDE integrators (internal; use granular).",
     -1, core_methods, NULL, NULL, NULL, NULL
 };
+
+/* A float constant of the module; 0, or -1 with an exception set. */
+static int add_double(PyObject *m, const char *name, double value)
+{
+    PyObject *x = PyFloat_FromDouble(value);
+    int status = x ? PyModule_AddObjectRef(m, name, x) : -1;
+    Py_XDECREF(x);
+    return status;
+}
 
 PyMODINIT_FUNC PyInit__core(void)
 {
@@ -817,6 +882,34 @@ PyMODINIT_FUNC PyInit__core(void)
         return NULL;
     }
     Py_DECREF(big_ratio);
+    /* EDMD's keywords (edmd_names): granular/_scene_params.py's test reads them */
+    Py_ssize_t count = 0;
+    while (edmd_names[count]) count++;
+    PyObject *keywords = PyTuple_New(count);
+    for (Py_ssize_t i = 0; keywords && i < count; i++) {
+        PyObject *name = PyUnicode_FromString(edmd_names[i]);
+        if (!name) {
+            Py_CLEAR(keywords);
+            break;
+        }
+        PyTuple_SET_ITEM(keywords, i, name);
+    }
+    if (!keywords || PyModule_AddObjectRef(m, "EDMD_KEYWORDS", keywords) < 0) {
+        Py_XDECREF(keywords);
+        Py_DECREF(m);
+        return NULL;
+    }
+    Py_DECREF(keywords);
+    /* ==== restitution laws (restitution.h): granular/restitution.py reads these ==== */
+    if (PyModule_AddIntConstant(m, "LAW_CONSTANT", GR_LAW_CONSTANT) < 0 ||
+        PyModule_AddIntConstant(m, "LAW_VISCOELASTIC", GR_LAW_VISCOELASTIC) < 0 ||
+        PyModule_AddIntConstant(m, "LAW_TABLE", GR_LAW_TABLE) < 0 ||
+        PyModule_AddIntConstant(m, "LAW_TABLE_MAX", GR_LAW_TABLE_MAX) < 0 ||
+        add_double(m, "VISCO_C1", GR_VISCO_C1) < 0 || add_double(m, "VISCO_C2", GR_VISCO_C2) < 0 ||
+        add_double(m, "VISCO_DELTA_MAX", GR_VISCO_DELTA_MAX) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
     /* ==== SDE constants ==== */
     PyObject *max_steps = PyLong_FromLongLong(GR_SDE_MAX_STEPS);
     if (!max_steps || PyModule_AddObjectRef(m, "SDE_MAX_STEPS", max_steps) < 0) {

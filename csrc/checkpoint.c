@@ -14,6 +14,7 @@
 #include "checkpoint.h"
 #include "engine.h"
 #include "hugemem.h"
+#include "scene_params.h"
 
 static const char magic[8] = {'G', 'R', 'E', 'D', 'M', 'D', 'C', 'K'};
 #define GR_BYTE_ORDER_MARK 0x01020304u
@@ -167,9 +168,9 @@ static void transfer(cursor *c, gr_edmd *s)
     io(c, cfg->lo, sizeof cfg->lo);
     io(c, cfg->hi, sizeof cfg->hi);
     IO(c, cfg->periodic);
-    IO(c, cfg->wall_restitution);
-    IO(c, cfg->restitution);
-    IO(c, cfg->contact_duration);
+#define TRANSFER(field) IO(c, cfg->field);
+    GR_SCENE_DOUBLES(TRANSFER)
+#undef TRANSFER
     IO(c, cfg->cell_factor);
     IO(c, cfg->big_ratio);
     IO(c, cfg->shell);
@@ -353,9 +354,9 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
     const gr_edmd_config *a = &t->cfg, *b = &s->cfg;
     if (a->dim != b->dim || a->n != b->n || a->periodic != b->periodic ||
         memcmp(a->lo, b->lo, sizeof a->lo) != 0 || memcmp(a->hi, b->hi, sizeof a->hi) != 0 ||
-        !same_double(a->wall_restitution, b->wall_restitution) ||
-        !same_double(a->restitution, b->restitution) ||
-        !same_double(a->contact_duration, b->contact_duration) ||
+#define DIFFERS(field) !same_double(a->field, b->field) ||
+        GR_SCENE_DOUBLES(DIFFERS)
+#undef DIFFERS
         !same_double(a->cell_factor, b->cell_factor) || !same_double(a->big_ratio, b->big_ratio) ||
         !same_double(a->shell, b->shell))
         return "its box, restitution, contact duration or engine knobs differ from the scene's";

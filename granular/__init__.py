@@ -25,11 +25,10 @@ from .errors import (
     ProcessBackendError,
     UnstableStepError,
 )
-from .gsd_io import read
 from .restitution import ConstantRestitution, TabulatedRestitution, Viscoelastic
 from .scene import Scene
 from .simulation import Simulation
-from .trajectory import Trajectory
+from .trajectory import Trajectory, read
 
 __version__ = "0.1.0"
 

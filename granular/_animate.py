@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._figures import POSITION, SPEED, _matplotlib
+
 if TYPE_CHECKING:  # matplotlib is an extra, imported only when an animation is made
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -333,8 +335,6 @@ def animate(
     IndexError
         A particle in ``trails`` or a sample in ``frames`` that does not exist.
     """
-    from . import plot
-
     positions = traj._need("positions")
     n, dim = traj.n, traj.dim
     samples = _samples(len(traj.times), frames, stride)
@@ -354,7 +354,7 @@ def animate(
     elif norm is not None:
         raise ValueError("norm sets the colours of speeds: pass color_by_speed=True with it")
 
-    plot._matplotlib("matplotlib")  # a bare install: say which extra brings it
+    _matplotlib("matplotlib")  # a bare install: say which extra brings it
     from matplotlib import colors as mcolors
     from matplotlib.collections import EllipseCollection
     from matplotlib.patches import Rectangle
@@ -376,7 +376,7 @@ def animate(
         from matplotlib import colormaps
 
         cmap = colormaps["viridis"]
-        speed_label = plot.SPEED
+        speed_label = SPEED
         if norm is None:
             # each sample's speeds over its rms speed: a cooling gas' speed distribution keeps
             # its shape while its scale falls, so one fixed scale would fade to dark
@@ -416,8 +416,8 @@ def animate(
     ax.spines[["top", "right"]].set_visible(False)
     ax.spines["left"].set_bounds(lo[ax1], hi[ax1])
     ax.set_aspect("equal")
-    ax.set_xlabel(plot.POSITION.format("xyz"[ax0]))
-    ax.set_ylabel(plot.POSITION.format("xyz"[ax1]))
+    ax.set_xlabel(POSITION.format("xyz"[ax0]))
+    ax.set_ylabel(POSITION.format("xyz"[ax1]))
     if depth is not None:
         what = "projection" if slab is None else f"slice |{'xyz'[depth]} − {z0:g}| < {w:g}"
         title = title or f"{what} onto the {'xyz'[ax0]}{'xyz'[ax1]} plane"

@@ -10,7 +10,12 @@ from numpy.typing import ArrayLike, NDArray
 BIG_MAX: int
 BIG_RATIO: float
 CHECKPOINT_LAYOUT: int
+EDMD_KEYWORDS: tuple[str, ...]
 HEADS_CACHED: int
+LAW_CONSTANT: int
+LAW_TABLE: int
+LAW_TABLE_MAX: int
+LAW_VISCOELASTIC: int
 RNG_KERNEL: str
 SCAN_KERNEL: str
 SDE_BLOCK: int
@@ -20,51 +25,41 @@ STOP_COLLISIONS: int
 STOP_ENERGY: int
 STOP_IDLE: int
 STOP_TIME: int
-
-# a restitution law as the engine takes it (RestitutionLaw._engine): (kind, scale, v_max,
-# speeds, values), or None for a constant
-_Law = tuple[int, float, float, Any, Any] | None
+VISCO_C1: float
+VISCO_C2: float
+VISCO_DELTA_MAX: float
 
 @final
 class EDMD:
+    # every argument a keyword (so are advance's and edmd_check's); the scene's are
+    # EDMD_KEYWORDS, made by granular/_scene_params.py (Scene._engine_keywords)
     def __init__(
         self,
-        positions: ArrayLike,
-        velocities: ArrayLike,
-        radii: ArrayLike,
-        masses: ArrayLike,
-        lower: ArrayLike,
-        upper: ArrayLike,
-        periodic: bool,
-        wall_restitution: float,
-        restitution: float,
-        contact_duration: float,
+        *,
         cell_factor: float = ...,
         big_ratio: float = ...,
         shell: float = ...,
-        law: _Law = ...,
-        wall_law: _Law = ...,
+        **scene: Any,
     ) -> None: ...
-    # The C keyword list names "kinetic_energy" twice: the criterion (third) and the samples'
-    # buffer; a keyword kinetic_energy fills the buffer, so the criterion goes by position.
-    # Returns (the STOP_* reason, the next sample's index).
+    # Returns (the STOP_* reason, the next sample's index).  stop_kinetic_energy < 0: no
+    # energy criterion; a buffer left None is not sampled.
     def advance(
         self,
+        *,
         t_stop: float,
         collisions_per_particle: float,
         stop_kinetic_energy: float,
         max_events: int,
         sample_times: ArrayLike,
         next: int,
-        /,
-        positions: NDArray[np.float64] | None,
-        velocities: NDArray[np.float64] | None,
-        kinetic_energy: NDArray[np.float64] | None,
-        momentum: NDArray[np.float64] | None,
-        pair_collisions: NDArray[np.int64] | None,
-        wall_collisions: NDArray[np.int64] | None,
-        virial: NDArray[np.float64] | None,
-        wall_impulse: NDArray[np.float64] | None,
+        positions: NDArray[np.float64] | None = ...,
+        velocities: NDArray[np.float64] | None = ...,
+        kinetic_energy: NDArray[np.float64] | None = ...,
+        momentum: NDArray[np.float64] | None = ...,
+        pair_collisions: NDArray[np.int64] | None = ...,
+        wall_collisions: NDArray[np.int64] | None = ...,
+        virial: NDArray[np.float64] | None = ...,
+        wall_impulse: NDArray[np.float64] | None = ...,
     ) -> tuple[int, int]: ...
     def state(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]: ...
     def counters(self) -> dict[str, Any]: ...
@@ -74,21 +69,7 @@ class EDMD:
     ) -> None: ...
 
 def edmd_check(
-    positions: ArrayLike,
-    velocities: ArrayLike,
-    radii: ArrayLike,
-    masses: ArrayLike,
-    lower: ArrayLike,
-    upper: ArrayLike,
-    periodic: bool,
-    wall_restitution: float,
-    restitution: float,
-    contact_duration: float,
-    cell_factor: float = ...,
-    big_ratio: float = ...,
-    shell: float = ...,
-    law: _Law = ...,
-    wall_law: _Law = ...,
+    *, cell_factor: float = ..., big_ratio: float = ..., shell: float = ..., **scene: Any
 ) -> None: ...
 def big_cut(radii: ArrayLike, big_ratio: float, /) -> float: ...
 def big_particles(
@@ -96,6 +77,7 @@ def big_particles(
 ) -> NDArray[np.bool_]: ...
 def edmd_bytes_per_particle(dim: int, lists: bool, /) -> int: ...
 def sde_run(
+    *,
     dim: int,
     model: int,
     scheme: int,

@@ -10,14 +10,28 @@ from __future__ import annotations
 
 import math
 import os
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
 from . import _core
 
-if TYPE_CHECKING:
-    from .scene import Scene
+
+class _Scene(Protocol):
+    """What the engine is built from: a Scene (named here by what it offers, so that this
+    module need not import scene, which imports it)."""
+
+    @property
+    def radii(self) -> NDArray[np.float64]: ...
+    @property
+    def n(self) -> int: ...
+    @property
+    def dim(self) -> int: ...
+    @property
+    def packing_fraction(self) -> float: ...
+    def _engine_keywords(self) -> dict[str, Any]: ...
+
 
 # shell="auto": neighbour lists with this shell (in largest diameters) for dense 3D
 # scenes.  Measured (pair collisions/s, N = 1e4, melted Scene.random, cells vs lists
@@ -49,7 +63,7 @@ def check_memory(need, what):
 
 
 def build(
-    scene: Scene, cell_factor: float = 1.0, big_ratio: float = _core.BIG_RATIO, shell: Any = "auto"
+    scene: _Scene, cell_factor: float = 1.0, big_ratio: float = _core.BIG_RATIO, shell: Any = "auto"
 ) -> _core.EDMD:
     """A new engine (_core.EDMD) at a Scene's state; see Simulation for the knobs."""
     big = np.max(scene.radii) > _core.big_cut(scene.radii, big_ratio)
@@ -73,11 +87,10 @@ def build(
         "the event-driven engine's state" + (" with neighbour lists" if shell > 0 else ""),
     )
     return _core.EDMD(
-        *scene._engine_args(),
-        float(cell_factor),
-        float(big_ratio),
-        float(shell),
-        **scene._engine_laws(),
+        **scene._engine_keywords(),
+        cell_factor=float(cell_factor),
+        big_ratio=float(big_ratio),
+        shell=float(shell),
     )
 
 
@@ -87,20 +100,12 @@ def run_collisions(engine, collisions_per_particle):
     no_samples = np.empty(0)
     while True:
         code, _ = engine.advance(
-            math.inf,
-            float(collisions_per_particle),
-            -1.0,
-            CHUNK,
-            no_samples,
-            0,
-            None,
-            None,
-            None,
-            None,
-            None,
-            None,
-            None,
-            None,
+            t_stop=math.inf,
+            collisions_per_particle=float(collisions_per_particle),
+            stop_kinetic_energy=-1.0,
+            max_events=CHUNK,
+            sample_times=no_samples,
+            next=0,
         )
         if code != _core.STOP_BUDGET:
             return code

@@ -1,8 +1,8 @@
 """The steps of ``granular.langevin.run``, one job each: check and normalise the arguments
 (``_checked``, ``_sample_steps``, ``_tamsd_lag_steps``, ``_check_scales``), draw the start
-(``_initial_state``), allocate what the engine accumulates into (``_new_sums``), step the
-particles in chunks through the C engine (``_integrate``, its arguments built by name in
-``_sde_args``) and make the result (``_result``).  The lag grid's checks (``_lag_steps``)
+(``_initial_state``), allocate what the engine accumulates into (``_new_sums``) and step the
+particles in chunks through the C engine (``_integrate``, every argument by name); the
+result is made in granular.langevin (``_result``).  The lag grid's checks (``_lag_steps``)
 and the names of the models, schemes and estimators are here too, where the run needs
 them first; ``granular.langevin`` shows them to users."""
 
@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -19,9 +19,6 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core
 from ._scales import SCALE_HI, SCALE_LO, check_range
 from .errors import shown
-
-if TYPE_CHECKING:  # for the hints only: langevin imports this module
-    from . import langevin
 
 MODELS = ("langevin", "udsbm")
 # the TAMSD's windows (csrc/tamsd.h): "strided" starts a lag's windows every power of
@@ -415,69 +412,6 @@ def _chunks(n_steps: int, threads: int, work: int) -> tuple[int, int]:
     return per_call, steps_per_call
 
 
-def _sde_args(
-    *,
-    dim: int,
-    model: int,
-    scheme: int,
-    gamma0: float,
-    D0: float,
-    tau0: float,
-    dt: float,
-    key: int,
-    n: int,
-    first: int,
-    step_from: int,
-    step_to: int,
-    n_steps: int,
-    x: NDArray[np.float64],
-    v: NDArray[np.float64],
-    sample_steps: NDArray[np.int64],
-    x2: NDArray[np.float64],
-    v2: NDArray[np.float64],
-    positions: NDArray[np.float64] | None,
-    lags: NDArray[np.int64],
-    tamsd: NDArray[np.float64],
-    ring: NDArray[np.float64],
-    carry: NDArray[np.float64],
-    threads: int,
-    tamsd_estimator: int,
-    exponent: float,
-) -> tuple[Any, ...]:
-    """``_core.sde_run``'s arguments, taken by name and put in the binding's order, that of
-    ``names[]`` and the format "iiiddddKLLLLLOOOOOOOOO|Oiid" of ``sde_run`` in
-    csrc/_core.c: they are passed by position, where two swapped numbers of one type would
-    run unseen (tests/test_langevin.py checks that the two orders agree)."""
-    return (
-        dim,
-        model,
-        scheme,
-        gamma0,
-        D0,
-        tau0,
-        dt,
-        key,
-        n,
-        first,
-        step_from,
-        step_to,
-        n_steps,
-        x,
-        v,
-        sample_steps,
-        x2,
-        v2,
-        positions,
-        lags,
-        tamsd,
-        ring,
-        carry,
-        threads,
-        tamsd_estimator,
-        exponent,
-    )
-
-
 def _integrate(
     p: _Run,
     key: int,
@@ -507,7 +441,7 @@ def _integrate(
             vs = np.ascontiguousarray(v[first : first + per_call])
             for step_from in range(0, p.n_steps, steps_per_call):
                 step_to = min(step_from + steps_per_call, p.n_steps)
-                args = _sde_args(
+                _core.sde_run(
                     dim=p.dim,
                     model=model,
                     scheme=scheme,
@@ -535,7 +469,6 @@ def _integrate(
                     tamsd_estimator=estimator,
                     exponent=p.exponent,
                 )
-                _core.sde_run(*args)
                 if bar is not None:
                     bar.update(len(xs) * (step_to - step_from))
             x[first : first + len(xs)] = xs
@@ -543,51 +476,3 @@ def _integrate(
     finally:
         if bar is not None:
             bar.close()
-
-
-def _result(
-    p: _Run,
-    initial: str,
-    steps: NDArray[np.int64],
-    lags: NDArray[np.int64],
-    sums: _Sums,
-    x: NDArray[np.float64],
-    v: NDArray[np.float64],
-    v0_sq: float,
-) -> langevin.LangevinResult:
-    """The result of a run: the engine's sums divided into means (the TAMSD by each lag's
-    number of windows), with what the run was given."""
-    from .langevin import LangevinResult
-
-    n, L = p.n, len(lags)
-    estimator = _estimator_code(p.tamsd_estimator)
-    strides = np.array([_core.sde_lag_stride(int(k), estimator) for k in lags], dtype=np.int64)
-    windows = (p.n_steps - lags) // np.maximum(strides, 1) + 1
-    per_particle = sums.tamsd / windows if L else sums.tamsd
-    return LangevinResult(
-        times=(steps * p.dt).astype(np.float64, copy=False),
-        steps=steps,
-        msd_total=sums.x2.sum(1) / n,
-        msd_per_dimension=sums.x2 / n,
-        v2=sums.v2.sum(1) / n,
-        tamsd_lags=(lags * p.dt).astype(np.float64, copy=False),
-        tamsd_mean=per_particle.mean(0) if L else np.zeros(0),
-        tamsd_per_particle=per_particle,
-        positions=sums.positions,
-        final_positions=x,
-        final_velocities=v,
-        model=p.model,
-        scheme=p.scheme,
-        tamsd_estimator=p.tamsd_estimator,
-        gamma0=p.gamma0,
-        D0=p.D0,
-        tau0=p.tau0,
-        dt=p.dt,
-        n=n,
-        dim=p.dim,
-        t_stop=p.n_steps * p.dt,
-        v0_sq=v0_sq,
-        exponent=p.exponent if p.model == "udsbm" else 1.0,
-        initial=initial,
-        mass=p.mass,
-    )

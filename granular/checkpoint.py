@@ -34,27 +34,42 @@ import os
 import stat
 import struct
 import zipfile
-from typing import IO, TYPE_CHECKING, Any
+from collections.abc import Callable
+from typing import IO, Any, Protocol, TypeVar
 
 import numpy as np
 
 from . import _core
 from ._files import WHAT_READS, kind_of, write_atomic
+from ._scene_params import PARAMETERS, shape_of
 from .errors import CheckpointError, GranularError
 from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
 from .scene import Scene
 
-if TYPE_CHECKING:
-    from .simulation import Simulation
+
+class _Run(Protocol):
+    """What a checkpoint takes from a granular.Simulation and gives back (named here by
+    what it offers: simulation imports this module, so this one does not import it)."""
+
+    _initial: Scene
+    _knobs: dict[str, Any]
+    _engine: Any  # _core.EDMD
+
+    @property
+    def scene(self) -> Scene: ...
+
+
+_S = TypeVar("_S", bound=_Run)
+
 
 FORMAT = "granular-checkpoint"
 FORMAT_VERSION = 1
 
-# The Scene as stored: its arrays, and its other constructor keywords as JSON.  A new
-# Scene parameter (e.g. a restitution law) is one more name in _SCENE_PARAMS, with a
-# JSON-able value.
-_SCENE_ARRAYS = ("positions", "velocities", "radii", "masses", "lower", "upper")
-_SCENE_PARAMS = ("boundary", "wall_restitution", "restitution", "contact_duration")
+# The Scene as stored, as its declaration (granular/_scene_params.py) says: an array
+# parameter as a member scene_<attribute> each (the box as its corners lower and upper),
+# the others in the meta JSON (restitution.describe: numbers, strings and laws).
+_SCENE_ARRAYS = tuple(a for p in PARAMETERS if p.is_array for a in p.fields)
+_SCENE_PARAMS = tuple(p.name for p in PARAMETERS if not p.is_array)
 
 
 # Collisions without heated walls never add kinetic energy, elastic ones keep it, and
@@ -72,7 +87,7 @@ def _version() -> str:
     return __version__
 
 
-def _fault(sim: Simulation) -> str | None:
+def _fault(sim: _Run) -> str | None:
     """What makes ``sim``'s current state one its run cannot have reached or cannot go on
     from, or None: its positions and velocities must make a valid Scene (the scale limits,
     inside the walls, no overlaps: the checks of a new scene, scene.py and
@@ -110,7 +125,7 @@ def _fault(sim: Simulation) -> str | None:
     return None
 
 
-def dumps(sim: Simulation) -> bytes:
+def dumps(sim: _Run) -> bytes:
     """The checkpoint of ``sim`` as the bytes of an ``.npz`` file (see ``Simulation.save``)."""
     fault = _fault(sim)
     if fault:
@@ -135,14 +150,15 @@ def dumps(sim: Simulation) -> bytes:
     return buf.getvalue()
 
 
-def save(sim: Simulation, path: str | os.PathLike) -> None:
+def save(sim: _Run, path: str | os.PathLike) -> None:
     """Write ``sim``'s checkpoint to ``path`` atomically (``_files.write_atomic``): an older
     checkpoint at ``path`` survives until the new one is complete."""
     write_atomic(path, dumps(sim), suffix=".npz")
 
 
-def load(path: str | os.PathLike) -> Simulation:
-    """The Simulation saved in ``path`` (see ``Simulation.load``)."""
+def load(path: str | os.PathLike, make: Callable[..., _S]) -> _S:
+    """The Simulation saved in ``path`` (see ``Simulation.load``), built by
+    ``make(scene, **knobs)`` (the Simulation class) and given the saved state."""
     where = repr(os.fspath(path))
     try:
         f = open(path, "rb")  # closed by the with below, after the checks on it
@@ -159,7 +175,7 @@ def load(path: str | os.PathLike) -> Simulation:
                 "is a file written by Simulation.save"
             )
         meta, arrays = _read_npz(f, where)
-    return _build(meta, arrays, where)
+    return _build(meta, arrays, where, make)
 
 
 # The members of a checkpoint's zip archive, each an .npy array.
@@ -291,14 +307,7 @@ def _read_members(zf, f, where):
         raise ValueError(f"its scene positions have shape {n_d}, not (N, 2) or (N, 3)")
     n, d = n_d
     f8 = np.dtype(np.float64)  # native, as np.savez wrote the Scene's arrays
-    shapes = {
-        "positions": (n, d),
-        "velocities": (n, d),
-        "radii": (n,),
-        "masses": (n,),
-        "lower": (d,),
-        "upper": (d,),
-    }
+    shapes = {a: shape_of(p, n, d) for p in PARAMETERS if p.is_array for a in p.fields}
     arrays = {
         f"scene_{name}": _member_array(zf, names[f"scene_{name}.npy"], f8, shape, size)
         for name, shape in shapes.items()
@@ -333,35 +342,36 @@ def _check_version(meta: dict, where: str) -> None:
         )
 
 
-def loads(data: bytes, where: str = "the checkpoint") -> Simulation:
-    """The Simulation in checkpoint bytes made by ``dumps`` (also what unpickling calls)."""
+def loads(data: bytes, make: Callable[..., _S], where: str = "the checkpoint") -> _S:
+    """The Simulation in checkpoint bytes made by ``dumps`` (also what unpickling calls),
+    built by ``make`` as in ``load``."""
     meta, arrays = _read_npz(bytes(data), where)
-    return _build(meta, arrays, where)
+    return _build(meta, arrays, where, make)
 
 
-def _build(meta: dict[str, Any], arrays: dict[str, np.ndarray], where: str) -> Simulation:
+def _build(
+    meta: dict[str, Any],
+    arrays: dict[str, np.ndarray],
+    where: str,
+    make: Callable[..., _S],
+) -> _S:
     """The Simulation of a checkpoint's parts, read and checked for their sizes."""
-    from .simulation import Simulation
-
     try:
         state = arrays["engine_state"]
         if hashlib.sha256(state.data).hexdigest() != meta["engine_state_sha256"]:
             raise ValueError("the engine state does not match its checksum")
-        fields = {name: arrays[f"scene_{name}"] for name in _SCENE_ARRAYS}
-        # the boundary's string, numbers and laws: Any, to be checked by Scene
+        # the arrays; the boundary's string, numbers and laws: Any, to be checked by Scene
         params: dict[str, Any] = {
-            name: from_description(meta["scene"][name]) for name in _SCENE_PARAMS
+            p.name: tuple(arrays[f"scene_{a}"] for a in p.fields)
+            if p.attributes
+            else arrays[f"scene_{p.name}"]
+            for p in PARAMETERS
+            if p.is_array
         }
+        params.update({name: from_description(meta["scene"][name]) for name in _SCENE_PARAMS})
         knobs = meta["knobs"]
-        scene = Scene(
-            fields["positions"],
-            fields["velocities"],
-            fields["radii"],
-            fields["masses"],
-            box=(fields["lower"], fields["upper"]),
-            **params,
-        )
-        sim = Simulation(scene, **knobs)
+        scene = Scene(**params)
+        sim = make(scene, **knobs)
         sim._engine.restore_state(state)
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise CheckpointError(f"{where} is corrupt: {exc}") from exc

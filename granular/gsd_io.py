@@ -359,49 +359,26 @@ def _wrap_checked(f: _File, k: int, x: np.ndarray, p: dict[str, Any]) -> np.ndar
     return _wrap(x, p["lower"], p["upper"], True)[0]
 
 
-def _scene(f: _File, k: int, x: np.ndarray, v: np.ndarray, p: dict[str, Any]) -> Any:
-    """Frame ``k``'s state as a Scene, which checks it as every scene is checked (finite,
-    positive radii and masses, the box, the scales, inside the box, no overlaps)."""
-    from .scene import Scene
-
+def _scene(
+    f: _File, k: int, x: np.ndarray, v: np.ndarray, p: dict[str, Any], make_scene: Any
+) -> Any:
+    """Frame ``k``'s state as a Scene (``make_scene``: the Scene class), which checks it as
+    every scene is checked (finite, positive radii and masses, the box, the scales, inside
+    the box, no overlaps)."""
     x = _wrap_checked(f, k, x, p)
     try:
-        return Scene(
+        return make_scene(
             x, v, p["radii"], p["masses"], box=(p["lower"], p["upper"]), boundary=p["boundary"]
         )
     except (ValueError, TypeError) as exc:
         raise GSDFileError(f"{f.where}, frame {k}: not a valid state: {exc}") from exc
 
 
-def read(path: str | os.PathLike) -> Any:
-    """Read a GSD file written by ``Trajectory.write`` back into a Trajectory, with the
-    exact float64 values of the log section.
-
-    Every frame is checked as a Scene is (finite positions and velocities, positive radii
-    and masses, a valid box and boundary, particles inside it and not overlapping), the
-    sample times must increase and the collision counts must be whole numbers that never
-    decrease.  Only the log section is read, no more of it than the file holds.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        A ``.gsd`` file.
-
-    Returns
-    -------
-    Trajectory
-
-    Raises
-    ------
-    GSDFileError
-        Not a GSD file, truncated or corrupt, not written by granular, or a field missing,
-        of the wrong shape or an impossible value; the message names the file, the frame
-        and the field.
-    FileNotFoundError
-        No file at ``path``.
-    """
-    from .trajectory import Trajectory
-
+def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
+    """The Trajectory (``make_trajectory``: the Trajectory class) in a GSD file written by
+    ``Trajectory.write``, each frame checked as a Scene (``make_scene``); see
+    ``granular.read``, which calls this.  Passed the classes, this module imports neither
+    scene nor trajectory (which import it)."""
     with _File(path) as f:
         if f.frames == 0:
             raise GSDFileError(f"{f.where} holds no frames")
@@ -431,7 +408,7 @@ def read(path: str | os.PathLike) -> Any:
                 velocities.append(v)
             elif f.has(k, _log("velocities")):
                 raise f.error(k, _log("velocities"), "is there but frame 0 has none")
-            _scene(f, k, x, v, p)
+            _scene(f, k, x, v, p, make_scene)
             positions.append(x)
             for name in _COUNTERS:
                 value = _counter(f, k, name, d, counters[name])
@@ -439,7 +416,7 @@ def read(path: str | os.PathLike) -> Any:
     # the counters' keywords: arrays of floats or of counts (Any: mypy would match them
     # against every keyword of Trajectory, its strings too)
     arrays: dict[str, Any] = {name: np.array(values) for name, values in counters.items()}
-    return Trajectory(
+    return make_trajectory(
         np.array(times),
         np.array(positions).reshape(len(times), n, d),
         np.array(velocities).reshape(len(times), n, d) if has_v else None,
@@ -463,7 +440,7 @@ def _counter(f: _File, k: int, name: str, d: int, before: list) -> Any:
     return array if name == "momentum" else float(array[0])
 
 
-def scene_from_gsd(path: str | os.PathLike, frame: int = -1, **params: Any) -> Any:
+def scene_from_gsd(path: str | os.PathLike, frame: int, make_scene: Any, **params: Any) -> Any:
     """A Scene from one frame of a GSD file: exact when granular wrote it, else from the
     float32 HOOMD fields (a periodic box centred at the origin).
 
@@ -473,9 +450,11 @@ def scene_from_gsd(path: str | os.PathLike, frame: int = -1, **params: Any) -> A
         A ``.gsd`` file.
     frame : int
         The frame's index (negative: from the end).
+    make_scene : type
+        The Scene class (``Scene.from_gsd`` passes it).
     **params
-        The Scene's other keywords (restitution, wall_restitution, contact_duration;
-        boundary for a foreign file), which a trajectory does not record.
+        Scene parameters to set (``Scene.replace``): those a trajectory does not record,
+        such as the restitutions; the boundary of a foreign file.
 
     Raises
     ------
@@ -484,8 +463,6 @@ def scene_from_gsd(path: str | os.PathLike, frame: int = -1, **params: Any) -> A
     IndexError
         No such frame.
     """
-    from .scene import Scene
-
     with _File(path) as f:
         count = f.frames
         if not -count <= frame < count:
@@ -498,25 +475,16 @@ def scene_from_gsd(path: str | os.PathLike, frame: int = -1, **params: Any) -> A
             v = np.zeros((n, d))
             if f.has(k, _log("velocities")):
                 v = f.array(k, _log("velocities"), (n, d))
-            own = _scene(f, k, x, v, p)
+            own = _scene(f, k, x, v, p, make_scene)
         else:
-            own = _foreign_scene(f, k)
-    params.setdefault("boundary", own.boundary)
-    return Scene(
-        own.positions,
-        own.velocities,
-        own.radii,
-        own.masses,
-        box=(own.lower, own.upper),
-        **params,
-    )
+            own = _foreign_scene(f, k, make_scene)
+    return own.replace(**params)
 
 
-def _foreign_scene(f: _File, k: int) -> Any:
+def _foreign_scene(f: _File, k: int, make_scene: Any) -> Any:
     """Frame ``k`` of a file granular did not write, from its float32 HOOMD fields, as a
     periodic box centred at the origin.  A field missing from frame ``k`` is frame 0's, else
     HOOMD's default (gsd.hoomd's rule)."""
-    from .scene import Scene
 
     def get(name, shape, default=None):
         for at in (k, 0):
@@ -545,7 +513,7 @@ def _foreign_scene(f: _File, k: int) -> Any:
     lower, upper = -0.5 * lengths, 0.5 * lengths
     x = np.where(x >= upper, x - lengths, x)
     try:
-        return Scene(
+        return make_scene(
             x,
             v,
             0.5 * get("particles/diameter", (n,), 1.0),

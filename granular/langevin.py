@@ -54,7 +54,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core
+from . import _core, _langevin_run
 from ._deprecation import REMOVAL_VERSION, _MethodWithArrayShim
 from ._langevin_run import INITIAL as INITIAL
 from ._langevin_run import MODELS as MODELS
@@ -69,7 +69,6 @@ from ._langevin_run import (
     _integrate,
     _lag_steps,
     _new_sums,
-    _result,
     _sample_steps,
     _tamsd_lag_steps,
 )
@@ -462,6 +461,52 @@ class LangevinResult:
             f"dim={self.dim}, dt={self.dt}, t_stop={self.t_stop}, samples={len(self.times)}, "
             f"lags={len(self.tamsd_lags)})"
         )
+
+
+def _result(
+    p: _langevin_run._Run,
+    initial: str,
+    steps: NDArray[np.int64],
+    lags: NDArray[np.int64],
+    sums: _langevin_run._Sums,
+    x: NDArray[np.float64],
+    v: NDArray[np.float64],
+    v0_sq: float,
+) -> LangevinResult:
+    """The result of a run: the engine's sums divided into means (the TAMSD by each lag's
+    number of windows), with what the run was given."""
+    n, L = p.n, len(lags)
+    estimator = _estimator_code(p.tamsd_estimator)
+    strides = np.array([_core.sde_lag_stride(int(k), estimator) for k in lags], dtype=np.int64)
+    windows = (p.n_steps - lags) // np.maximum(strides, 1) + 1
+    per_particle = sums.tamsd / windows if L else sums.tamsd
+    return LangevinResult(
+        times=(steps * p.dt).astype(np.float64, copy=False),
+        steps=steps,
+        msd_total=sums.x2.sum(1) / n,
+        msd_per_dimension=sums.x2 / n,
+        v2=sums.v2.sum(1) / n,
+        tamsd_lags=(lags * p.dt).astype(np.float64, copy=False),
+        tamsd_mean=per_particle.mean(0) if L else np.zeros(0),
+        tamsd_per_particle=per_particle,
+        positions=sums.positions,
+        final_positions=x,
+        final_velocities=v,
+        model=p.model,
+        scheme=p.scheme,
+        tamsd_estimator=p.tamsd_estimator,
+        gamma0=p.gamma0,
+        D0=p.D0,
+        tau0=p.tau0,
+        dt=p.dt,
+        n=n,
+        dim=p.dim,
+        t_stop=p.n_steps * p.dt,
+        v0_sq=v0_sq,
+        exponent=p.exponent if p.model == "udsbm" else 1.0,
+        initial=initial,
+        mass=p.mass,
+    )
 
 
 def theory_tamsd(

@@ -22,49 +22,33 @@ Ratios and counts are marked dimensionless.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ._animate import animate  # noqa: F401 (public here; animations have their own module)
+from ._figures import (
+    COLLISIONS,
+    DIFFUSIVITY,
+    ENERGY,
+    LAG_OR_TIME,
+    MSD,
+    MSD_AND_TAMSD,
+    POSITION,
+    RELATIVE_ENERGY,
+    SPEED,
+    SPEED_DENSITY,
+    TEMPERATURE,
+    TIME,
+    _matplotlib,
+)
 from ._params import keyword_only as _keyword_only
 
 if TYPE_CHECKING:  # matplotlib is an extra, imported only when a figure is drawn
     from matplotlib.axes import Axes
 
     from .clustering import CurrentCorrelations, FlowEnergy, StructureFactor
-
-
-# Axis labels with their units (mathtext).
-TIME = r"time $t$ [$L\sqrt{m/\varepsilon}$]"
-LAG_OR_TIME = r"time $t$ or lag $\Delta$ [$L\sqrt{m/\varepsilon}$]"
-ENERGY = r"kinetic energy $E$ [$\varepsilon$]"
-RELATIVE_ENERGY = r"$E(t)/E(0) - 1$ (dimensionless)"
-COLLISIONS = "collisions per particle (dimensionless count)"
-SPEED = r"speed $v$ [$\sqrt{\varepsilon/m}$]"
-SPEED_DENSITY = r"probability density [$\sqrt{m/\varepsilon}$]"
-TEMPERATURE = r"granular temperature $T$ [$\varepsilon$; $k_B = 1$]"
-MSD = r"MSD $\langle |x(t) - x(0)|^2 \rangle$ [$L^2$]"
-MSD_AND_TAMSD = r"MSD, time-averaged MSD [$L^2$]"
-DIFFUSIVITY = r"diffusivity $D(t)$ [$L\sqrt{\varepsilon/m}$]"
-POSITION = r"${}$ [$L$]"
-
-
-def _matplotlib(module: str) -> Any:
-    """Import a matplotlib module, or say which extra brings it (matplotlib is not a
-    dependency of granular itself)."""
-    try:
-        return importlib.import_module(module)
-    except ModuleNotFoundError as exc:
-        if not (exc.name or "").startswith("matplotlib"):
-            raise
-        raise ModuleNotFoundError(
-            "granular.plot draws with matplotlib, which is not installed: pip install "
-            "matplotlib (or pip install 'granular[plot]')",
-            name=exc.name,
-        ) from exc
 
 
 def _axes(ax: Axes | None) -> Axes:

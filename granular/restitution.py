@@ -25,22 +25,26 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-# Kinds of law as the engine numbers them (csrc/restitution.h GR_LAW_*).
-_KIND_VISCOELASTIC = 1
-_KIND_TABLE = 2
+from . import _core
+
+# The engine owns the laws (csrc/restitution.h): their kind numbers, the viscoelastic
+# series' coefficients and range and the largest table are read from it, never copied.
+_KIND_VISCOELASTIC: int = _core.LAW_VISCOELASTIC
+_KIND_TABLE: int = _core.LAW_TABLE
 
 # eps = 1 - C1 delta + C2 delta^2, delta = A kappa^(2/5) v^(1/5) (Schwager & Poeschel 1998,
 # Phys. Rev. E 57, 650; Brilliantov & Poeschel, Kinetic Theory of Granular Gases, 2004,
-# ch. 6): C1 = Gamma(3/5) sqrt(pi) / (2^(1/5) 5^(2/5) Gamma(21/10)), C2 = (3/5) C1^2.
-C1: float = math.gamma(3 / 5) * math.sqrt(math.pi) / (2**0.2 * 5**0.4 * math.gamma(21 / 10))
-C2: float = 0.6 * C1**2
-# The series is used up to this delta (csrc/restitution.h GR_VISCO_DELTA_MAX): for a
-# contact that ends where the force vanishes (Schwager & Poeschel 2008) the first dropped
-# term is +(4/15) delta^(5/2) and the error 0.0015 here (tests/test_restitution.py
-# integrates the contact); past delta = C1 / (2 C2) = 0.72 the truncated series rises again.
-DELTA_MAX: float = 0.25
-# A table of at most this many points (csrc/restitution.h GR_LAW_TABLE_MAX).
-TABLE_MAX = 1_000_000
+# ch. 6): C1 = Gamma(3/5) sqrt(pi) / (2^(1/5) 5^(2/5) Gamma(21/10)), C2 = (3/5) C1^2
+# (tests/test_restitution.py checks the engine's numbers against these formulas).
+C1: float = _core.VISCO_C1
+C2: float = _core.VISCO_C2
+# The series is used up to this delta: for a contact that ends where the force vanishes
+# (Schwager & Poeschel 2008) the first dropped term is +(4/15) delta^(5/2) and the error
+# 0.0015 here (tests/test_restitution.py integrates the contact); past delta = C1 / (2 C2)
+# = 0.72 the truncated series rises again.
+DELTA_MAX: float = _core.VISCO_DELTA_MAX
+# A table of at most this many points.
+TABLE_MAX: int = _core.LAW_TABLE_MAX
 
 
 def _positive(value: Any, name: str) -> float:
@@ -70,9 +74,10 @@ class RestitutionLaw(abc.ABC):
         """Whether some collision loses kinetic energy under this law (eps < 1)."""
 
     @abc.abstractmethod
-    def _engine(self) -> tuple | None:
-        """The law as the engine takes it: (kind, scale, v_max, speeds, values), or None
-        for a constant (the engine's own loop)."""
+    def _engine(self) -> dict[str, Any] | None:
+        """The law as the engine takes it (``_core.EDMD``'s ``law``, ``wall_law``): a dict
+        of kind, scale, v_max, speeds and values, or None for a constant (the engine's
+        own loop)."""
 
     @abc.abstractmethod
     def _key(self) -> tuple:
@@ -307,8 +312,14 @@ class Viscoelastic(RestitutionLaw):
     def loses_energy(self) -> bool:
         return True
 
-    def _engine(self) -> tuple:
-        return (_KIND_VISCOELASTIC, self.scale, self.max_speed, np.empty(0), np.empty(0))
+    def _engine(self) -> dict[str, Any]:
+        return dict(
+            kind=_KIND_VISCOELASTIC,
+            scale=self.scale,
+            v_max=self.max_speed,
+            speeds=np.empty(0),
+            values=np.empty(0),
+        )
 
     def _key(self) -> tuple:
         return (self.damping, self.kappa)
@@ -376,8 +387,8 @@ class TabulatedRestitution(RestitutionLaw):
     def loses_energy(self) -> bool:
         return bool(np.any(self.values < 1.0))
 
-    def _engine(self) -> tuple:
-        return (_KIND_TABLE, 0.0, 0.0, self.speeds, self.values)
+    def _engine(self) -> dict[str, Any]:
+        return dict(kind=_KIND_TABLE, scale=0.0, v_max=0.0, speeds=self.speeds, values=self.values)
 
     def _key(self) -> tuple:
         return (self.speeds.tobytes(), self.values.tobytes())
@@ -407,7 +418,7 @@ def heats(restitution: float | RestitutionLaw) -> bool:
     return not isinstance(restitution, RestitutionLaw) and restitution > 1.0
 
 
-def engine_law(restitution: float | RestitutionLaw) -> tuple | None:
+def engine_law(restitution: float | RestitutionLaw) -> dict[str, Any] | None:
     """The law as the engine takes it, or None for a number."""
     return restitution._engine() if isinstance(restitution, RestitutionLaw) else None
 

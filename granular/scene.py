@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import math
 import os
 from typing import Any
@@ -9,12 +10,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _edmd
+from . import _core, _edmd, gsd_io
 from ._scales import SCALE_HI, SCALE_LO, check_range
+from ._scene_params import BOUNDARIES, NAMES, PARAMETERS, SIGNATURE, engine_keywords, real
+from ._scene_params import box_corners as _box_corners
+from ._scene_params import docstring as _parameters_doc
 from .placement import draw_velocities, lattice_order, place_lattice, place_rsa
-from .restitution import ConstantRestitution, RestitutionLaw, engine_law
-
-BOUNDARIES = ("periodic", "walls")
+from .restitution import RestitutionLaw
 
 # Random sequential addition jams near these packing fractions (3D ~0.38, 2D ~0.55);
 # above a safe fraction of them Scene.random places on a lattice and melts it instead.
@@ -105,117 +107,28 @@ def frozen_energy(radii, masses):
     return 0.5 * len(radii) * float(np.max(masses)) * speed * speed
 
 
-def _box_corners(box, dim):
-    """(lower, upper) float64 arrays of length dim from a scalar L, a pair (lo, hi) of
-    scalars or a pair of length-dim arrays."""
-    if np.ndim(box) == 0:
-        lo, hi = np.zeros(dim), np.full(dim, float(box))
-    else:
-        if len(box) != 2:
-            raise ValueError("box must be a length L, or a pair (lower, upper)")
-        lo = np.broadcast_to(np.asarray(box[0], dtype=np.float64), (dim,)).copy()
-        hi = np.broadcast_to(np.asarray(box[1], dtype=np.float64), (dim,)).copy()
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
-        raise ValueError(f"box needs finite lower < upper on every axis, got {lo} and {hi}")
-    with np.errstate(over="ignore", under="ignore"):
-        lengths = hi - lo
-        volume = float(np.prod(lengths))
-    if not (np.all(np.isfinite(lengths)) and _SCALE_LO**2 <= volume <= _SCALE_HI**2):
-        raise ValueError(
-            f"the box's volume {volume:.3g} is outside {_SCALE_LO**2:g} .. "
-            f"{_SCALE_HI**2:g}: choose units nearer the box's size"
-        )
-    return lo, hi
-
-
-def _real(value, name):
-    """value as a float64 array, refusing what float64 would silently change: complex
-    numbers (the imaginary part dropped) and non-numbers."""
-    a = np.asarray(value)
-    if np.iscomplexobj(a):
-        raise TypeError(f"{name} must be real numbers, got complex")
-    if a.dtype.kind not in "biuf":
-        raise TypeError(f"{name} must be numbers, got dtype {a.dtype}")
-    return a.astype(np.float64, copy=False)  # callers that keep it copy it (_array)
-
-
-def _restitution(value, name):
-    """A restitution as a Scene keeps it: a law, or a float (a ConstantRestitution's
-    number); the caller checks the number's range."""
-    if isinstance(value, ConstantRestitution):
-        return value.value
-    if isinstance(value, RestitutionLaw):
-        return value
-    try:
-        return float(value)
-    except TypeError:
-        raise TypeError(f"{name} must be a number or a restitution law, got {value!r}") from None
-
-
-def _array(value, name, shape):
-    a = np.array(_real(value, name), dtype=np.float64, order="C", copy=True)
-    if a.shape != shape:
-        if a.ndim == 0 and len(shape) == 1:
-            a = np.full(shape, float(a))
-        else:
-            raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} contains NaN or infinity")
-    a.setflags(write=False)
-    return a
-
-
-# what Scene.replace changes
-_FIELDS = (
-    "positions",
-    "velocities",
-    "radii",
-    "masses",
-    "box",
-    "boundary",
-    "wall_restitution",
-    "restitution",
-    "contact_duration",
-)
-
-
 def _set(scene: Scene, name: str, value: Any) -> None:
     """Set a field while the Scene is made (``Scene.__setattr__`` refuses it after)."""
     object.__setattr__(scene, name, value)
 
 
-class Scene:
-    """Hard disks (2D) or hard spheres (3D) in a box: positions, velocities, radii, masses.
+_DOC = """Hard disks (2D) or hard spheres (3D) in a box: positions, velocities, radii, masses.
 
-    Parameters
-    ----------
-    positions, velocities : array_like, shape (N, d), d = 2 or 3
-    radii : float or array_like (N,)
-    masses : float or array_like (N,), default 1
-    box : float, or (lower, upper) with scalars or length-d arrays
-        A float L means the box [0, L]^d (the thesis' unit box is ``box=1``).
-    boundary : {"periodic", "walls"}
-    wall_restitution : float or RestitutionLaw
-        Walls reflect with ``v' = e_w * (v mirrored)`` (thesis eq. 2.22): 1 elastic, < 1
-        inelastic, > 1 "heated".  A law (``granular.restitution``) gives e_w from the
-        normal impact speed ``|v_n|`` of each hit, in the same rule (so the tangential
-        velocity is scaled by e_w too).  Ignored for periodic boxes.
-    restitution : float in [0, 1] or RestitutionLaw
-        Coefficient of restitution xi of pair collisions (thesis 2.10-2.11), or a law
-        xi(v_n) of the normal impact speed: ``granular.Viscoelastic``,
-        ``granular.TabulatedRestitution`` (a ``ConstantRestitution`` is stored as its
-        number).
-    contact_duration : float >= 0
-        TC model t_c (thesis 3.6): a collision within t_c of a particle's previous one is
-        elastic, which prevents inelastic collapse.  0 turns it off.
+    {parameters}
 
     Notes
     -----
     A Scene is immutable: its attributes cannot be set (AttributeError) and its arrays are
     read-only; ``replace`` makes a changed copy, checked anew.  It is checked on
     construction: shapes, finite numbers, positive radii and masses, particles inside the
-    box, and no two particles overlapping (``OverlapError`` names the pair).
+    box, and no two particles overlapping (``OverlapError`` names the pair).  Its parameters
+    are declared once, in granular/_scene_params.py.
     """
+
+
+class Scene:
+    # the docstring is _DOC, with the parameters' section made from the declaration
+    # (granular/_scene_params.py); so are the constructor's signature and checks
 
     # the fields, set once in __init__ (through _set: __setattr__ refuses)
     positions: NDArray[np.float64]
@@ -229,72 +142,42 @@ class Scene:
     restitution: float | RestitutionLaw
     contact_duration: float
 
-    def __init__(
-        self,
-        positions: ArrayLike,
-        velocities: ArrayLike,
-        radii: ArrayLike,
-        masses: ArrayLike = 1.0,
-        *,
-        box: float | ArrayLike = 1.0,
-        boundary: str = "periodic",
-        wall_restitution: float | RestitutionLaw = 1.0,
-        restitution: float | RestitutionLaw = 1.0,
-        contact_duration: float = 0.0,
-    ) -> None:
-        pos = _real(positions, "positions")
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        try:
+            bound = SIGNATURE.bind(*args, **kwargs)
+        except TypeError as exc:
+            raise TypeError(f"Scene{SIGNATURE}: {exc}") from None
+        bound.apply_defaults()
+        given = bound.arguments
+        pos = real(given["positions"], "positions")
         if pos.ndim != 2 or pos.shape[1] not in (2, 3) or pos.shape[0] < 1:
             raise ValueError(
                 f"positions must have shape (N, 2) or (N, 3) with N >= 1, got {pos.shape}"
             )
         n, d = pos.shape
-        _set(self, "positions", _array(pos, "positions", (n, d)))
-        _set(self, "velocities", _array(velocities, "velocities", (n, d)))
-        _set(self, "radii", _array(radii, "radii", (n,)))
-        _set(self, "masses", _array(masses, "masses", (n,)))
-        if np.any(self.radii <= 0):
-            raise ValueError(f"radii must be positive (particle {int(np.argmin(self.radii))})")
-        if np.any(self.masses <= 0):
-            raise ValueError(f"masses must be positive (particle {int(np.argmin(self.masses))})")
-        lower, upper = _box_corners(box, d)
-        _set(self, "lower", lower)
-        _set(self, "upper", upper)
-        _check_scales(self.radii, self.masses, self.velocities, self.lower, self.upper)
-        with np.errstate(over="ignore"):
-            finite_energy = math.isfinite(self.kinetic_energy)
-        if not finite_energy:
-            raise ValueError("the kinetic energy overflows: velocities too large for float64")
-        self.lower.setflags(write=False)
-        self.upper.setflags(write=False)
-        if boundary not in BOUNDARIES:
-            raise ValueError(f"boundary must be one of {BOUNDARIES}, got {boundary!r}")
-        _set(self, "boundary", boundary)
-        _set(self, "wall_restitution", _restitution(wall_restitution, "wall_restitution"))
-        if not isinstance(self.wall_restitution, RestitutionLaw) and not (
-            self.wall_restitution > 0 and math.isfinite(self.wall_restitution)
-        ):
-            raise ValueError(
-                f"wall_restitution must be positive and finite, got {wall_restitution}"
-            )
-        _set(self, "restitution", _restitution(restitution, "restitution"))
-        if not isinstance(self.restitution, RestitutionLaw) and not (
-            0.0 <= self.restitution <= 1.0
-        ):
-            raise ValueError(f"restitution must lie in [0, 1], got {restitution}")
-        _set(self, "contact_duration", float(contact_duration))
-        if not (self.contact_duration >= 0 and math.isfinite(self.contact_duration)):
-            raise ValueError(f"contact_duration must be finite and >= 0, got {contact_duration}")
+        for p in PARAMETERS:
+            kept = p.check(pos if p.name == "positions" else given[p.name], n, d)
+            for field, value in zip(p.fields, kept if p.attributes else (kept,), strict=True):
+                _set(self, field, value)
+            if p.name == "box":  # the scales need the particles' arrays and the box
+                _check_scales(self.radii, self.masses, self.velocities, self.lower, self.upper)
+                with np.errstate(over="ignore"):
+                    finite_energy = math.isfinite(self.kinetic_energy)
+                if not finite_energy:
+                    raise ValueError(
+                        "the kinetic energy overflows: velocities too large for float64"
+                    )
         # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
         # the engine's own rules in O(N) through a cell grid, without building an engine.
-        _core.edmd_check(*self._engine_args(), **self._engine_laws())
+        _core.edmd_check(**self._engine_keywords())
 
     def __setattr__(self, name: str, value: Any) -> None:
         # a field set after the checks would skip them (a restitution of 7.5, an overlap)
         field = "box" if name in ("lower", "upper") else name
         how = (
             f"scene.replace({field}=...)"
-            if field in _FIELDS
-            else f"scene.replace(...) of its fields {', '.join(_FIELDS)}"
+            if field in NAMES
+            else f"scene.replace(...) of its fields {', '.join(NAMES)}"
         )
         raise AttributeError(
             f"a Scene is immutable: {name} cannot be set; make a changed copy, checked "
@@ -304,27 +187,10 @@ class Scene:
     def __delattr__(self, name: str) -> None:
         raise AttributeError(f"a Scene is immutable: {name} cannot be deleted")
 
-    def _engine_laws(self) -> dict[str, Any]:
-        """The restitution laws as keywords of ``_core.EDMD`` (None: the number)."""
-        return dict(law=engine_law(self.restitution), wall_law=engine_law(self.wall_restitution))
-
-    def _engine_args(
-        self,
-    ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray, NDArray, bool, float, float, float]:
-        """The scene as the C engine takes it (``_core.edmd_check`` and ``_core.EDMD``),
-        with ``_engine_laws`` as keywords; a law's number is 1 (unused)."""
-        return (
-            self.positions,
-            self.velocities,
-            self.radii,
-            self.masses,
-            self.lower,
-            self.upper,
-            self.boundary == "periodic",
-            1.0 if isinstance(self.wall_restitution, RestitutionLaw) else self.wall_restitution,
-            1.0 if isinstance(self.restitution, RestitutionLaw) else self.restitution,
-            self.contact_duration,
-        )
+    def _engine_keywords(self) -> dict[str, Any]:
+        """The scene as the C engine takes it: the keywords of ``_core.edmd_check`` and
+        ``_core.EDMD``, made from the declaration (``_scene_params.engine_keywords``)."""
+        return engine_keywords(self)
 
     # -- derived quantities ---------------------------------------------------------
     @property
@@ -370,33 +236,24 @@ class Scene:
         return 2.0 * self.kinetic_energy / (self.dim * self.n)
 
     def replace(self, **changes: Any) -> Scene:
-        """A copy with some fields changed, e.g. ``scene.replace(restitution=0.8)``."""
-        fields: dict[str, Any] = dict(
-            positions=self.positions,
-            velocities=self.velocities,
-            radii=self.radii,
-            masses=self.masses,
-            box=(self.lower, self.upper),
-            boundary=self.boundary,
-            wall_restitution=self.wall_restitution,
-            restitution=self.restitution,
-            contact_duration=self.contact_duration,
-        )
-        unknown = set(changes) - set(fields)
+        """A copy with some fields changed, e.g. ``scene.replace(restitution=0.8)``; the
+        box is changed as ``box=`` (a length, or the corners (lower, upper))."""
+        unknown = set(changes) - set(NAMES)
         if unknown:
-            raise TypeError(f"unknown Scene fields: {sorted(unknown)}")
-        fields.update(changes)
-        positions = fields.pop("positions")
-        velocities = fields.pop("velocities")
-        radii = fields.pop("radii")
-        return Scene(positions, velocities, radii, **fields)
+            raise TypeError(f"unknown Scene fields: {sorted(unknown)}; a Scene has {NAMES}")
+        return Scene(**{p.name: changes.get(p.name, p.get(self)) for p in PARAMETERS})
 
     def __repr__(self):
+        # the gas' summary, then each parameter that is not an array (the wall restitution
+        # only where there are walls)
+        shown = [
+            f"{p.name}={p.get(self)!r}"
+            for p in PARAMETERS
+            if not p.is_array and (p.name != "wall_restitution" or self.boundary == "walls")
+        ]
         return (
-            f"Scene(n={self.n}, dim={self.dim}, boundary={self.boundary!r}, "
-            f"packing_fraction={self.packing_fraction:.4g}, restitution={self.restitution}, "
-            + (f"wall_restitution={self.wall_restitution}, " if self.boundary == "walls" else "")
-            + f"temperature={self.temperature:.4g})"
+            f"Scene(n={self.n}, dim={self.dim}, packing_fraction={self.packing_fraction:.4g}, "
+            f"temperature={self.temperature:.4g}, {', '.join(shown)})"
         )
 
     # -- constructors ---------------------------------------------------------------
@@ -404,12 +261,10 @@ class Scene:
     def from_gsd(cls, path: str | os.PathLike, frame: int = -1, **params: Any) -> Scene:
         """The scene at one frame (default the last) of a GSD file: exact float64 positions
         (wrapped into the box), velocities, radii, masses and box when granular wrote it
-        (``Trajectory.write``), else from the float32 HOOMD fields.  ``params`` are the
-        other Scene keywords (restitution, wall_restitution, contact_duration), which a
-        trajectory does not record."""
-        from . import gsd_io
-
-        return gsd_io.scene_from_gsd(path, frame, **params)
+        (``Trajectory.write``), else from the float32 HOOMD fields.  ``params`` are Scene
+        parameters to set (as ``replace`` does): those a trajectory does not record, such
+        as the restitutions."""
+        return gsd_io.scene_from_gsd(path, frame, cls, **params)
 
     @classmethod
     def random(
@@ -609,3 +464,12 @@ class Scene:
         """The lecture notes' ideal gas: elastic spheres in the unit box with reflecting
         walls and Maxwell-Boltzmann velocities at T = 1."""
         return cls.random(n, radius, dim=3, box=1.0, boundary="walls", temperature=1.0, seed=seed)
+
+
+Scene.__doc__ = _DOC.format(parameters=_parameters_doc().replace("\n", "\n    "))
+Scene.__init__.__signature__ = SIGNATURE.replace(  # type: ignore[attr-defined]
+    parameters=[
+        inspect.Parameter("self", inspect.Parameter.POSITIONAL_ONLY),
+        *SIGNATURE.parameters.values(),
+    ]
+)

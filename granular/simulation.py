@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _edmd
+from . import _core, _edmd, checkpoint
 from . import restitution as _restitution
 from ._edmd import check_memory as _check_memory
 from .errors import (
@@ -116,8 +116,6 @@ class Simulation:
             ``NonFiniteError`` leaves them, or anything else ``load`` would refuse):
             nothing is written.
         """
-        from . import checkpoint
-
         with self._exclusive():
             checkpoint.save(self, path)
 
@@ -144,17 +142,18 @@ class Simulation:
             momentum), or was written by another granular version or engine layout (a
             run continues bit for bit only in the version that saved it).
         """
-        from . import checkpoint
+        return checkpoint.load(path, cls)
 
-        return checkpoint.load(path)
+    @classmethod
+    def _loads(cls, data: bytes) -> Simulation:
+        """The Simulation in checkpoint bytes (``checkpoint.dumps``): what unpickling calls."""
+        return checkpoint.loads(data, cls)
 
     def __reduce__(self):
         # pickling (and copy.copy / copy.deepcopy, Dask) goes through a checkpoint: the
         # copy gets its own engine with the same state, never a shared one
-        from . import checkpoint
-
         with self._exclusive():
-            return (checkpoint.loads, (checkpoint.dumps(self),))
+            return (type(self)._loads, (checkpoint.dumps(self),))
 
     @contextlib.contextmanager
     def _exclusive(self, instead: str = "save or copy it between runs") -> Iterator[None]:
@@ -204,18 +203,7 @@ class Simulation:
     def scene(self) -> Scene:
         """The current state as a new Scene (positions wrapped into a periodic box)."""
         pos, vel, _ = self._engine.state()
-        s = self._initial
-        return Scene(
-            pos,
-            vel,
-            s.radii,
-            s.masses,
-            box=(s.lower, s.upper),
-            boundary=s.boundary,
-            wall_restitution=s.wall_restitution,
-            restitution=s.restitution,
-            contact_duration=s.contact_duration,
-        )
+        return self._initial.replace(positions=pos, velocities=vel)
 
     @property
     def unwrapped_positions(self) -> NDArray[np.float64]:
@@ -371,7 +359,15 @@ class Simulation:
             self._check_not_frozen(start, frozen, moving)
             while budget - done > 0:
                 chunk = int(min(_CHUNK, budget - done))
-                code, nxt = self._engine.advance(t_end, cpp, kin, chunk, times, nxt, **views)
+                code, nxt = self._engine.advance(
+                    t_stop=t_end,
+                    collisions_per_particle=cpp,
+                    stop_kinetic_energy=kin,
+                    max_events=chunk,
+                    sample_times=times,
+                    next=nxt,
+                    **views,
+                )
                 after = self._engine.counters()
                 done += after["events"] - events
                 events = after["events"]

@@ -8,7 +8,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import gsd_io
 from ._results import readonly
+from .scene import Scene
 
 
 def _pressure_volume(lower, upper, radii, boundary):
@@ -346,8 +348,6 @@ class Trajectory:
         velocities, times and counters go in its log section (see ``granular.gsd_io``).
         Other formats (XYZ, TRR, ...): MDAnalysis' writers on ``to_universe()``.  Needs
         the positions stored."""
-        from . import gsd_io
-
         gsd_io.write(self, path)
 
     def __len__(self) -> int:
@@ -359,3 +359,33 @@ class Trajectory:
             f"Trajectory({len(self.times)} samples, {span}, n={self.n}, dim={self.dim}, "
             f"stop_reason={self.stop_reason!r})"
         )
+
+
+def read(path: str | os.PathLike) -> Trajectory:
+    """Read a GSD file written by ``Trajectory.write`` back into a Trajectory, with the
+    exact float64 values of the log section.
+
+    Every frame is checked as a Scene is (finite positions and velocities, positive radii
+    and masses, a valid box and boundary, particles inside it and not overlapping), the
+    sample times must increase and the collision counts must be whole numbers that never
+    decrease.  Only the log section is read, no more of it than the file holds.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.gsd`` file.
+
+    Returns
+    -------
+    Trajectory
+
+    Raises
+    ------
+    GSDFileError
+        Not a GSD file, truncated or corrupt, not written by granular, or a field missing,
+        of the wrong shape or an impossible value; the message names the file, the frame
+        and the field.
+    FileNotFoundError
+        No file at ``path``.
+    """
+    return gsd_io.read(path, Scene, Trajectory)

@@ -37,21 +37,53 @@ def test_bytes_per_particle():
 
 def test_check_agrees_with_the_engine():
     s = granular.Scene.random(200, 0.02, seed=3)
-    assert _core.edmd_check(*s._engine_args()) is None
+    assert _core.edmd_check(**s._engine_keywords()) is None
     pos = s.positions.copy()
     pos[5] = pos[9] + [0.01, 0.0, 0.0]  # overlapping 9
     pos[5] %= 1.0
-    bad = list(s._engine_args())
-    bad[0] = pos
+    bad = {**s._engine_keywords(), "positions": pos}
+    knobs = dict(cell_factor=1.0, big_ratio=BIG_RATIO, shell=0.0)
     for build in (_core.edmd_check, _core.EDMD):
         with pytest.raises(GranularError, match="overlap"):
-            build(*bad, 1.0, BIG_RATIO, 0.0)
+            build(**bad, **knobs)
     pos = s.positions.copy()
     pos[3, 1] = 1.5  # outside the box
-    bad[0] = pos
+    bad["positions"] = pos
     for build in (_core.edmd_check, _core.EDMD):
         with pytest.raises((GranularError, ValueError)):
-            build(*bad, 1.0, BIG_RATIO, 0.0)
+            build(**bad, **knobs)
+
+
+def test_the_engine_takes_keywords_only():
+    """EDMD, edmd_check and advance take every argument by name: a positional call, a
+    misspelt or a missing name is a TypeError naming it, so two numbers cannot swap
+    places unseen; advance's energy criterion and its samples' buffer have two names."""
+    s = granular.Scene.random(20, 0.02, seed=3)
+    kw = s._engine_keywords()
+    for build in (_core.edmd_check, _core.EDMD):
+        with pytest.raises(TypeError, match="positional"):
+            build(*kw.values())
+        with pytest.raises(TypeError, match="restitutoin"):
+            build(**kw, restitutoin=0.5)
+        with pytest.raises(TypeError, match="missing required keyword argument 'contact_duration'"):
+            build(**{k: v for k, v in kw.items() if k != "contact_duration"})
+    engine = _core.EDMD(**kw)
+    stop = dict(
+        t_stop=math.inf,
+        collisions_per_particle=1.0,
+        stop_kinetic_energy=-1.0,
+        max_events=10**6,
+        sample_times=np.array([0.0, 0.001]),
+        next=0,
+    )
+    with pytest.raises(TypeError, match="positional"):
+        engine.advance(*stop.values())
+    with pytest.raises(TypeError, match="missing required keyword argument 'max_events'"):
+        engine.advance(**{k: v for k, v in stop.items() if k != "max_events"})
+    kinetic = np.full(2, -1.0)
+    code, nxt = engine.advance(**stop, kinetic_energy=kinetic)
+    assert code == _core.STOP_COLLISIONS and nxt == 2
+    assert kinetic == pytest.approx(np.full(2, s.kinetic_energy), rel=1e-12)
 
 
 def test_scene_and_simulation_do_not_import_each_other():

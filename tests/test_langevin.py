@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import granular
-from granular import _langevin_run, langevin, theory
+from granular import _core, langevin, theory
 
 from helpers import sde_bits, sde_reference
 
@@ -481,7 +481,7 @@ def test_default_samples_end_at_t_stop_for_any_step_count(monkeypatch):
     logspace overshoots it (10^15 + 3 steps: 10^15 + 4); no stepping is needed to see it,
     so the C core is replaced by a stub (called once)."""
     seen = []
-    monkeypatch.setattr(langevin._core, "sde_run", lambda *args, **kw: seen.append(args[15]))
+    monkeypatch.setattr(langevin._core, "sde_run", lambda **kw: seen.append(kw["sample_steps"]))
     monkeypatch.setattr(langevin, "_CHUNK_PARTICLE_STEPS", 10**16)
     r = langevin.run(1, gamma0=G0, D0=D0, dt=1.0, t_stop=1e15 + 3, seed=1)
     assert r.times[-1] == 1e15 + 3 and np.all(np.diff(r.times) > 0)
@@ -948,16 +948,40 @@ def test_every_compilation_of_the_batched_normals_gives_the_same_bits(kernel):
     assert json.loads(out[1]) == want
 
 
-def test_the_engine_arguments_are_built_in_the_bindings_order():
-    """_core.sde_run reads most of its arguments by position (csrc/_core.c, sde_run's
-    names[] and format), so two swapped numbers (gamma0 and D0, say) would run unseen;
-    run builds them by name in one place, _sde_args, whose order must be the binding's.
-    Each argument is given its own name as value: the tuple must read the binding's names
-    in the binding's order."""
-    source = Path(__file__).resolve().parent.parent / "csrc" / "_core.c"
-    if not source.is_file():
-        pytest.skip("needs the source tree (csrc/_core.c)")
-    binding = source.read_text().split("static PyObject *sde_run(", 1)[1]
-    names = re.findall(r'"(\w+)"', re.search(r"names\[\] = \{(.*?)NULL\}", binding, re.S)[1])
-    assert names[:3] == ["dim", "model", "scheme"] and names[-1] == "exponent", names
-    assert _langevin_run._sde_args(**{k: k for k in names}) == tuple(names)
+def test_the_engine_takes_its_arguments_by_name():
+    """_core.sde_run takes every argument by name (23 numbers and arrays, many of one
+    type: gamma0 and D0 swapped would run unseen): a positional call, a misspelt or a
+    missing name is a TypeError naming it."""
+    x, v = np.zeros((1, 3)), np.zeros((1, 3))
+    args = dict(
+        dim=3,
+        model=0,
+        scheme=1,
+        gamma0=G0,
+        D0=D0,
+        tau0=math.inf,
+        dt=0.01,
+        key=1,
+        n=1,
+        first=0,
+        step_from=0,
+        step_to=1,
+        n_steps=1,
+        x=x,
+        v=v,
+        sample_steps=np.array([0, 1]),
+        x2=np.zeros((2, 3)),
+        v2=np.zeros((2, 3)),
+        positions=None,
+        lags=np.zeros(0, np.int64),
+        tamsd=np.zeros((1, 0)),
+        ring=np.zeros(0),
+    )
+    _core.sde_run(**args)
+    assert np.all(np.isfinite(v)) and np.any(v != 0)
+    with pytest.raises(TypeError, match="positional"):
+        _core.sde_run(*args.values())
+    with pytest.raises(TypeError, match="gamma"):
+        _core.sde_run(**{("gamma" if k == "gamma0" else k): a for k, a in args.items()})
+    with pytest.raises(TypeError, match="missing required keyword argument 'D0'"):
+        _core.sde_run(**{k: a for k, a in args.items() if k != "D0"})

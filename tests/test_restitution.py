@@ -34,6 +34,39 @@ def test_series_coefficients_are_the_published_ones():
     assert 0 <= C2 - 0.7982 < 1e-4
 
 
+def test_law_constants_are_the_cores():
+    """The law kinds, C1, C2, DELTA_MAX and TABLE_MAX are read from _core (the engine owns
+    them, csrc/restitution.h), not copied: each is assigned from ``_core.NAME`` in
+    restitution.py, and the engine's series coefficients are the formulas'."""
+    import ast
+    import inspect
+
+    tree = ast.parse(inspect.getsource(granular.restitution))
+    assigned = {
+        node.target.id if isinstance(node, ast.AnnAssign) else node.targets[0].id: node.value
+        for node in tree.body
+        if isinstance(node, (ast.Assign, ast.AnnAssign))
+        and isinstance(
+            node.target if isinstance(node, ast.AnnAssign) else node.targets[0], ast.Name
+        )
+    }
+    wanted = {
+        "_KIND_VISCOELASTIC": "LAW_VISCOELASTIC",
+        "_KIND_TABLE": "LAW_TABLE",
+        "C1": "VISCO_C1",
+        "C2": "VISCO_C2",
+        "DELTA_MAX": "VISCO_DELTA_MAX",
+        "TABLE_MAX": "LAW_TABLE_MAX",
+    }
+    for name, core_name in wanted.items():
+        value = assigned[name]
+        assert ast.unparse(value) == f"_core.{core_name}", (name, ast.unparse(value))
+    c1 = math.gamma(3 / 5) * math.sqrt(math.pi) / (2**0.2 * 5**0.4 * math.gamma(21 / 10))
+    assert math.isclose(_core.VISCO_C1, c1, rel_tol=4e-16)
+    assert math.isclose(_core.VISCO_C2, 0.6 * c1 * c1, rel_tol=4e-16)
+    assert _core.LAW_CONSTANT == 0 and len({_core.LAW_VISCOELASTIC, _core.LAW_TABLE, 0}) == 3
+
+
 def contact_restitution(young, poisson, damping, radius, mass, speed, ending="force"):
     """eps of two equal spheres from Newton's equation of the compression xi during the
     contact, m_eff xi'' = -rho (xi^(3/2) + (3/2) A xi^(1/2) xi'), rho = 2 Y sqrt(R_eff) /
@@ -451,17 +484,21 @@ def test_scene_refuses_what_is_not_a_restitution():
         s.replace(restitution=float("nan"))
 
 
+def _law(kind, scale, v_max, speeds, values):
+    return dict(kind=kind, scale=scale, v_max=v_max, speeds=speeds, values=values)
+
+
 @pytest.mark.parametrize(
     "law,match",
     [
-        ((7, 0.0, 0.0, np.empty(0), np.empty(0)), "unknown kind"),
-        ((1, -1.0, 1.0, np.empty(0), np.empty(0)), "viscoelastic"),
+        (_law(7, 0.0, 0.0, np.empty(0), np.empty(0)), "unknown kind"),
+        (_law(1, -1.0, 1.0, np.empty(0), np.empty(0)), "viscoelastic"),
         # v_max past the series' range (0.25 / 0.1)^5 = 97.66 would let eps exceed 1
-        ((1, 0.1, math.inf, np.empty(0), np.empty(0)), "viscoelastic"),
-        ((1, 0.1, 98.0, np.empty(0), np.empty(0)), "viscoelastic"),
-        ((2, 0.0, 0.0, np.array([0.0, 2.0, 1.0]), np.array([1.0, 0.9, 0.8])), "increasing"),
-        ((2, 0.0, 0.0, np.array([0.0, 1.0]), np.array([1.0, 2.0])), r"\[0, 1\]"),
-        ((2, 0.0, 0.0, np.empty(0), np.empty(0)), "points"),
+        (_law(1, 0.1, math.inf, np.empty(0), np.empty(0)), "viscoelastic"),
+        (_law(1, 0.1, 98.0, np.empty(0), np.empty(0)), "viscoelastic"),
+        (_law(2, 0.0, 0.0, np.array([0.0, 2.0, 1.0]), np.array([1.0, 0.9, 0.8])), "increasing"),
+        (_law(2, 0.0, 0.0, np.array([0.0, 1.0]), np.array([1.0, 2.0])), r"\[0, 1\]"),
+        (_law(2, 0.0, 0.0, np.empty(0), np.empty(0)), "points"),
     ],
 )
 def test_the_engine_checks_a_law_itself(law, match):
@@ -470,9 +507,24 @@ def test_the_engine_checks_a_law_itself(law, match):
     s = Scene.random(10, 0.02, seed=1)
     for key in ("law", "wall_law"):
         with pytest.raises(ValueError, match=match):
-            _core.edmd_check(*s._engine_args(), **{key: law})
-    with pytest.raises(TypeError, match="law must be None"):
-        _core.EDMD(*s._engine_args(), law=(1, 2.0))
+            _core.edmd_check(**{**s._engine_keywords(), key: law})
+
+
+def test_the_engine_takes_a_law_by_name():
+    """A law reaches the engine as a dict of named fields: a tuple, a misspelt or a
+    missing field is a TypeError naming it, never a number read into the wrong place."""
+    s = Scene.random(10, 0.02, seed=1)
+    good = _law(1, 0.1, 90.0, np.empty(0), np.empty(0))
+    _core.edmd_check(**{**s._engine_keywords(), "law": good})
+    with pytest.raises(TypeError, match="law must be None or a dict"):
+        _core.EDMD(**{**s._engine_keywords(), "law": (1, 0.1, 90.0, np.empty(0), np.empty(0))})
+    with pytest.raises(TypeError, match="vmax"):
+        bad = {("vmax" if k == "v_max" else k): v for k, v in good.items()}
+        _core.EDMD(**{**s._engine_keywords(), "wall_law": bad})
+    with pytest.raises(TypeError, match="'scale'"):
+        _core.EDMD(
+            **{**s._engine_keywords(), "law": {k: v for k, v in good.items() if k != "scale"}}
+        )
 
 
 def test_constant_restitution_formulas_name_what_to_use_for_a_law():

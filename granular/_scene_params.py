@@ -1,0 +1,386 @@
+"""A Scene's parameters, each declared once: its name, type, shape, default, unit, meaning,
+the check that normalises it, the keywords it becomes in the C engine and how a checkpoint
+stores it.  That one declaration (``PARAMETERS``) drives Scene's constructor (its signature
+and checks), ``replace``, ``repr``, the engine's arguments (``engine_keywords``), the
+checkpoints (arrays or JSON) and the GSD reader's keywords.
+
+Adding a parameter (docs/engine.md, "Adding a scene parameter"): one ``SceneParameter``
+here, its field in the engine's config (csrc/edmd.h ``gr_edmd_config``; a number is also
+one line of csrc/scene_params.h, which gives the binding its keyword and a checkpoint its
+bytes), its check in csrc/validate.c, and the physics that uses it.
+tests/test_scene_params.py checks that every parameter reaches the engine by name
+(``_core.EDMD_KEYWORDS``), goes through ``replace`` and survives a checkpoint.
+
+Units as in docs/conventions.md: ``L`` the length unit, ``m`` the mass unit, speeds in
+``sqrt(eps/m)``, time in ``L sqrt(m/eps)``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import textwrap
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ._scales import SCALE_HI, SCALE_LO
+from .restitution import ConstantRestitution, RestitutionLaw, engine_law
+
+BOUNDARIES = ("periodic", "walls")
+
+REQUIRED = inspect.Parameter.empty
+
+
+@dataclass(frozen=True)
+class SceneParameter:
+    """One parameter of a Scene.
+
+    Parameters
+    ----------
+    name : str
+        The constructor's and ``replace``'s keyword.
+    type : str
+        Its type as the documentation states it.
+    shape : tuple of str, or None
+        An array's shape in ``"N"`` (particles) and ``"d"`` (dimension); None: not an array.
+    default : object
+        The value when it is not given (``REQUIRED``: it must be).
+    unit : str
+        Its unit (docs/conventions.md).
+    doc : str
+        What it means (the constructor's docstring).
+    check : callable
+        ``check(value, n, d)``: the value as the Scene keeps it, checked (ValueError or
+        TypeError naming it otherwise).
+    engine : callable
+        ``engine(kept)``: the keywords of ``_core.EDMD`` it becomes.
+    attributes : tuple of str
+        The Scene's attributes that hold it (its name, unless it is split: the box into
+        ``lower`` and ``upper``); a checkpoint stores an array under each.
+    positional : bool
+        Whether the constructor also takes it by position (the particles' arrays).
+    """
+
+    name: str
+    type: str
+    shape: tuple[str, ...] | None
+    default: Any
+    unit: str
+    doc: str
+    check: Callable[[Any, int, int], Any]
+    engine: Callable[[Any], dict[str, Any]]
+    attributes: tuple[str, ...] = ()
+    positional: bool = False
+
+    @property
+    def fields(self) -> tuple[str, ...]:
+        """The Scene's attributes holding the value."""
+        return self.attributes or (self.name,)
+
+    @property
+    def is_array(self) -> bool:
+        """Stored as arrays (a checkpoint's ``scene_<attribute>`` members), else as JSON."""
+        return self.shape is not None
+
+    def get(self, scene: Any) -> Any:
+        """The value as a Scene keeps it (a tuple of its attributes if it is split)."""
+        values = tuple(getattr(scene, a) for a in self.fields)
+        return values if self.attributes else values[0]
+
+
+# -- the checks ---------------------------------------------------------------------------
+
+
+def real(value: Any, name: str) -> np.ndarray:
+    """value as a float64 array, refusing what float64 would silently change: complex
+    numbers (the imaginary part dropped) and non-numbers."""
+    a = np.asarray(value)
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} must be real numbers, got complex")
+    if a.dtype.kind not in "biuf":
+        raise TypeError(f"{name} must be numbers, got dtype {a.dtype}")
+    return a.astype(np.float64, copy=False)  # callers that keep it copy it (array)
+
+
+def array(value: Any, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    """A read-only C-ordered float64 copy of ``value`` of ``shape`` (a number fills a
+    one-dimensional shape), finite."""
+    a = np.array(real(value, name), dtype=np.float64, order="C", copy=True)
+    if a.shape != shape:
+        if a.ndim == 0 and len(shape) == 1:
+            a = np.full(shape, float(a))
+        else:
+            raise ValueError(f"{name} must have shape {shape}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} contains NaN or infinity")
+    a.setflags(write=False)
+    return a
+
+
+def box_corners(box: Any, dim: int) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) float64 arrays of length dim from a scalar L, a pair (lo, hi) of
+    scalars or a pair of length-dim arrays."""
+    if np.ndim(box) == 0:
+        lo, hi = np.zeros(dim), np.full(dim, float(box))
+    else:
+        if len(box) != 2:
+            raise ValueError("box must be a length L, or a pair (lower, upper)")
+        lo = np.broadcast_to(np.asarray(box[0], dtype=np.float64), (dim,)).copy()
+        hi = np.broadcast_to(np.asarray(box[1], dtype=np.float64), (dim,)).copy()
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(hi > lo)):
+        raise ValueError(f"box needs finite lower < upper on every axis, got {lo} and {hi}")
+    with np.errstate(over="ignore", under="ignore"):
+        lengths = hi - lo
+        volume = float(np.prod(lengths))
+    if not (np.all(np.isfinite(lengths)) and SCALE_LO**2 <= volume <= SCALE_HI**2):
+        raise ValueError(
+            f"the box's volume {volume:.3g} is outside {SCALE_LO**2:g} .. "
+            f"{SCALE_HI**2:g}: choose units nearer the box's size"
+        )
+    return lo, hi
+
+
+def _restitution(value: Any, name: str) -> float | RestitutionLaw:
+    """A restitution as a Scene keeps it: a law, or a float (a ConstantRestitution's
+    number); the caller checks the number's range."""
+    if isinstance(value, ConstantRestitution):
+        return value.value
+    if isinstance(value, RestitutionLaw):
+        return value
+    try:
+        return float(value)
+    except TypeError:
+        raise TypeError(f"{name} must be a number or a restitution law, got {value!r}") from None
+
+
+def _positions(value: Any, n: int, d: int) -> np.ndarray:
+    return array(value, "positions", (n, d))  # its shape gave n and d (Scene.__init__)
+
+
+def _velocities(value: Any, n: int, d: int) -> np.ndarray:
+    return array(value, "velocities", (n, d))
+
+
+def _positive(name: str) -> Callable[[Any, int, int], np.ndarray]:
+    def check(value: Any, n: int, d: int) -> np.ndarray:
+        a = array(value, name, (n,))
+        if np.any(a <= 0):
+            raise ValueError(f"{name} must be positive (particle {int(np.argmin(a))})")
+        return a
+
+    return check
+
+
+def _box(value: Any, n: int, d: int) -> tuple[np.ndarray, np.ndarray]:
+    lower, upper = box_corners(value, d)
+    lower.setflags(write=False)
+    upper.setflags(write=False)
+    return lower, upper
+
+
+def _boundary(value: Any, n: int, d: int) -> str:
+    if value not in BOUNDARIES:
+        raise ValueError(f"boundary must be one of {BOUNDARIES}, got {value!r}")
+    return str(value)
+
+
+def _wall_restitution(value: Any, n: int, d: int) -> float | RestitutionLaw:
+    kept = _restitution(value, "wall_restitution")
+    if not isinstance(kept, RestitutionLaw) and not (kept > 0 and math.isfinite(kept)):
+        raise ValueError(f"wall_restitution must be positive and finite, got {value}")
+    return kept
+
+
+def _pair_restitution(value: Any, n: int, d: int) -> float | RestitutionLaw:
+    kept = _restitution(value, "restitution")
+    if not isinstance(kept, RestitutionLaw) and not (0.0 <= kept <= 1.0):
+        raise ValueError(f"restitution must lie in [0, 1], got {value}")
+    return kept
+
+
+def _contact_duration(value: Any, n: int, d: int) -> float:
+    kept = float(value)
+    if not (kept >= 0 and math.isfinite(kept)):
+        raise ValueError(f"contact_duration must be finite and >= 0, got {value}")
+    return kept
+
+
+def _law_keywords(number: str, law: str) -> Callable[[Any], dict[str, Any]]:
+    """A restitution's keywords: the number (1, unused, for a law) and the law (None for a
+    number: the engine's constant loop)."""
+
+    def engine(kept: Any) -> dict[str, Any]:
+        is_law = isinstance(kept, RestitutionLaw)
+        return {number: 1.0 if is_law else kept, law: engine_law(kept)}
+
+    return engine
+
+
+def _same(name: str) -> Callable[[Any], dict[str, Any]]:
+    return lambda kept: {name: kept}
+
+
+# -- the declaration ----------------------------------------------------------------------
+
+PARAMETERS: tuple[SceneParameter, ...] = (
+    SceneParameter(
+        "positions",
+        "array_like",
+        ("N", "d"),
+        REQUIRED,
+        "L",
+        "Particle centres, d = 2 or 3.",
+        _positions,
+        _same("positions"),
+        positional=True,
+    ),
+    SceneParameter(
+        "velocities",
+        "array_like",
+        ("N", "d"),
+        REQUIRED,
+        "sqrt(eps/m)",
+        "Particle velocities.",
+        _velocities,
+        _same("velocities"),
+        positional=True,
+    ),
+    SceneParameter(
+        "radii",
+        "float or array_like",
+        ("N",),
+        REQUIRED,
+        "L",
+        "Particle radii, > 0 (a number: all alike).",
+        _positive("radii"),
+        _same("radii"),
+        positional=True,
+    ),
+    SceneParameter(
+        "masses",
+        "float or array_like",
+        ("N",),
+        1.0,
+        "m",
+        "Particle masses, > 0 (a number: all alike).",
+        _positive("masses"),
+        _same("masses"),
+        positional=True,
+    ),
+    SceneParameter(
+        "box",
+        "float, or (lower, upper) with scalars or length-d arrays",
+        ("d",),
+        1.0,
+        "L",
+        "A float L means the box [0, L]^d (the thesis' unit box is ``box=1``); the Scene "
+        "keeps its corners as ``lower`` and ``upper``.",
+        _box,
+        lambda kept: {"lower": kept[0], "upper": kept[1]},
+        attributes=("lower", "upper"),
+    ),
+    SceneParameter(
+        "boundary",
+        '{"periodic", "walls"}',
+        None,
+        "periodic",
+        "",
+        "A periodic box, or reflecting walls.",
+        _boundary,
+        lambda kept: {"periodic": kept == "periodic"},
+    ),
+    SceneParameter(
+        "wall_restitution",
+        "float > 0 or RestitutionLaw",
+        None,
+        1.0,
+        "dimensionless",
+        "Walls reflect with ``v' = e_w * (v mirrored)`` (thesis eq. 2.22): 1 elastic, < 1 "
+        'inelastic, > 1 "heated".  A law (``granular.restitution``) gives e_w from the '
+        "normal impact speed ``|v_n|`` of each hit, in the same rule (so the tangential "
+        "velocity is scaled by e_w too).  Ignored for periodic boxes.",
+        _wall_restitution,
+        _law_keywords("wall_restitution", "wall_law"),
+    ),
+    SceneParameter(
+        "restitution",
+        "float in [0, 1] or RestitutionLaw",
+        None,
+        1.0,
+        "dimensionless",
+        "Coefficient of restitution xi of pair collisions (thesis 2.10-2.11), or a law "
+        "xi(v_n) of the normal impact speed: ``granular.Viscoelastic``, "
+        "``granular.TabulatedRestitution`` (a ``ConstantRestitution`` is stored as its "
+        "number).",
+        _pair_restitution,
+        _law_keywords("restitution", "law"),
+    ),
+    SceneParameter(
+        "contact_duration",
+        "float >= 0",
+        None,
+        0.0,
+        "L sqrt(m/eps)",
+        "TC model t_c (thesis 3.6): a collision within t_c of a particle's previous one is "
+        "elastic, which prevents inelastic collapse.  0 turns it off.",
+        _contact_duration,
+        _same("contact_duration"),
+    ),
+)
+
+BY_NAME: dict[str, SceneParameter] = {p.name: p for p in PARAMETERS}
+NAMES: tuple[str, ...] = tuple(BY_NAME)
+# the Scene's attributes that hold parameters (the box's corners for the box)
+FIELDS: tuple[str, ...] = tuple(a for p in PARAMETERS for a in p.fields)
+
+# Scene(positions, velocities, radii, masses=1.0, *, box=1.0, ...), made from the declaration
+SIGNATURE = inspect.Signature(
+    [
+        inspect.Parameter(
+            p.name,
+            inspect.Parameter.POSITIONAL_OR_KEYWORD
+            if p.positional
+            else inspect.Parameter.KEYWORD_ONLY,
+            default=p.default,
+        )
+        for p in PARAMETERS
+    ]
+)
+
+
+def shape_of(parameter: SceneParameter, n: int, d: int) -> tuple[int, ...]:
+    """An array parameter's shape for N particles in d dimensions."""
+    assert parameter.shape is not None
+    return tuple(n if s == "N" else d for s in parameter.shape)
+
+
+def engine_keywords(scene: Any) -> dict[str, Any]:
+    """The scene as the C engine takes it: the keywords of ``_core.edmd_check`` and
+    ``_core.EDMD``, each parameter's own."""
+    keywords: dict[str, Any] = {}
+    for p in PARAMETERS:
+        keywords.update(p.engine(p.get(scene)))
+    return keywords
+
+
+def shape_text(parameter: SceneParameter) -> str:
+    """An array parameter's shape as the docs write it: (N, d), (N,)."""
+    assert parameter.shape is not None
+    return f"({', '.join(parameter.shape)}{',' if len(parameter.shape) == 1 else ''})"
+
+
+def docstring() -> str:
+    """The constructor's Parameters section, from the declaration."""
+    lines = ["Parameters", "----------"]
+    for p in PARAMETERS:
+        default = "" if p.default is REQUIRED else f", default {p.default!r}"
+        unit = f" [{p.unit}]" if p.unit and p.unit != "dimensionless" else ""
+        shape = f", shape {shape_text(p)}" if p.shape and p.positional else ""
+        lines.append(f"{p.name} : {p.type}{shape}{default}")
+        lines += textwrap.wrap(
+            f"{p.doc}{unit}", 84, initial_indent="    ", subsequent_indent="    "
+        )
+    return "\n".join(lines)

@@ -1,0 +1,119 @@
+"""Each Scene parameter is declared once (granular/_scene_params.py) and that declaration
+drives the Scene, the engine's arguments and the checkpoints: a parameter that exists in
+one of them but not in the others fails here."""
+
+import inspect
+
+import numpy as np
+import pytest
+
+from granular import Scene, Simulation, TabulatedRestitution, Viscoelastic, _core, _scene_params
+from granular._scene_params import NAMES, PARAMETERS, REQUIRED
+
+_ENGINE_KNOBS = {"cell_factor", "big_ratio", "shell"}  # Simulation's, not the scene's
+
+
+_INNER = (np.array([-1.0, 0.5]), np.array([1.5, 2.0]))
+_RADII = np.array([0.03, 0.05] * 6)
+
+
+def _examples():
+    """A value for every declared parameter, none its default: a walled 2D box off the
+    origin, unequal radii and masses, laws for the restitutions, the TC model on."""
+    base = Scene.random(12, _RADII, dim=2, box=_INNER, boundary="walls", seed=4)
+    return {
+        "positions": base.positions,
+        "velocities": base.velocities,
+        "radii": base.radii,
+        "masses": np.linspace(0.5, 2.0, 12),
+        "box": (_INNER[0] - 0.5, _INNER[1] + 0.5),
+        "boundary": "walls",
+        "wall_restitution": Viscoelastic.from_restitution(0.9, 1.0),
+        "restitution": TabulatedRestitution([0.0, 1.0, 3.0], [1.0, 0.9, 0.7]),
+        "contact_duration": 1e-3,
+    }
+
+
+def _alternative(name):
+    """Another valid value of parameter ``name`` beside the other examples: its default,
+    or for the particles and the box one that _examples' values fit."""
+    other = Scene.random(12, _RADII, dim=2, box=_INNER, boundary="walls", seed=5)
+    special = {
+        "positions": other.positions,
+        "velocities": np.zeros((12, 2)),
+        "radii": 0.8 * _RADII,
+        "box": _INNER,
+    }
+    return special[name] if name in special else _scene_params.BY_NAME[name].default
+
+
+def _same(a, b):
+    if isinstance(a, tuple):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, np.ndarray):
+        return np.array_equal(a, b)
+    return a == b
+
+
+def test_every_parameter_has_an_example_unlike_its_default():
+    examples = _examples()
+    assert set(examples) == set(NAMES), "give the new parameter an example value here"
+    for p in PARAMETERS:
+        assert p.default is REQUIRED or not _same(p.check(p.default, 12, 2), examples[p.name])
+
+
+def test_the_scene_is_its_declaration():
+    """Scene's constructor, its attributes and replace's fields are the declared ones."""
+    params = list(inspect.signature(Scene).parameters)
+    assert params == list(NAMES)
+    assert set(Scene.__annotations__) == set(_scene_params.FIELDS), (
+        "a Scene attribute that is not a declared parameter (or the reverse)"
+    )
+    for p in PARAMETERS:
+        assert f"{p.name} : " in Scene.__doc__
+
+
+def test_every_parameter_reaches_the_engine_by_name():
+    """The keywords the declaration gives the engine are exactly the scene's part of the
+    binding's keyword list (_core.EDMD_KEYWORDS: csrc/_core.c's edmd_names, whose numbers
+    come from csrc/scene_params.h), each parameter giving some; and the engine takes them
+    (edmd_check of a scene with every parameter set)."""
+    names = _core.EDMD_KEYWORDS
+    scene = Scene(**_examples())
+    given = {}
+    for p in PARAMETERS:
+        keywords = p.engine(p.get(scene))
+        assert keywords, f"{p.name} gives the engine nothing"
+        assert not set(keywords) & set(given), f"{p.name} gives a keyword twice"
+        given.update(keywords)
+    assert set(given) == set(names) - _ENGINE_KNOBS
+    assert list(given) == list(scene._engine_keywords())
+    assert _core.edmd_check(**given) is None
+    _core.EDMD(**given)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_parameter_goes_through_replace(name):
+    examples = _examples()
+    base = Scene(**{**examples, name: _alternative(name)})
+    p = _scene_params.BY_NAME[name]
+    assert not _same(p.get(base), p.check(examples[name], 12, 2))
+    changed = base.replace(**{name: examples[name]})
+    assert _same(p.get(changed), p.check(examples[name], 12, 2))
+
+
+def test_every_parameter_survives_a_checkpoint(tmp_path):
+    """A scene with every parameter set is saved and loaded with each one unchanged (the
+    initial scene and the state now), and the run goes on bit for bit."""
+    scene = Scene(**_examples())
+    sim = Simulation(scene)
+    sim.run(stop_when={"collisions_per_particle": 2}, store=())
+    sim.save(tmp_path / "c.npz")
+    loaded = Simulation.load(tmp_path / "c.npz")
+    for p in PARAMETERS:
+        assert _same(p.get(loaded._initial), p.get(scene)), p.name
+        if p.name not in ("positions", "velocities"):
+            assert _same(p.get(loaded.scene), p.get(scene)), p.name
+    a = sim.run(stop_when={"collisions_per_particle": 4}, store=("positions",))
+    b = loaded.run(stop_when={"collisions_per_particle": 4}, store=("positions",))
+    assert np.array_equal(a.positions, b.positions)
