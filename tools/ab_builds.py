@@ -7,7 +7,7 @@ same module name, from their own files), builds one engine from each with the sa
 equilibrated scene, and runs them in windows of a fixed number of events, A B B A A B ...,
 timing each window by the CPU time of this thread (the engines run on it). It prints the
 median, quartiles and range of the per-pair ratio A / B, and whether both engines did the
-same events (their counters after all windows).
+same events (their event counts after all windows).
 
 A build is a folder holding an importable `granular` with its compiled `_core`, e.g.
 
@@ -99,7 +99,10 @@ def main():
         ratios.append(seconds[0] / seconds[1])
     r = np.array(ratios)
     q1, q3 = np.percentile(r, [25, 75])
-    same = engines[0].counters() == engines[1].counters()
+    # the event counts; float sums can differ in their last bits between builds (the energy
+    # total is re-summed from the velocities now and then since the kinetic-energy stop fix)
+    counts = [{k: v for k, v in e.counters().items() if isinstance(v, int)} for e in engines]
+    same = counts[0] == counts[1]
     print(
         f"N = {args.n}, packing {args.eta}, shell {shell}: A / B, thread CPU time per window of "
         f"{args.window} events, {args.pairs} pairs: median {np.median(r):.3f} (quartiles "
