@@ -30,8 +30,17 @@ The exact float64 (and int64) values granular reads back live in the log section
 - every frame: ``log/granular/time`` (the real sample time), ``log/granular/unwrapped_positions``
   and ``log/granular/velocities`` (float64, (N, d)), and the counters ``kinetic_energy``,
   ``momentum``, ``pair_collisions``, ``wall_collisions``, ``virial``, ``wall_impulse``
-- frame 0: the scene's ``lower``, ``upper``, ``radii``, ``masses`` (float64), ``boundary`` and
-  ``stop_reason`` (as UTF-8 bytes), and ``format`` (this layout's version)
+- frame 0: ``stop_reason`` (UTF-8 bytes), ``format`` (this layout's version), and every
+  parameter of the run's scene but the positions and velocities (``_scene_params``'s
+  ``RUN_PARAMETERS``), each attribute the Scene keeps it in under its own name: ``lower``,
+  ``upper``, ``radii``, ``masses``, ``boundary``, ``wall_restitution``, ``restitution``,
+  ``contact_duration``, ... .  Arrays and numbers are float64 (a number of shape (1,)), a
+  string UTF-8 bytes, a restitution law the UTF-8 bytes of its JSON description
+  (``restitution.describe``, as checkpoints store it).  They are written and read by
+  iterating the declaration, each read back through its declared check: a parameter
+  declared later needs no change here, and a file without it (written before) reads with
+  its default.  Layout 1 from the start: the parameters after ``boundary`` were added
+  beside the fields earlier readers read, and they read these files still.
 
 (gsd >= 4 can write the HOOMD fields in float64, but OVITO and older gsd and HOOMD read
 float32 ones: the standard fields stay float32 and the exact values go in the log.)
@@ -69,6 +78,9 @@ _COUNTERS = (
     "wall_impulse",
 )
 _INT_COUNTERS = ("pair_collisions", "wall_collisions")
+# the log's own names beside the scene parameters' (which may not take one of them:
+# tests/test_scene_params.py checks)
+LOG_NAMES = ("format", "stop_reason", "time", "unwrapped_positions", "velocities", *_COUNTERS)
 
 
 def _gsd():
@@ -497,8 +509,8 @@ def scene_from_gsd(path: str | os.PathLike, frame: int, make_scene: Any, **param
     make_scene : type
         The Scene class (``Scene.from_gsd`` passes it).
     **params
-        Scene parameters to set (``Scene.replace``): those a trajectory does not record,
-        such as the restitutions; the boundary of a foreign file.
+        Scene parameters to set (``Scene.replace``): those a foreign file does not hold
+        (its boundary, restitutions), or changes to the run's.
 
     Raises
     ------

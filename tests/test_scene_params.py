@@ -164,3 +164,11 @@ def test_a_parameter_the_gsd_writer_skips_is_caught(tmp_path, monkeypatch, name)
     except granular.errors.GSDFileError:
         return
     assert name in differ
+
+
+def test_no_parameter_takes_a_name_the_gsd_log_uses_for_its_own():
+    # a GSD file logs each parameter's attributes by name beside its own fields
+    from granular import gsd_io
+
+    fields = {a for p in _scene_params.RUN_PARAMETERS for a in p.fields}
+    assert not fields & set(gsd_io.LOG_NAMES)
