@@ -332,6 +332,10 @@ PARAMETERS: tuple[SceneParameter, ...] = (
 )
 
 BY_NAME: dict[str, SceneParameter] = {p.name: p for p in PARAMETERS}
+# what a trajectory samples; the other parameters are the run's, the same at every sample
+# (a Trajectory and a GSD file keep them once)
+SAMPLED: tuple[str, ...] = ("positions", "velocities")
+RUN_PARAMETERS: tuple[SceneParameter, ...] = tuple(p for p in PARAMETERS if p.name not in SAMPLED)
 NAMES: tuple[str, ...] = tuple(BY_NAME)
 # the Scene's attributes that hold parameters (the box's corners for the box)
 FIELDS: tuple[str, ...] = tuple(a for p in PARAMETERS for a in p.fields)
@@ -355,6 +359,12 @@ def shape_of(parameter: SceneParameter, n: int, d: int) -> tuple[int, ...]:
     """An array parameter's shape for N particles in d dimensions."""
     assert parameter.shape is not None
     return tuple(n if s == "N" else d for s in parameter.shape)
+
+
+def split(parameter: SceneParameter, kept: Any) -> dict[str, Any]:
+    """A kept value as the Scene's attributes that hold it: ``{"lower": .., "upper": ..}``
+    for the box, ``{name: kept}`` for the others."""
+    return dict(zip(parameter.fields, kept if parameter.attributes else (kept,), strict=True))
 
 
 def engine_keywords(scene: Any) -> dict[str, Any]:

@@ -30,8 +30,17 @@ The exact float64 (and int64) values granular reads back live in the log section
 - every frame: ``log/granular/time`` (the real sample time), ``log/granular/unwrapped_positions``
   and ``log/granular/velocities`` (float64, (N, d)), and the counters ``kinetic_energy``,
   ``momentum``, ``pair_collisions``, ``wall_collisions``, ``virial``, ``wall_impulse``
-- frame 0: the scene's ``lower``, ``upper``, ``radii``, ``masses`` (float64), ``boundary`` and
-  ``stop_reason`` (as UTF-8 bytes), and ``format`` (this layout's version)
+- frame 0: ``stop_reason`` (UTF-8 bytes), ``format`` (this layout's version), and every
+  parameter of the run's scene but the positions and velocities (``_scene_params``'s
+  ``RUN_PARAMETERS``), each attribute the Scene keeps it in under its own name: ``lower``,
+  ``upper``, ``radii``, ``masses``, ``boundary``, ``wall_restitution``, ``restitution``,
+  ``contact_duration``, ... .  Arrays and numbers are float64 (a number of shape (1,)), a
+  string UTF-8 bytes, a restitution law the UTF-8 bytes of its JSON description
+  (``restitution.describe``, as checkpoints store it).  They are written and read by
+  iterating the declaration, each read back through its declared check: a parameter
+  declared later needs no change here, and a file without it (written before) reads with
+  its default.  Layout 1 from the start: the parameters after ``boundary`` were added
+  beside the fields earlier readers read, and they read these files still.
 
 (gsd >= 4 can write the HOOMD fields in float64, but OVITO and older gsd and HOOMD read
 float32 ones: the standard fields stay float32 and the exact values go in the log.)
@@ -44,6 +53,7 @@ and its writers.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import secrets
 import stat
@@ -53,8 +63,10 @@ from typing import Any
 import numpy as np
 
 from ._files import check_kind
+from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, split
 from .errors import GSDFileError
 from .interop import box_lengths_3d
+from .restitution import RestitutionLaw, describe, from_description
 
 FORMAT = 1  # the version of the log layout above
 _COUNTERS = (
@@ -66,6 +78,9 @@ _COUNTERS = (
     "wall_impulse",
 )
 _INT_COUNTERS = ("pair_collisions", "wall_collisions")
+# the log's own names beside the scene parameters' (which may not take one of them:
+# tests/test_scene_params.py checks)
+LOG_NAMES = ("format", "stop_reason", "time", "unwrapped_positions", "velocities", *_COUNTERS)
 
 
 def _gsd():
@@ -94,6 +109,17 @@ def _check_suffix(path: str | os.PathLike) -> Path:
 
 def _text(value: str) -> np.ndarray:
     return np.frombuffer(value.encode("utf-8"), dtype=np.uint8).copy()
+
+
+def _encode(value: Any) -> np.ndarray:
+    """A scene parameter's value as a log chunk: an array or a number as float64 (a number
+    of shape (1,)), a string as its UTF-8 bytes, a restitution law as the UTF-8 bytes of
+    its JSON description (``restitution.describe``, as checkpoints store it)."""
+    if isinstance(value, str):
+        return _text(value)
+    if isinstance(value, RestitutionLaw):
+        return _text(json.dumps(describe(value)))
+    return np.atleast_1d(np.asarray(value, dtype=np.float64))
 
 
 def _wrap(
@@ -159,17 +185,12 @@ def _frame(hoomd, traj, k, lower, upper):
         dtype = np.int64 if name in _INT_COUNTERS else np.float64
         log[f"granular/{name}"] = np.atleast_1d(np.asarray(getattr(traj, name)[k], dtype))
     if k == 0:
-        log.update(
-            {
-                "granular/format": np.array([FORMAT], dtype=np.int64),
-                "granular/lower": lower,
-                "granular/upper": upper,
-                "granular/radii": np.asarray(traj.radii, dtype=np.float64),
-                "granular/masses": np.asarray(traj.masses, dtype=np.float64),
-                "granular/boundary": _text(traj.boundary),
-                "granular/stop_reason": _text(traj.stop_reason),
-            }
-        )
+        log["granular/format"] = np.array([FORMAT], dtype=np.int64)
+        log["granular/stop_reason"] = _text(traj.stop_reason)
+        params = traj.scene_parameters
+        for p in RUN_PARAMETERS:
+            for field, value in split(p, params[p.name]).items():
+                log[f"granular/{field}"] = _encode(value)
     frame.log = log
     return frame
 
@@ -310,17 +331,21 @@ def _log(name: str) -> str:
     return f"log/granular/{name}"
 
 
-def _params(f: _File) -> dict[str, Any]:
-    """The scene's fields from frame 0 of a file granular wrote."""
+def _params(f: _File) -> tuple[dict[str, Any], str]:
+    """The run's scene parameters (``{name: value as the Scene keeps it}``) and the stop
+    reason, from frame 0 of a file granular wrote; each parameter checked by its declared
+    check (GSDFileError naming the field).  A parameter the file lacks, from a granular
+    that did not declare it yet, has its default (what that granular's runs used)."""
     if not f.has(0, _log("format")):
         raise GSDFileError(
             f"{f.where} was not written by granular (no log/granular/format); read it "
             "with gsd.hoomd.open, or take one frame with Scene.from_gsd"
         )
     version = int(f.array(0, _log("format"), (1,), integer=True)[0])
-    if version != FORMAT:
+    if not 1 <= version <= FORMAT:
         raise GSDFileError(
-            f"{f.where} has granular GSD layout {version}, this version reads {FORMAT}"
+            f"{f.where} has granular GSD layout {version}, this version reads layouts 1 to "
+            f"{FORMAT}" + (": it was written by a newer granular" if version > FORMAT else "")
         )
     # the particles and dimensions are those of frame 0's positions; every other array must
     # agree with them
@@ -330,46 +355,68 @@ def _params(f: _File) -> dict[str, Any]:
             0, _log("unwrapped_positions"), f"has shape {x0.shape}, expected (N, 2) or (N, 3)"
         )
     n, d = x0.shape
-    return dict(
-        lower=f.array(0, _log("lower"), (d,)),
-        upper=f.array(0, _log("upper"), (d,)),
-        radii=f.array(0, _log("radii"), (n,)),
-        masses=f.array(0, _log("masses"), (n,)),
-        boundary=f.text(0, _log("boundary")),
-        stop_reason=f.text(0, _log("stop_reason")),
-    )
+    params: dict[str, Any] = {}
+    for p in RUN_PARAMETERS:
+        names = [_log(field) for field in p.fields]
+        if p.default is not REQUIRED and not any(f.has(0, name) for name in names):
+            params[p.name] = p.check(p.default, n, d)
+            continue
+        if p.is_array:
+            parts = tuple(f.array(0, name, shape_of(p, n, d)) for name in names)
+            value = parts if p.attributes else parts[0]
+        else:
+            value = _decode(f, names[0], p.default)
+        try:
+            params[p.name] = p.check(value, n, d)
+        except (ValueError, TypeError, OverflowError) as exc:
+            raise f.error(0, " and ".join(names), f"is not a valid {p.name}: {exc}") from exc
+    return params, f.text(0, _log("stop_reason"))
+
+
+def _decode(f: _File, name: str, default: Any) -> Any:
+    """A parameter that is not an array, as ``_encode`` wrote it in frame 0: a number
+    (float64 of shape (1,)), a string or a restitution law's JSON description (text)."""
+    a = f.raw(0, name)
+    if not isinstance(default, str) and not (a.dtype.kind in "iu" and a.dtype.itemsize == 1):
+        return f.array(0, name, (1,))[0]  # not text: a number
+    text = f.text(0, name)
+    if not text.startswith("{"):
+        if not isinstance(default, str):
+            raise f.error(0, name, f"is the text {text[:40]!r}, not a number or a law")
+        return text
+    try:
+        return from_description(json.loads(text))
+    except (ValueError, TypeError, RecursionError) as exc:
+        raise f.error(0, name, f"is not a restitution law's description ({exc})") from exc
 
 
 def _wrap_checked(f: _File, k: int, x: np.ndarray, p: dict[str, Any]) -> np.ndarray:
     """Unwrapped positions of frame ``k`` wrapped into a periodic box (as they are in a
-    walled one).  Positions or a box that are not finite are left for Scene to refuse (it
-    names what is wrong); positions so far out that float64 cannot wrap them are refused."""
+    walled one).  Positions that are not finite are left for Scene to refuse (it names
+    what is wrong); positions so far out that float64 cannot wrap them are refused."""
+    lower, upper = p["box"]
     with np.errstate(all="ignore"):
-        lengths = p["upper"] - p["lower"]
-        sound = np.all(np.isfinite(x)) and np.all(np.isfinite(lengths)) and np.all(lengths > 0)
-        if p["boundary"] != "periodic" or not sound:
+        if p["boundary"] != "periodic" or not np.all(np.isfinite(x)):
             return x  # Scene refuses what is not sound, and says why
-        boxes = np.max(np.abs((x - p["lower"]) / lengths))
+        boxes = np.max(np.abs((x - lower) / (upper - lower)))
     if not boxes < 2.0**53:
         raise f.error(
             k,
             _log("unwrapped_positions"),
             f"reaches {boxes:.3g} box lengths from the box: float64 cannot wrap it back",
         )
-    return _wrap(x, p["lower"], p["upper"], True)[0]
+    return _wrap(x, lower, upper, True)[0]
 
 
 def _scene(
     f: _File, k: int, x: np.ndarray, v: np.ndarray, p: dict[str, Any], make_scene: Any
 ) -> Any:
-    """Frame ``k``'s state as a Scene (``make_scene``: the Scene class), which checks it as
-    every scene is checked (finite, positive radii and masses, the box, the scales, inside
+    """Frame ``k``'s state as a Scene (``make_scene``: the Scene class) with the run's
+    parameters ``p``, which checks it as every scene is checked (finite, the scales, inside
     the box, no overlaps)."""
     x = _wrap_checked(f, k, x, p)
     try:
-        return make_scene(
-            x, v, p["radii"], p["masses"], box=(p["lower"], p["upper"]), boundary=p["boundary"]
-        )
+        return make_scene(x, v, **p)
     except (ValueError, TypeError) as exc:
         raise GSDFileError(f"{f.where}, frame {k}: not a valid state: {exc}") from exc
 
@@ -382,8 +429,8 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
     with _File(path) as f:
         if f.frames == 0:
             raise GSDFileError(f"{f.where} holds no frames")
-        p = _params(f)
-        n, d = len(p["radii"]), len(p["lower"])
+        p, stop_reason = _params(f)
+        n, d = len(p["radii"]), len(p["box"][0])
         has_v = f.has(0, _log("velocities"))
         still = np.zeros((n, d))
         times: list[float] = []
@@ -421,7 +468,16 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
         np.array(positions).reshape(len(times), n, d),
         np.array(velocities).reshape(len(times), n, d) if has_v else None,
         **arrays,
-        **p,
+        # the scene's fields the Trajectory keeps as its own (radii, masses, the box's
+        # corners, the boundary: the same rule as Trajectory's), and all of its parameters
+        **{
+            field: value
+            for q in RUN_PARAMETERS
+            for field, value in split(q, p[q.name]).items()
+            if field in make_trajectory.__annotations__
+        },
+        stop_reason=stop_reason,
+        parameters=p,
     )
 
 
@@ -453,8 +509,8 @@ def scene_from_gsd(path: str | os.PathLike, frame: int, make_scene: Any, **param
     make_scene : type
         The Scene class (``Scene.from_gsd`` passes it).
     **params
-        Scene parameters to set (``Scene.replace``): those a trajectory does not record,
-        such as the restitutions; the boundary of a foreign file.
+        Scene parameters to set (``Scene.replace``): those a foreign file does not hold
+        (its boundary, restitutions), or changes to the run's.
 
     Raises
     ------
@@ -469,8 +525,8 @@ def scene_from_gsd(path: str | os.PathLike, frame: int, make_scene: Any, **param
             raise IndexError(f"frame {frame} out of range: {f.where} holds {count} frames")
         k = frame % count
         if f.has(0, _log("format")):
-            p = _params(f)
-            n, d = len(p["radii"]), len(p["lower"])
+            p, _ = _params(f)
+            n, d = len(p["radii"]), len(p["box"][0])
             x = f.array(k, _log("unwrapped_positions"), (n, d))
             v = np.zeros((n, d))
             if f.has(k, _log("velocities")):

@@ -260,10 +260,10 @@ class Scene:
     @classmethod
     def from_gsd(cls, path: str | os.PathLike, frame: int = -1, **params: Any) -> Scene:
         """The scene at one frame (default the last) of a GSD file: exact float64 positions
-        (wrapped into the box), velocities, radii, masses and box when granular wrote it
-        (``Trajectory.write``), else from the float32 HOOMD fields.  ``params`` are Scene
-        parameters to set (as ``replace`` does): those a trajectory does not record, such
-        as the restitutions."""
+        (wrapped into the box), velocities and every other parameter of the run's scene
+        (restitutions, ...) when granular wrote it (``Trajectory.write``), else from the
+        float32 HOOMD fields.  ``params`` are Scene parameters to set (as ``replace``
+        does): the boundary of a foreign file, say."""
         return gsd_io.scene_from_gsd(path, frame, cls, **params)
 
     @classmethod

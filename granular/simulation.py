@@ -15,6 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core, _edmd, checkpoint
 from . import restitution as _restitution
 from ._edmd import check_memory as _check_memory
+from ._scene_params import RUN_PARAMETERS
 from .errors import (
     ClusteringWarning,
     FrozenGasError,
@@ -527,6 +528,7 @@ class Simulation:
             upper=s.upper,
             boundary=s.boundary,
             stop_reason=reason,
+            parameters={p.name: p.get(s) for p in RUN_PARAMETERS},
         )
 
 

@@ -10,6 +10,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import gsd_io
 from ._results import readonly
+from ._scene_params import RUN_PARAMETERS
 from .scene import Scene
 
 
@@ -44,6 +45,9 @@ class Trajectory:
         "idle" (no event will ever happen); a run cut short carries the samples so far in
         its exception's ``.trajectory``, with "error" or, after Ctrl-C, "interrupted"
     masses, radii, lower, upper, boundary : copied from the scene
+    scene_parameters : dict, the run's scene's parameters other than the positions and
+        velocities (radii, masses, box, boundary, restitutions, contact_duration, ...), as
+        the Scene keeps them (the box as its corners (lower, upper))
     temperature : (T,) granular temperature, an energy
     tamsd_lags : (T - 1,) the lags of ``tamsd()`` by default
     """
@@ -64,6 +68,7 @@ class Trajectory:
     upper: NDArray[np.float64]
     boundary: str
     stop_reason: str
+    _parameters: tuple[tuple[str, Any], ...]  # scene_parameters, a tuple: read-only
 
     def __init__(
         self,
@@ -83,6 +88,7 @@ class Trajectory:
         upper: NDArray[np.float64],
         boundary: str,
         stop_reason: str,
+        parameters: dict[str, Any] | None = None,
     ) -> None:
         # read-only views: a caller writing into an array the trajectory hands out gets a
         # ValueError instead of changing the trajectory unseen
@@ -105,6 +111,31 @@ class Trajectory:
         )
         for name, value in fields.items():
             object.__setattr__(self, name, readonly(value))
+        object.__setattr__(self, "_parameters", self._run_parameters(parameters or {}))
+
+    def _run_parameters(self, given: dict[str, Any]) -> tuple[tuple[str, Any], ...]:
+        """The scene's run parameters (see ``scene_parameters``): those the trajectory's own
+        fields hold (radii, masses, the box, the boundary) from them, the others from
+        ``given`` (checked as a Scene checks them) or their defaults (a trajectory made by
+        hand)."""
+        held = [p for p in RUN_PARAMETERS if all(a in type(self).__annotations__ for a in p.fields)]
+        others = {p.name: p for p in RUN_PARAMETERS if p not in held}
+        unknown = set(given) - set(others) - {p.name for p in held}
+        if unknown:
+            raise TypeError(
+                f"unknown scene parameters {sorted(unknown)}; a trajectory keeps {sorted(others)}"
+            )
+        n, d = len(self.masses), len(self.lower)
+        values = {p.name: p.get(self) for p in held}
+        for name, p in others.items():
+            values[name] = p.check(given.get(name, p.default), n, d)
+        return tuple((p.name, values[p.name]) for p in RUN_PARAMETERS)
+
+    @property
+    def scene_parameters(self) -> dict[str, Any]:
+        """The run's scene's parameters other than the positions and velocities, as the
+        Scene keeps them: ``scene.replace(**traj.scene_parameters)`` has them all."""
+        return dict(self._parameters)
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError(

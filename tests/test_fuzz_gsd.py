@@ -30,11 +30,22 @@ LOG = "log/granular/"
 
 
 def _bases(folder):
-    """Three small sound files: granular's 2D walls with velocities and 3D periodic without,
-    and one granular did not write."""
+    """Three small sound files: granular's 2D walls with velocities (and every scene
+    parameter set: a restitution law, the TC model) and 3D periodic without, and one
+    granular did not write."""
     import granular
 
-    walls = granular.Scene.random(6, 0.05, dim=2, boundary="walls", restitution=0.9, seed=1)
+    law = granular.TabulatedRestitution([0.0, 1.0, 3.0], [1.0, 0.9, 0.7])  # JSON in the file
+    walls = granular.Scene.random(
+        6,
+        0.05,
+        dim=2,
+        boundary="walls",
+        restitution=0.9,
+        wall_restitution=law,
+        contact_duration=1e-3,
+        seed=1,
+    )
     a = granular.Simulation(walls).run(t_stop=0.5, sample_times=[0.0, 0.2, 0.5])
     gas = granular.Scene.random(5, 0.05, dim=3, seed=2)
     b = granular.Simulation(gas).run(t_stop=1.0, sample_times=[0.0, 0.5, 1.0], store=("positions",))

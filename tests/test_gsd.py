@@ -308,6 +308,10 @@ def _set(frame, name, value):
     return change
 
 
+def _bytes(text):
+    return np.frombuffer(text.encode(), np.uint8).copy()
+
+
 def _item(index, value):
     def set_item(data):
         data[index] = value
@@ -347,7 +351,20 @@ BAD = {
     "count down": (_set(3, "pair_collisions", np.array([0], np.int64)), 3, "never decreases"),
     "count float": (_set(1, "wall_collisions", np.array([0.5])), 1, "not integers"),
     "counter nan": (_set(2, "kinetic_energy", np.array([np.nan])), 2, "NaN or infinity"),
-    "format": (_set(0, "format", np.array([7], np.int64)), None, "layout 7"),
+    "format": (_set(0, "format", np.array([7], np.int64)), None, "layout 7.*newer granular"),
+    "format 0": (_set(0, "format", np.array([0], np.int64)), None, "layout 0, .* 1 to"),
+    "restitution range": (_set(0, "restitution", np.array([1.5])), 0, r"restitution must lie"),
+    "restitution text": (_set(0, "restitution", _bytes("0.5")), 0, "not a number or a law"),
+    "restitution shape": (_set(0, "restitution", np.ones(2)), 0, r"restitution has shape"),
+    "unknown law": (_set(0, "restitution", _bytes('{"law": "Magic"}')), 0, "unknown .* 'Magic'"),
+    "broken law": (_set(0, "restitution", _bytes('{"law": ')), 0, "not a restitution law's"),
+    "law arguments": (
+        _set(0, "restitution", _bytes('{"law": "Viscoelastic", "speed": 1}')),
+        0,
+        "restitution is not a restitution law's description",
+    ),
+    "wall restitution": (_set(0, "wall_restitution", np.array([-1.0])), 0, "wall_restitution"),
+    "contact nan": (_set(0, "contact_duration", np.array([np.nan])), 0, "contact_duration must"),
     "not granular": (_set(0, "format", None), None, "not written by granular"),
 }
 
@@ -459,3 +476,40 @@ def test_a_damaged_file_is_a_gsd_file_error(tmp_path):
     for name in ("cut.gsd", "text.gsd", "empty.gsd"):
         with pytest.raises(granular.errors.GSDFileError, match=name):
             granular.read(tmp_path / name)
+
+
+def test_the_scene_parameters_keep_the_fields_older_readers_read(tmp_path):
+    """Frame 0 keeps the layout-1 fields as they were (the box's corners, radii and masses
+    in float64, the boundary as UTF-8 text), so an older granular still reads the file
+    (without the parameters it did not know); the restitution, a number, as float64."""
+    _, tr = run_2d_walled()
+    tr.write(tmp_path / "run.gsd")
+    with gsd.fl.open(str(tmp_path / "run.gsd"), "r") as f:
+        assert f.read_chunk(0, LOG + "format").tolist() == [1]
+        for name in ("lower", "upper", "radii", "masses"):
+            a = f.read_chunk(0, LOG + name)
+            assert a.dtype == np.float64
+            np.testing.assert_array_equal(a, getattr(tr, name))
+        assert bytes(f.read_chunk(0, LOG + "boundary")) == b"walls"
+        assert f.read_chunk(0, LOG + "restitution").tolist() == [0.9]
+        assert f.read_chunk(0, LOG + "contact_duration").tolist() == [0.0]
+        assert not f.chunk_exists(1, LOG + "restitution")  # the run's: frame 0 only
+
+
+def test_a_file_without_the_newer_parameters_reads_with_their_defaults(tmp_path):
+    # a file written before granular recorded the restitutions and the TC model: they take
+    # their defaults, and Scene.from_gsd sets them as before
+    _, tr = run_2d_walled()
+    tr.write(tmp_path / "run.gsd")
+    newer = ("restitution", "wall_restitution", "contact_duration")
+
+    def drop(k, name, data):
+        return None if name in [LOG + n for n in newer] else data
+
+    old = copy_chunks(tmp_path / "run.gsd", tmp_path / "old.gsd", drop)
+    assert Scene.from_gsd(old).restitution == 1.0
+    assert Scene.from_gsd(old, restitution=0.9).restitution == 0.9
+    back = granular.read(old)
+    assert back.scene_parameters["restitution"] == 1.0
+    np.testing.assert_array_equal(back.positions, tr.positions)
+    assert Scene.from_gsd(tmp_path / "run.gsd").restitution == 0.9

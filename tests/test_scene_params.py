@@ -1,5 +1,5 @@
 """Each Scene parameter is declared once (granular/_scene_params.py) and that declaration
-drives the Scene, the engine's arguments and the checkpoints: a parameter that exists in
+drives the Scene, the engine's arguments, the checkpoints and GSD files: a parameter that exists in
 one of them but not in the others fails here."""
 
 import inspect
@@ -7,8 +7,9 @@ import inspect
 import numpy as np
 import pytest
 
+import granular
 from granular import Scene, Simulation, TabulatedRestitution, Viscoelastic, _core, _scene_params
-from granular._scene_params import NAMES, PARAMETERS, REQUIRED
+from granular._scene_params import BY_NAME, NAMES, PARAMETERS, REQUIRED
 
 _ENGINE_KNOBS = {"cell_factor", "big_ratio", "shell"}  # Simulation's, not the scene's
 
@@ -117,3 +118,57 @@ def test_every_parameter_survives_a_checkpoint(tmp_path):
     a = sim.run(stop_when={"collisions_per_particle": 4}, store=("positions",))
     b = loaded.run(stop_when={"collisions_per_particle": 4}, store=("positions",))
     assert np.array_equal(a.positions, b.positions)
+
+
+def _gsd_round_trip(tmp_path, writer=None):
+    """A run of a scene with every parameter set, written to a GSD file (by ``writer``,
+    else ``Trajectory.write``): the parameters whose value ``Scene.from_gsd`` (of the last
+    frame) or ``granular.read`` gives back differs from the run's, and those read keeps."""
+    scene = Scene(**_examples())
+    sim = Simulation(scene)
+    traj = sim.run(t_stop=0.05, sample_times=[0.0, 0.05], store=("positions", "velocities"))
+    (writer or type(traj).write)(traj, tmp_path / "run.gsd")
+    back = Scene.from_gsd(tmp_path / "run.gsd")
+    read = granular.read(tmp_path / "run.gsd").scene_parameters
+    now = scene.replace(positions=traj.positions[-1], velocities=traj.velocities[-1])
+    differ = [p.name for p in PARAMETERS if not _same(p.get(back), p.get(now))]
+    differ += [f"read {n}" for n in read if not _same(read[n], BY_NAME[n].get(scene))]
+    return differ, set(read)
+
+
+def test_every_parameter_survives_a_gsd_file(tmp_path):
+    """Scene.from_gsd of a file a run wrote is the run's scene at that frame, every
+    parameter (restitution laws, the TC model, ...) included, and granular.read's
+    Trajectory keeps them all."""
+    differ, kept = _gsd_round_trip(tmp_path)
+    assert not differ
+    assert kept == set(NAMES) - set(_scene_params.SAMPLED)
+
+
+@pytest.mark.parametrize("name", [p.name for p in _scene_params.RUN_PARAMETERS])
+def test_a_parameter_the_gsd_writer_skips_is_caught(tmp_path, monkeypatch, name):
+    """The round trip above fails if the writer leaves a parameter out: the file is
+    refused (a required one, or the box its particles no longer fit) or read with the
+    parameter's default, unlike the run's."""
+    from granular import gsd_io
+
+    skipped = tuple(p for p in gsd_io.RUN_PARAMETERS if p.name != name)
+
+    def write(traj, path):
+        with monkeypatch.context() as m:
+            m.setattr(gsd_io, "RUN_PARAMETERS", skipped)
+            traj.write(path)
+
+    try:
+        differ, _ = _gsd_round_trip(tmp_path, write)
+    except granular.errors.GSDFileError:
+        return
+    assert name in differ
+
+
+def test_no_parameter_takes_a_name_the_gsd_log_uses_for_its_own():
+    # a GSD file logs each parameter's attributes by name beside its own fields
+    from granular import gsd_io
+
+    fields = {a for p in _scene_params.RUN_PARAMETERS for a in p.fields}
+    assert not fields & set(gsd_io.LOG_NAMES)
