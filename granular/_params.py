@@ -25,6 +25,7 @@ from typing import Any, TypeVar, cast
 import numpy as np
 
 from ._deprecation import deprecated
+from .errors import shown
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -112,17 +113,6 @@ QUANTITIES: dict[str, Quantity] = {
 }
 
 
-def _number(value: Any) -> str:
-    """A number as a user writes it (no NumPy repr)."""
-    if isinstance(value, (bool, np.bool_)):
-        return str(bool(value))
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    if isinstance(value, (float, np.floating)):
-        return repr(float(value))
-    return "..." if np.ndim(value) else repr(value)
-
-
 _RULES = {
     "positive": (lambda x: (x > 0) & np.isfinite(x), "must be positive and finite"),
     "positive_or_inf": (lambda x: x > 0, "must be positive (inf allowed)"),
@@ -142,7 +132,7 @@ def check(name: str, value: Any) -> None:
         return
     if rule == "dim":
         if value not in (2, 3) or isinstance(value, bool):
-            raise ValueError(f"dim must be 2 or 3, got {_number(value)}")
+            raise ValueError(f"dim must be 2 or 3, got {shown(value)}")
         return
     try:
         x = np.asarray(value, dtype=np.float64)
@@ -159,7 +149,7 @@ def check(name: str, value: Any) -> None:
         bad = x[~good].flat[0] if x.ndim else x[()]
         where = "" if x.ndim == 0 else " in the array"
         raise ValueError(
-            f"{name} {says}, got {_number(bad)}{where} ({name}: {QUANTITIES[name].meaning})"
+            f"{name} {says}, got {shown(bad)}{where} ({name}: {QUANTITIES[name].meaning})"
         )
 
 
@@ -194,9 +184,11 @@ def keyword_only(
             old_keywords = renamed.keys() & kwargs.keys()
             if len(args) > len(positional) or old_keywords:
                 if len(args) > len(old_order):
+                    which = f"all but {', '.join(positional)}" if positional else "them"
                     raise TypeError(
-                        f"{func.__name__}() takes {len(positional)} positional argument(s) "
-                        f"but {len(args)} were given"
+                        f"{func.__name__}() takes at most {len(old_order)} positional "
+                        f"arguments (deprecated: pass {which} by keyword) but {len(args)} "
+                        f"were given"
                     )
                 moved = dict(zip(new_old[len(positional) :], args[len(positional) :], strict=False))
                 for old in old_keywords:
@@ -210,7 +202,10 @@ def keyword_only(
                 kwargs = {**moved, **kwargs}
                 _warn(wrapper, args, kwargs, moved, old_keywords, renamed)
             if validate:
-                bound = sig.bind(*args, **kwargs)
+                try:
+                    bound = sig.bind(*args, **kwargs)
+                except TypeError as exc:  # bind's message names no function
+                    raise TypeError(f"{func.__name__}() {exc}") from None
                 for name, value in bound.arguments.items():
                     check(name, value)
             return func(*args, **kwargs)
@@ -226,8 +221,8 @@ def keyword_only(
 
 def _warn(wrapper, args, kwargs, moved, old_keywords, renamed):
     name = f"{wrapper.__module__}.{wrapper.__name__}"
-    shown = [_number(a) if np.ndim(a) == 0 else "..." for a in args]
-    shown += [f"{k}={_number(v) if np.ndim(v) == 0 else '...'}" for k, v in kwargs.items()]
+    written = [shown(a) if np.ndim(a) == 0 else "..." for a in args]
+    written += [f"{k}={shown(v) if np.ndim(v) == 0 else '...'}" for k, v in kwargs.items()]
     what = []
     if moved:
         what.append("passing " + ", ".join(moved) + " by position")
@@ -235,7 +230,7 @@ def _warn(wrapper, args, kwargs, moved, old_keywords, renamed):
         what.append(
             "the keyword(s) " + ", ".join(f"{k}= (now {renamed[k]}=)" for k in old_keywords)
         )
-    deprecated(f"{name}: {' and '.join(what)}", f"call {name}({', '.join(shown)})", stacklevel=4)
+    deprecated(f"{name}: {' and '.join(what)}", f"call {name}({', '.join(written)})", stacklevel=4)
 
 
 def parameters_section(func: Callable[..., Any]) -> str:
