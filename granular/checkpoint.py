@@ -162,6 +162,8 @@ def load(path: str | os.PathLike, make: Callable[..., _S]) -> _S:
     where = repr(os.fspath(path))
     try:
         f = open(path, "rb")  # closed by the with below, after the checks on it
+    except (FileNotFoundError, PermissionError):
+        raise  # as open() and granular.read say it: not a fault of the file's content
     except OSError as exc:
         raise CheckpointError(f"cannot read the checkpoint {where}: {exc}") from exc
     with f:

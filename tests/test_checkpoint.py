@@ -349,8 +349,13 @@ def test_truncated_corrupt_and_foreign_files_are_refused(saved, tmp_path):
     np.savez(other, meta=np.array(json.dumps({"format": "something else"})))
     with pytest.raises(CheckpointError, match="not a granular checkpoint"):
         Simulation.load(other)
-    with pytest.raises(CheckpointError, match="cannot read"):
+    # a missing or unreadable file is the OSError open() gives, as granular.read does
+    with pytest.raises(FileNotFoundError):
         Simulation.load(tmp_path / "missing.ckpt")
+    with pytest.raises(FileNotFoundError):
+        granular.read(tmp_path / "missing.gsd")
+    with pytest.raises(CheckpointError, match="cannot read"):
+        Simulation.load(tmp_path)  # a directory
     with zipfile.ZipFile(tmp_path / "empty.npz", "w"):
         pass
     with pytest.raises(CheckpointError):
