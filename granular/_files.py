@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import secrets
+from typing import IO
 
 # The first bytes of each kind of file: a zip archive (an .npz, and so a checkpoint or an
 # ensemble's run file), a single .npy array, a GSD file (its magic number 0x65DF65DF65DF65DF,
@@ -43,29 +44,43 @@ def kind_of(head: bytes) -> str | None:
     return None
 
 
-def check_kind(path: str | os.PathLike, want: str) -> None:
-    """Raise ValueError if the file at ``path`` starts as another kind of file than
-    ``want`` ("npz", "gsd"), saying what it is and which function reads it; a file that
-    cannot be read, or is of no kind known here, is left to the reader's own checks.
+def check_kind(
+    source: str | os.PathLike | IO[bytes],
+    want: str,
+    error: type[Exception] = ValueError,
+    where: str | None = None,
+) -> str | None:
+    """Raise ``error`` if the file ``source`` starts as another kind of file than ``want``
+    ("npz", "gsd"), saying what it is and which function reads it; return its kind
+    (``want``), or None for a file that cannot be read or is of no kind known here, which
+    is left to the reader's own checks.
 
     Parameters
     ----------
-    path : str or os.PathLike
-        The file a reader was given.
+    source : str, os.PathLike or binary file
+        The file a reader was given: a path, or a file open at its start (left there).
     want : str
         The kind that reader reads.
+    error : type of Exception
+        What to raise: the reader's own error class (GSDFileError, CheckpointError).
+    where : str, optional
+        How the message names the file (default: the path's repr).
     """
-    try:
-        with open(path, "rb") as f:
-            head = f.read(8)
-    except OSError:
-        return
+    if hasattr(source, "read"):
+        head = source.read(8)
+        source.seek(0)
+    else:
+        try:
+            with open(source, "rb") as f:
+                head = f.read(8)
+        except OSError:
+            return None
+    if where is None:
+        where = repr(getattr(source, "name", None) or os.fspath(source))
     kind = kind_of(head)
     if kind is not None and kind != want:
-        raise ValueError(
-            f"{os.fspath(path)!r} is not {WHAT_READS[want].split(' (')[0]}: it is "
-            f"{WHAT_READS[kind]}"
-        )
+        raise error(f"{where} is not {WHAT_READS[want].split(' (')[0]}: it is {WHAT_READS[kind]}")
+    return kind
 
 
 def write_atomic(path: str | os.PathLike, data: bytes, suffix: str = ".part") -> None:

@@ -40,7 +40,7 @@ from typing import IO, Any, Protocol, TypeVar
 import numpy as np
 
 from . import _core
-from ._files import WHAT_READS, kind_of, write_atomic
+from ._files import check_kind, write_atomic
 from ._scene_params import PARAMETERS, shape_of
 from .errors import CheckpointError, GranularError
 from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
@@ -254,14 +254,10 @@ def _read_npz(
     read is bounded by the file's size and the sizes the state's arrays must have."""
     if isinstance(f, (bytes, bytearray, memoryview)):
         f = io.BytesIO(f)
-    head = f.read(8)
-    f.seek(0)
-    kind = kind_of(head)
-    if kind != "npz":
-        what = WHAT_READS[kind] if kind else "neither a zip archive nor a GSD file"
+    if check_kind(f, "npz", CheckpointError, where) is None:
         raise CheckpointError(
-            f"{where} is not a granular checkpoint: it is {what}.  Simulation.load reads "
-            "the checkpoints Simulation.save writes"
+            f"{where} is not a granular checkpoint: it is neither a zip archive nor a GSD "
+            "file.  Simulation.load reads the checkpoints Simulation.save writes"
         )
     try:
         with zipfile.ZipFile(f) as zf:

@@ -243,7 +243,7 @@ class _File:
     is a corrupt index whose chunks overlap."""
 
     def __init__(self, path: str | os.PathLike) -> None:
-        check_kind(path, "gsd")  # a checkpoint or another .npz: say what reads it
+        check_kind(path, "gsd", GSDFileError)  # a checkpoint or another .npz: say what reads it
         self.path = _check_suffix(path)
         if not self.path.is_file():
             raise FileNotFoundError(f"no GSD file at {str(self.path)!r}")

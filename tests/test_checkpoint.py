@@ -616,7 +616,9 @@ def test_a_gsd_file_given_to_load_and_a_checkpoint_given_to_read_are_named(saved
     Simulation.load; a lone .npy names numpy.load."""
     gsd = tmp_path / "run.gsd"
     gsd.write_bytes(b"\xdf\x65\xdf\x65\xdf\x65\xdf\x65" + bytes(200))  # GSD's magic number
-    with pytest.raises(CheckpointError, match=r"GSD trajectory file .*granular\.read") as exc:
+    with pytest.raises(
+        CheckpointError, match=r"'.*run\.gsd' .* GSD trajectory file .*granular\.read"
+    ) as exc:
         Simulation.load(gsd)
     assert "pickle" not in str(exc.value)
     npy = tmp_path / "a.npy"
@@ -625,8 +627,11 @@ def test_a_gsd_file_given_to_load_and_a_checkpoint_given_to_read_are_named(saved
         Simulation.load(npy)
     ck_file = tmp_path / "ck.npz"
     ck_file.write_bytes(saved)
-    with pytest.raises(ValueError, match=r"not a GSD .*Simulation\.load"):
+    # each reader's own error class, as the docs promise for a bad file
+    with pytest.raises(granular.GSDFileError, match=r"'.*ck\.npz' is not a GSD .*Simulation\.load"):
         granular.read(ck_file)
+    with pytest.raises(granular.GSDFileError, match=r"not a GSD .*Simulation\.load"):
+        Scene.from_gsd(ck_file)
 
 
 # -- damaged and crafted archives: CheckpointError, and no more read than the state needs --
