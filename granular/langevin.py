@@ -47,7 +47,6 @@ window per lag per step.  See docs/performance.md.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -55,7 +54,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _langevin_run
-from ._deprecation import REMOVAL_VERSION, _MethodWithArrayShim
+from ._deprecation import _MethodWithArrayShim, deprecated
 from ._langevin_run import INITIAL as INITIAL
 from ._langevin_run import MODELS as MODELS
 from ._langevin_run import SCHEMES as SCHEMES
@@ -230,7 +229,7 @@ class LangevinResult:
         Notes
         -----
         Used as an array, ``result.msd`` is still the (T,) MSD, with a FutureWarning: that
-        use goes in granular ``REMOVAL_VERSION``."""
+        use goes in granular 0.3.0."""
         if particles is None:
             return self.msd_per_dimension if per_dimension else self.msd_total
         if self.positions is None:
@@ -277,7 +276,7 @@ class LangevinResult:
         Notes
         -----
         Used as an array, ``result.tamsd`` is still the (L,) TAMSD, with a FutureWarning:
-        that use goes in granular ``REMOVAL_VERSION``."""
+        that use goes in granular 0.3.0."""
         pick = _lag_indices(self.tamsd_lags, self.dt, lags, lag_samples)
         if particles is None and not per_particle:
             return self.tamsd_mean[pick]
@@ -296,14 +295,12 @@ class LangevinResult:
 
         It used to be the temperature per unit mass, ``v2 / dim``; the numbers
         differ only for a mass other than 1 (a ``from_scene`` run of heavier or lighter
-        particles), which warns (FutureWarning) until granular ``REMOVAL_VERSION``."""
+        particles), which warns (FutureWarning) until granular 0.3.0."""
         if self.mass != 1.0:
-            warnings.warn(
+            deprecated(
                 f"LangevinResult.temperature is an energy now, mass * v2 / dim with this "
-                f"run's mass {shown(self.mass)}; it used to be per unit mass, which is "
-                f"result.v2 / result.dim.  This notice goes in granular {REMOVAL_VERSION}",
-                FutureWarning,
-                stacklevel=2,
+                f"run's mass {shown(self.mass)}; the temperature per unit mass it used to be",
+                "that is result.v2 / result.dim",
             )
         return self._temperature()
 
