@@ -1,14 +1,17 @@
 """Writing files atomically, and telling granular's files apart by their first bytes.
 
-``write_atomic`` is used for checkpoints (granular/checkpoint.py) and an ensemble's run
-files (granular/ensemble_store.py); ``kind_of`` lets a reader that was handed the wrong
+``atomic_target`` is used for GSD files (granular/gsd_io.py) and, through ``write_atomic``,
+for checkpoints (granular/checkpoint.py) and an ensemble's run files
+(granular/ensemble_store.py); ``kind_of`` lets a reader that was handed the wrong
 kind of file say what the file is and which function reads it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import secrets
+from collections.abc import Iterator
 from typing import IO
 
 # The first bytes of each kind of file: a zip archive (an .npz, and so a checkpoint or an
@@ -83,28 +86,30 @@ def check_kind(
     return kind
 
 
-def write_atomic(path: str | os.PathLike, data: bytes, suffix: str = ".part") -> None:
-    """Write ``data`` to ``path`` so that a crash mid-way never leaves a half file: into a
-    temporary file (``.tmp-*``) in the same directory, flushed to disk, then renamed over
-    ``path`` (a rename within a file system is atomic).
+@contextlib.contextmanager
+def atomic_target(path: str | os.PathLike, suffix: str = ".part") -> Iterator[str]:
+    """Write a file so that a crash mid-way never leaves a half file: yield the path of a
+    new empty temporary file (``.tmp-*``) in ``path``'s directory for the caller to write;
+    when the ``with`` block ends without an exception it is flushed to disk and renamed
+    over ``path`` (a rename within a file system is atomic); on any exception, a
+    KeyboardInterrupt too, it is removed and ``path`` left as it was.
 
-    The file gets the permissions a plain ``open(path, "wb")`` would give it: those of the
+    The file gets the permissions a plain ``open(path, "w")`` would give it: those of the
     file it replaces, or for a new file 0o666 less the process' umask (the temporary file
     is created with mode 0o666 and the kernel applies the umask and any default ACL).
+    A writer that truncates the temporary file keeps its mode.
 
     Parameters
     ----------
     path : str or os.PathLike
-        Where to write.
-    data : bytes
-        The whole content.
+        Where the file goes.
     suffix : str
-        The temporary file's suffix.
+        The temporary file's suffix (some writers want their own, e.g. ``.gsd``).
     """
     path = os.fspath(path)
     folder = os.path.dirname(os.path.abspath(path))
     try:
-        mode = os.stat(path).st_mode & 0o777
+        mode = os.stat(path).st_mode & 0o777  # not set-id bits, which a write clears
     except FileNotFoundError:
         mode = None
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0)
@@ -118,14 +123,36 @@ def write_atomic(path: str | os.PathLike, data: bytes, suffix: str = ".part") ->
     else:
         raise FileExistsError(f"no free temporary name in {folder!r}")
     try:
-        with os.fdopen(fd, "wb") as f:
+        try:
             if mode is not None and hasattr(os, "fchmod"):
-                os.fchmod(f.fileno(), mode)
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
+                os.fchmod(fd, mode)
+        finally:
+            os.close(fd)
+        yield tmp
+        fd = os.open(tmp, os.O_RDONLY)  # the writer's own handle is closed: sync the file
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
         os.replace(tmp, path)
     except BaseException:
-        if os.path.exists(tmp):
+        with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+def write_atomic(path: str | os.PathLike, data: bytes, suffix: str = ".part") -> None:
+    """Write ``data`` to ``path`` atomically (see ``atomic_target``): a crash mid-way
+    leaves the old file, or none, never a half one.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Where to write.
+    data : bytes
+        The whole content.
+    suffix : str
+        The temporary file's suffix.
+    """
+    with atomic_target(path, suffix) as tmp, open(tmp, "wb") as f:
+        f.write(data)
