@@ -581,7 +581,7 @@ def test_a_state_that_cannot_continue_is_not_saved(tmp_path):
 # -- files get the permissions a plain open() gives ---------------------------------------
 
 
-@pytest.mark.parametrize("umask", [0o022, 0o077])
+@pytest.mark.parametrize("umask", [0o022, 0o027])
 def test_files_get_the_permissions_a_plain_open_gives(umask, tmp_path):
     """Checkpoints and an ensemble's run files (both written by _files.write_atomic) are
     readable by whom the user's umask lets read a file: 0o666 less the umask for a new
