@@ -113,8 +113,9 @@ QUANTITIES: dict[str, Quantity] = {
 }
 
 
+_POSITIVE = "must be positive and finite"
 _RULES = {
-    "positive": (lambda x: (x > 0) & np.isfinite(x), "must be positive and finite"),
+    "positive": (lambda x: (x > 0) & np.isfinite(x), _POSITIVE),
     "positive_or_inf": (lambda x: x > 0, "must be positive (inf allowed)"),
     "nonnegative": (lambda x: (x >= 0) & np.isfinite(x), "must be >= 0 and finite"),
     "restitution": (lambda x: (x >= 0) & (x <= 1), "must lie in [0, 1]"),
@@ -144,13 +145,46 @@ def check(name: str, value: Any) -> None:
             f"({name}: {QUANTITIES[name].meaning})"
         ) from None
     ok, says = _RULES[rule]
-    good = ok(x)
-    if not np.all(good):
-        bad = x[~good].flat[0] if x.ndim else x[()]
-        where = "" if x.ndim == 0 else " in the array"
-        raise ValueError(
-            f"{name} {says}, got {shown(bad)}{where} ({name}: {QUANTITIES[name].meaning})"
-        )
+    _refuse_unless(ok(x), name, x, says, QUANTITIES[name].meaning)
+
+
+def _refuse_unless(good: np.ndarray, name: str, x: np.ndarray, says: str, meaning: str | None):
+    """Raise ValueError naming ``name``, the first value of ``x`` that is not ``good``
+    (and its index in an array), what is allowed (``says``) and the meaning, if any."""
+    if np.all(good):
+        return
+    about = f" ({name}: {meaning})" if meaning else ""
+    if x.ndim == 0:
+        raise ValueError(f"{name} {says}, got {shown(x[()])}{about}")
+    k = tuple(int(i) for i in np.argwhere(~good)[0])
+    index = k[0] if len(k) == 1 else k
+    raise ValueError(f"{name} {says}, got {shown(x[k])} in the array (index {index}){about}")
+
+
+def check_positive(name: str, value: Any, meaning: str | None = None) -> Any:
+    """``value`` as a float (an array as a float64 array) if it is positive and finite
+    (every element of an array); else ValueError naming the parameter, the value (the
+    first bad element and its index) and its meaning -- ``meaning``, or that of
+    ``QUANTITIES[name]`` -- and TypeError for what is not a number.
+
+    Parameters
+    ----------
+    name : str
+        The parameter, as the user wrote it.
+    value : float or array_like
+        What the user gave.
+    meaning : str, optional
+        What the parameter is, for the message (default: from QUANTITIES, if named there).
+    """
+    if meaning is None and name in QUANTITIES:
+        meaning = QUANTITIES[name].meaning
+    try:
+        x = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        about = f" ({name}: {meaning})" if meaning else ""
+        raise TypeError(f"{name} must be a number, got {shown(value)}{about}") from None
+    _refuse_unless((x > 0) & np.isfinite(x), name, x, _POSITIVE, meaning)
+    return float(x) if x.ndim == 0 else x
 
 
 def keyword_only(

@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _edmd, gsd_io
+from ._params import check_positive
 from ._scales import SCALE_HI, SCALE_LO, check_range
 from ._scene_params import BOUNDARIES, NAMES, PARAMETERS, SIGNATURE, engine_keywords, real
 from ._scene_params import box_corners as _box_corners
@@ -321,12 +322,8 @@ class Scene:
             raise ValueError(f"n must be >= 1, got {n}")
         if speed is not None and temperature is not None:
             raise ValueError("give speed or temperature, not both")
-        radii = np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,)).copy()
-        if not np.all(radii > 0) or not np.all(np.isfinite(radii)):
-            raise ValueError("radius must be positive and finite")
-        masses = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,)).copy()
-        if not np.all(masses > 0) or not np.all(np.isfinite(masses)):
-            raise ValueError("mass must be positive and finite")
+        radii = np.broadcast_to(check_positive("radius", radius), (n,)).astype(np.float64)
+        masses = np.broadcast_to(check_positive("mass", mass), (n,)).astype(np.float64)
         lo, hi = _box_corners(box, dim)
         if boundary not in BOUNDARIES:
             raise ValueError(f"boundary must be one of {BOUNDARIES}, got {boundary!r}")
@@ -427,14 +424,14 @@ class Scene:
                 seed=seed,
             )
         r, m, lo, hi = 0.1, 1.0, np.full(2, -3.0), np.full(2, 3.0)
-        big_r = 5.0 * r if tracer_radius is None else float(tracer_radius)
-        if not (big_r > 0 and math.isfinite(big_r)):
-            raise ValueError(f"tracer_radius must be positive and finite, got {tracer_radius}")
+        big_r = 5.0 * r if tracer_radius is None else check_positive("tracer_radius", tracer_radius)
         if big_r >= 3.0:
             raise ValueError(f"tracer_radius = {big_r:g} does not fit between the walls at +-3")
-        big_m = m * (big_r / r) ** 2 if tracer_mass is None else float(tracer_mass)
-        if not (big_m > 0 and math.isfinite(big_m)):
-            raise ValueError(f"tracer_mass must be positive and finite, got {tracer_mass}")
+        big_m = (
+            m * (big_r / r) ** 2
+            if tracer_mass is None
+            else check_positive("tracer_mass", tracer_mass)
+        )
         ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
         rng_pos, rng_vel, rng_tracer = (np.random.default_rng(s) for s in ss.spawn(3))
         radii = np.full(150, r)
