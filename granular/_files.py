@@ -69,17 +69,17 @@ def check_kind(
     where : str, optional
         How the message names the file (default: the path's repr).
     """
-    if hasattr(source, "read"):
-        head = source.read(8)
-        source.seek(0)
-    else:
+    if isinstance(source, (str, os.PathLike)):
         try:
             with open(source, "rb") as f:
                 head = f.read(8)
         except OSError:
             return None
-    if where is None:
-        where = repr(getattr(source, "name", None) or os.fspath(source))
+        where = repr(os.fspath(source)) if where is None else where
+    else:
+        head = source.read(8)
+        source.seek(0)
+        where = repr(getattr(source, "name", "the file")) if where is None else where
     kind = kind_of(head)
     if kind is not None and kind != want:
         raise error(f"{where} is not {WHAT_READS[want].split(' (')[0]}: it is {WHAT_READS[kind]}")

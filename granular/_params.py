@@ -148,7 +148,9 @@ def check(name: str, value: Any) -> None:
     _refuse_unless(ok(x), name, x, says, QUANTITIES[name].meaning)
 
 
-def _refuse_unless(good: np.ndarray, name: str, x: np.ndarray, says: str, meaning: str | None):
+def _refuse_unless(
+    good: np.ndarray, name: str, x: np.ndarray, says: str, meaning: str | None
+) -> None:
     """Raise ValueError naming ``name``, the first value of ``x`` that is not ``good``
     (and its index in an array), what is allowed (``says``) and the meaning, if any."""
     if np.all(good):
