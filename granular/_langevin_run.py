@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._params import check_positive
 from ._scales import SCALE_HI, SCALE_LO, check_range
 from .errors import shown
 
@@ -73,13 +74,6 @@ def _threads(threads: int | None) -> int:
     return min(int(threads), 1024)
 
 
-def _positive(name: str, value: float) -> float:
-    value = float(value)
-    if not (value > 0 and math.isfinite(value)):
-        raise ValueError(f"{name} must be positive and finite, got {value}")
-    return value
-
-
 @dataclass(frozen=True)
 class _Run:
     """``run``'s arguments checked and normalised: what each of its steps reads."""
@@ -123,13 +117,13 @@ def _checked(
     if n < 1:
         raise ValueError(f"n must be >= 1, got {n}")
     n_threads = _threads(threads)
-    mass = _positive("mass", mass)
+    mass = check_positive("mass", mass)
     _estimator_code(tamsd_estimator)
     if dim not in (1, 2, 3):
         raise ValueError(f"dim must be 1, 2 or 3, got {dim}")
-    gamma0, D0, dt, t_stop = (
-        _positive(k, v) for k, v in (("gamma0", gamma0), ("D0", D0), ("dt", dt), ("t_stop", t_stop))
-    )
+    gamma0, D0 = check_positive("gamma0", gamma0), check_positive("D0", D0)
+    dt = check_positive("dt", dt, "the time step")
+    t_stop = check_positive("t_stop", t_stop, "the time the run ends at")
     tau0 = float(tau0)
     if not tau0 > 0:
         raise ValueError(f"tau0 must be positive (inf for the Langevin model), got {tau0}")
@@ -139,11 +133,7 @@ def _checked(
         raise ValueError(f"model must be one of {MODELS}, got {model!r}")
     if model == "udsbm" and math.isinf(tau0):
         raise ValueError("UDSBM needs a finite tau0")
-    exponent = float(exponent)
-    if not (exponent > 0 and math.isfinite(exponent)):
-        raise ValueError(
-            f"exponent must be positive and finite (UDSBM's (1 + t/tau0)^-exponent), got {exponent}"
-        )
+    exponent = check_positive("exponent", exponent)
     if model == "langevin":
         if exponent != 1.0:
             raise ValueError(
@@ -256,7 +246,11 @@ def _initial_state(
         v0_sq = udsbm_v0_sq(D0=p.D0, gamma0=p.gamma0, tau0=p.tau0)
         v = rng.normal(scale=math.sqrt(v0_sq), size=(n, dim))
     elif initial == "fixed":
-        s = math.sqrt(dim * thermal) if speed is None else _positive("speed", speed)
+        s = (
+            math.sqrt(dim * thermal)
+            if speed is None
+            else check_positive("speed", speed, "every particle's initial speed")
+        )
         g = rng.normal(size=(n, dim))
         g /= np.maximum(np.linalg.norm(g, axis=1), 1e-300)[:, None]
         v = s * g

@@ -25,6 +25,7 @@ from typing import Any, TypeVar, cast
 import numpy as np
 
 from ._deprecation import deprecated
+from .errors import shown
 
 _F = TypeVar("_F", bound=Callable[..., Any])
 
@@ -112,19 +113,9 @@ QUANTITIES: dict[str, Quantity] = {
 }
 
 
-def _number(value: Any) -> str:
-    """A number as a user writes it (no NumPy repr)."""
-    if isinstance(value, (bool, np.bool_)):
-        return str(bool(value))
-    if isinstance(value, (int, np.integer)):
-        return str(int(value))
-    if isinstance(value, (float, np.floating)):
-        return repr(float(value))
-    return "..." if np.ndim(value) else repr(value)
-
-
+_POSITIVE = "must be positive and finite"
 _RULES = {
-    "positive": (lambda x: (x > 0) & np.isfinite(x), "must be positive and finite"),
+    "positive": (lambda x: (x > 0) & np.isfinite(x), _POSITIVE),
     "positive_or_inf": (lambda x: x > 0, "must be positive (inf allowed)"),
     "nonnegative": (lambda x: (x >= 0) & np.isfinite(x), "must be >= 0 and finite"),
     "restitution": (lambda x: (x >= 0) & (x <= 1), "must lie in [0, 1]"),
@@ -142,7 +133,7 @@ def check(name: str, value: Any) -> None:
         return
     if rule == "dim":
         if value not in (2, 3) or isinstance(value, bool):
-            raise ValueError(f"dim must be 2 or 3, got {_number(value)}")
+            raise ValueError(f"dim must be 2 or 3, got {shown(value)}")
         return
     try:
         x = np.asarray(value, dtype=np.float64)
@@ -154,13 +145,48 @@ def check(name: str, value: Any) -> None:
             f"({name}: {QUANTITIES[name].meaning})"
         ) from None
     ok, says = _RULES[rule]
-    good = ok(x)
-    if not np.all(good):
-        bad = x[~good].flat[0] if x.ndim else x[()]
-        where = "" if x.ndim == 0 else " in the array"
-        raise ValueError(
-            f"{name} {says}, got {_number(bad)}{where} ({name}: {QUANTITIES[name].meaning})"
-        )
+    _refuse_unless(ok(x), name, x, says, QUANTITIES[name].meaning)
+
+
+def _refuse_unless(
+    good: np.ndarray, name: str, x: np.ndarray, says: str, meaning: str | None
+) -> None:
+    """Raise ValueError naming ``name``, the first value of ``x`` that is not ``good``
+    (and its index in an array), what is allowed (``says``) and the meaning, if any."""
+    if np.all(good):
+        return
+    about = f" ({name}: {meaning})" if meaning else ""
+    if x.ndim == 0:
+        raise ValueError(f"{name} {says}, got {shown(x[()])}{about}")
+    k = tuple(int(i) for i in np.argwhere(~good)[0])
+    index = k[0] if len(k) == 1 else k
+    raise ValueError(f"{name} {says}, got {shown(x[k])} in the array (index {index}){about}")
+
+
+def check_positive(name: str, value: Any, meaning: str | None = None) -> Any:
+    """``value`` as a float (an array as a float64 array) if it is positive and finite
+    (every element of an array); else ValueError naming the parameter, the value (the
+    first bad element and its index) and its meaning -- ``meaning``, or that of
+    ``QUANTITIES[name]`` -- and TypeError for what is not a number.
+
+    Parameters
+    ----------
+    name : str
+        The parameter, as the user wrote it.
+    value : float or array_like
+        What the user gave.
+    meaning : str, optional
+        What the parameter is, for the message (default: from QUANTITIES, if named there).
+    """
+    if meaning is None and name in QUANTITIES:
+        meaning = QUANTITIES[name].meaning
+    try:
+        x = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        about = f" ({name}: {meaning})" if meaning else ""
+        raise TypeError(f"{name} must be a number, got {shown(value)}{about}") from None
+    _refuse_unless((x > 0) & np.isfinite(x), name, x, _POSITIVE, meaning)
+    return float(x) if x.ndim == 0 else x
 
 
 def keyword_only(
@@ -194,9 +220,11 @@ def keyword_only(
             old_keywords = renamed.keys() & kwargs.keys()
             if len(args) > len(positional) or old_keywords:
                 if len(args) > len(old_order):
+                    which = f"all but {', '.join(positional)}" if positional else "them"
                     raise TypeError(
-                        f"{func.__name__}() takes {len(positional)} positional argument(s) "
-                        f"but {len(args)} were given"
+                        f"{func.__name__}() takes at most {len(old_order)} positional "
+                        f"arguments (deprecated: pass {which} by keyword) but {len(args)} "
+                        f"were given"
                     )
                 moved = dict(zip(new_old[len(positional) :], args[len(positional) :], strict=False))
                 for old in old_keywords:
@@ -210,7 +238,10 @@ def keyword_only(
                 kwargs = {**moved, **kwargs}
                 _warn(wrapper, args, kwargs, moved, old_keywords, renamed)
             if validate:
-                bound = sig.bind(*args, **kwargs)
+                try:
+                    bound = sig.bind(*args, **kwargs)
+                except TypeError as exc:  # bind's message names no function
+                    raise TypeError(f"{func.__name__}() {exc}") from None
                 for name, value in bound.arguments.items():
                     check(name, value)
             return func(*args, **kwargs)
@@ -226,8 +257,8 @@ def keyword_only(
 
 def _warn(wrapper, args, kwargs, moved, old_keywords, renamed):
     name = f"{wrapper.__module__}.{wrapper.__name__}"
-    shown = [_number(a) if np.ndim(a) == 0 else "..." for a in args]
-    shown += [f"{k}={_number(v) if np.ndim(v) == 0 else '...'}" for k, v in kwargs.items()]
+    written = [shown(a) if np.ndim(a) == 0 else "..." for a in args]
+    written += [f"{k}={shown(v) if np.ndim(v) == 0 else '...'}" for k, v in kwargs.items()]
     what = []
     if moved:
         what.append("passing " + ", ".join(moved) + " by position")
@@ -235,7 +266,7 @@ def _warn(wrapper, args, kwargs, moved, old_keywords, renamed):
         what.append(
             "the keyword(s) " + ", ".join(f"{k}= (now {renamed[k]}=)" for k in old_keywords)
         )
-    deprecated(f"{name}: {' and '.join(what)}", f"call {name}({', '.join(shown)})", stacklevel=4)
+    deprecated(f"{name}: {' and '.join(what)}", f"call {name}({', '.join(written)})", stacklevel=4)
 
 
 def parameters_section(func: Callable[..., Any]) -> str:

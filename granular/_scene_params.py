@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from ._params import check_positive
 from ._scales import SCALE_HI, SCALE_LO
 from .restitution import ConstantRestitution, RestitutionLaw, engine_law
 
@@ -164,11 +165,10 @@ def _velocities(value: Any, n: int, d: int) -> np.ndarray:
     return array(value, "velocities", (n, d))
 
 
-def _positive(name: str) -> Callable[[Any, int, int], np.ndarray]:
+def _positive(name: str, meaning: str) -> Callable[[Any, int, int], np.ndarray]:
     def check(value: Any, n: int, d: int) -> np.ndarray:
         a = array(value, name, (n,))
-        if np.any(a <= 0):
-            raise ValueError(f"{name} must be positive (particle {int(np.argmin(a))})")
+        check_positive(name, a, meaning)  # the index in the array is the particle's
         return a
 
     return check
@@ -189,8 +189,8 @@ def _boundary(value: Any, n: int, d: int) -> str:
 
 def _wall_restitution(value: Any, n: int, d: int) -> float | RestitutionLaw:
     kept = _restitution(value, "wall_restitution")
-    if not isinstance(kept, RestitutionLaw) and not (kept > 0 and math.isfinite(kept)):
-        raise ValueError(f"wall_restitution must be positive and finite, got {value}")
+    if not isinstance(kept, RestitutionLaw):
+        kept = check_positive("wall_restitution", kept, "the walls' restitution, > 1 heats")
     return kept
 
 
@@ -255,7 +255,7 @@ PARAMETERS: tuple[SceneParameter, ...] = (
         REQUIRED,
         "L",
         "Particle radii, > 0 (a number: all alike).",
-        _positive("radii"),
+        _positive("radii", "the particles' radii"),
         _same("radii"),
         positional=True,
     ),
@@ -266,7 +266,7 @@ PARAMETERS: tuple[SceneParameter, ...] = (
         1.0,
         "m",
         "Particle masses, > 0 (a number: all alike).",
-        _positive("masses"),
+        _positive("masses", "the particles' masses"),
         _same("masses"),
         positional=True,
     ),

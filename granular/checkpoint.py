@@ -31,7 +31,6 @@ import io
 import json
 import math
 import os
-import stat
 import struct
 import zipfile
 from collections.abc import Callable
@@ -40,7 +39,8 @@ from typing import IO, Any, Protocol, TypeVar
 import numpy as np
 
 from . import _core
-from ._files import WHAT_READS, kind_of, write_atomic
+from ._files import check_kind, write_atomic
+from ._npz import check_members, open_regular, read_header, read_member
 from ._scene_params import PARAMETERS, shape_of
 from .errors import CheckpointError, GranularError
 from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
@@ -161,19 +161,16 @@ def load(path: str | os.PathLike, make: Callable[..., _S]) -> _S:
     ``make(scene, **knobs)`` (the Simulation class) and given the saved state."""
     where = repr(os.fspath(path))
     try:
-        f = open(path, "rb")  # closed by the with below, after the checks on it
+        f = open_regular(path)
+    except (FileNotFoundError, PermissionError):
+        raise  # as open() and granular.read say it: not a fault of the file's content
     except OSError as exc:
         raise CheckpointError(f"cannot read the checkpoint {where}: {exc}") from exc
+    except ValueError as exc:  # a device (/dev/zero), a pipe: no size to check, no end
+        raise CheckpointError(
+            f"{where} is {exc}: a checkpoint is a file written by Simulation.save"
+        ) from exc
     with f:
-        try:
-            regular = stat.S_ISREG(os.fstat(f.fileno()).st_mode)
-        except OSError as exc:
-            raise CheckpointError(f"cannot read the checkpoint {where}: {exc}") from exc
-        if not regular:  # a device (/dev/zero), a pipe: no size to check, no end
-            raise CheckpointError(
-                f"{where} is not a regular file (a device, a pipe or a socket): a checkpoint "
-                "is a file written by Simulation.save"
-            )
         meta, arrays = _read_npz(f, where)
     return _build(meta, arrays, where, make)
 
@@ -200,51 +197,6 @@ _READ_ERRORS = (
 )
 
 
-def _npy_header(fp, name):
-    """(shape, dtype) from the .npy header at the start of ``fp``."""
-    version = np.lib.format.read_magic(fp)
-    if version == (1, 0):
-        shape, fortran, dtype = np.lib.format.read_array_header_1_0(fp)
-    elif version in ((2, 0), (3, 0)):
-        shape, fortran, dtype = np.lib.format.read_array_header_2_0(fp)
-    else:
-        raise ValueError(f"{name}: unknown .npy version {version}")
-    if fortran or dtype.hasobject:
-        raise ValueError(f"{name}: not a C-ordered array of numbers")
-    return shape, dtype
-
-
-def _member_array(zf, info, dtype, shape, max_bytes, check_head=None):
-    """The .npy member ``info`` of ``zf``, refused unless it holds an array of ``dtype``
-    ("U": a unicode string of any length) and ``shape`` (None: one-dimensional), its data
-    fills the rest of the member exactly, and that is at most ``max_bytes``.  Nothing
-    beyond the header is read before its size is known to be right; ``check_head(head,
-    nbytes)``, if given, checks the data's first 64 bytes before the rest is read."""
-    with zf.open(info) as fp:
-        got_shape, got = _npy_header(fp, info.filename)
-        if (got.kind != "U" or not got.isnative) if dtype == "U" else got != dtype:
-            raise ValueError(f"{info.filename}: an array of {got}, not of {dtype}")
-        if shape is None and len(got_shape) == 1:
-            shape = got_shape
-        if got_shape != shape:
-            raise ValueError(f"{info.filename}: an array of shape {got_shape}, not {shape}")
-        nbytes = got.itemsize * math.prod(shape)
-        left = info.file_size - fp.tell()
-        if nbytes > max_bytes or left != nbytes:
-            raise ValueError(
-                f"{info.filename}: {left} bytes of data for an array of {nbytes} bytes "
-                f"(at most {max_bytes})"
-            )
-        data = fp.read(min(nbytes, 64))
-        if check_head is not None:
-            check_head(data, nbytes)
-        data += fp.read(nbytes - len(data))
-        if len(data) != nbytes:
-            raise EOFError(f"{info.filename} is truncated")
-        fp.read(1)  # at the member's end: zipfile checks its CRC-32 on the way
-    return np.frombuffer(data, dtype=got).reshape(shape)
-
-
 def _read_npz(
     f: IO[bytes] | bytes | bytearray | memoryview, where: str
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
@@ -252,14 +204,10 @@ def _read_npz(
     read is bounded by the file's size and the sizes the state's arrays must have."""
     if isinstance(f, (bytes, bytearray, memoryview)):
         f = io.BytesIO(f)
-    head = f.read(8)
-    f.seek(0)
-    kind = kind_of(head)
-    if kind != "npz":
-        what = WHAT_READS[kind] if kind else "neither a zip archive nor a GSD file"
+    if check_kind(f, "npz", CheckpointError, where) is None:
         raise CheckpointError(
-            f"{where} is not a granular checkpoint: it is {what}.  Simulation.load reads "
-            "the checkpoints Simulation.save writes"
+            f"{where} is not a granular checkpoint: it is neither a zip archive nor a GSD "
+            "file.  Simulation.load reads the checkpoints Simulation.save writes"
         )
     try:
         with zipfile.ZipFile(f) as zf:
@@ -275,22 +223,10 @@ def _read_npz(
 
 def _read_members(zf, f, where):
     size = f.seek(0, os.SEEK_END)
-    infos = zf.infolist()
-    names = {info.filename: info for info in infos}
-    if len(names) != len(infos):
-        raise ValueError("a member is named twice")
-    for info in infos:
-        # np.savez stores its members: a compressed one could decompress to any size
-        if info.compress_type != zipfile.ZIP_STORED or info.flag_bits & 0x1:
-            raise ValueError(
-                f"its member {info.filename!r} is compressed or encrypted, which "
-                "Simulation.save never writes"
-            )
-        if info.compress_size != info.file_size or info.header_offset + info.file_size > size:
-            raise ValueError(f"its member {info.filename!r} claims more bytes than the file has")
+    names = check_members(zf, size)
     if "meta.npy" not in names:
         raise CheckpointError(f"{where} is not a granular checkpoint (no {FORMAT!r} header)")
-    meta = json.loads(str(_member_array(zf, names["meta.npy"], "U", (), _META_MAX_BYTES)[()]))
+    meta = json.loads(str(read_member(zf, names["meta.npy"], "U", (), _META_MAX_BYTES)[()]))
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise CheckpointError(f"{where} is not a granular checkpoint (no {FORMAT!r} header)")
     _check_version(meta, where)
@@ -302,14 +238,14 @@ def _read_members(zf, f, where):
     # the sizes of the scene's arrays follow from its positions' (N, d); the engine
     # state's size from its own header, which must agree with them
     with zf.open(names["scene_positions.npy"]) as fp:
-        n_d, _ = _npy_header(fp, "scene_positions.npy")
+        n_d, _, _ = read_header(fp, "scene_positions.npy")
     if len(n_d) != 2 or n_d[1] not in (2, 3) or n_d[0] < 1:
         raise ValueError(f"its scene positions have shape {n_d}, not (N, 2) or (N, 3)")
     n, d = n_d
     f8 = np.dtype(np.float64)  # native, as np.savez wrote the Scene's arrays
     shapes = {a: shape_of(p, n, d) for p in PARAMETERS if p.is_array for a in p.fields}
     arrays = {
-        f"scene_{name}": _member_array(zf, names[f"scene_{name}.npy"], f8, shape, size)
+        f"scene_{name}": read_member(zf, names[f"scene_{name}.npy"], f8, shape)
         for name, shape in shapes.items()
     }
 
@@ -326,7 +262,7 @@ def _read_members(zf, f, where):
             )
 
     state = names["engine_state.npy"]
-    arrays["engine_state"] = _member_array(zf, state, np.dtype("u1"), None, size, check_head)
+    arrays["engine_state"] = read_member(zf, state, np.dtype("u1"), (None,), check_head=check_head)
     return meta, arrays
 
 

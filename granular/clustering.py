@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .errors import shown
+
 if TYPE_CHECKING:
     from .restitution import RestitutionLaw
     from .scene import Scene
@@ -449,7 +451,7 @@ def effective_restitution(
     if not (np.all(T > 0) and np.all(np.isfinite(T)) and mass > 0 and math.isfinite(mass)):
         raise ValueError(
             f"effective_restitution needs temperatures > 0 and a mass > 0, got T = "
-            f"{T.tolist()} and mass = {mass}"
+            f"{shown(T)} and mass = {shown(mass)}"
         )
     scale = 4.0 * T[..., None] / mass  # g^2 = scale x = scale y^10
     kink = getattr(restitution, "max_speed", math.inf)

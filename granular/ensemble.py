@@ -27,7 +27,7 @@ from typing import Any, overload
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._results import readonly
+from ._results import _lag_indices, ergodicity_breaking, readonly
 from .errors import ProcessBackendError
 from .scene import Scene
 from .simulation import _STOP_KEYS, Simulation
@@ -250,7 +250,6 @@ class EnsembleResult:
         """Each run's (N, L) TAMSD of the chosen particles: the rows a Langevin run kept,
         or ``analysis.tamsd`` of an EDMD run's positions."""
         from . import analysis
-        from .langevin import _lag_indices
 
         if "tamsd_lags" in self.mean or (self.runs and "tamsd_per_particle" in self.runs[0]):
             runs = self._runs_with(
@@ -315,8 +314,6 @@ class EnsembleResult:
             (each Langevin run's ``tamsd_per_particle``), instead of the mean.
         """
         if particles is None and not per_particle and "tamsd" in self.mean:
-            from .langevin import _lag_indices
-
             dt = float(self._quantity("dt", "the runs' step"))
             return self.mean["tamsd"][_lag_indices(self.tamsd_lags, dt, lags, lag_samples)]
         rows = self._tamsd_rows(lags, lag_samples, particles)
@@ -340,10 +337,7 @@ class EnsembleResult:
         ----------
         lags, lag_samples, particles : as in ``tamsd``.
         """
-        from . import analysis
-
-        per = self.tamsd(lags, lag_samples=lag_samples, particles=particles, per_particle=True)
-        return analysis.ergodicity_breaking(per)
+        return ergodicity_breaking(self, lags, lag_samples, particles)
 
     def __repr__(self) -> str:
         q = ", ".join(

@@ -19,10 +19,11 @@ name, and the directory will not notice -- start a new directory when the model 
 Runs are identified by (point, run index) and their seeds, so the runs count may grow
 between calls: ``runs=k`` then ``runs=n`` computes only the n - k new ones.
 
-Reading a run file trusts nothing in it: the file must be a regular file, its zip members
-stored uncompressed (as ``np.savez`` writes them) and together no larger than the file,
-each a ``.npy`` array of plain numbers or text whose header's size matches its member, with
-the zip's CRC checked; anything else is a ``CheckpointError`` naming the file.  So a
+Reading a run file trusts nothing in it, by the rules a checkpoint is read by
+(granular/_npz.py): the file must be a regular file, its zip members stored uncompressed
+and unencrypted (as ``np.savez`` writes them), inside the file and together no larger than
+it, each a ``.npy`` array of plain numbers or text whose header's size matches its member,
+with the zip's CRC checked; anything else is a ``CheckpointError`` naming the file.  So a
 damaged or crafted file costs at most its own size in memory, and runs no code.
 """
 
@@ -33,16 +34,16 @@ import io
 import json
 import os
 import pickle
-import stat
 import sys
 import zipfile
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 import numpy as np
 
 from ._files import write_atomic
+from ._npz import check_members, read_member, read_regular
 from .errors import CheckpointError
 
 FINGERPRINT = "ensemble.json"
@@ -153,65 +154,19 @@ class _DirectoryLock:
             self._fd = None
 
 
-def _read_regular(path: Path, limit: int | None = None) -> bytes:
-    """The bytes of ``path``, which must be a regular file (not a device, a FIFO or a
-    directory, which could be read forever), of at most ``limit`` bytes."""
-    # non-blocking, so that opening a FIFO does not wait for a writer
-    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
-    with open(fd, "rb") as f:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise ValueError("not a regular file")
-        if limit is not None and info.st_size > limit:
-            raise ValueError(f"{info.st_size} bytes, more than the {limit} it can be")
-        data = f.read(info.st_size + 1)
-    if len(data) != info.st_size:
-        raise ValueError("its size changed while it was read")
-    return data
-
-
-def _read_npy(member: IO[bytes], size: int) -> np.ndarray:
-    """One ``.npy`` member whose header must describe exactly its ``size`` bytes."""
-    version = np.lib.format.read_magic(member)
-    if version == (1, 0):
-        shape, fortran, dtype = np.lib.format.read_array_header_1_0(member)
-    elif version == (2, 0):
-        shape, fortran, dtype = np.lib.format.read_array_header_2_0(member)
-    else:
-        raise ValueError(f"unsupported .npy version {version}")
-    if dtype.kind not in _KINDS or dtype.names is not None or dtype.subdtype is not None:
-        raise ValueError(f"an array of dtype {dtype}: a run file holds numbers and text only")
-    header = member.tell()
-    count = 1
-    for extent in shape:
-        count *= int(extent)
-    if count * dtype.itemsize != size - header:
-        raise ValueError(
-            f"a header for {shape} x {dtype.itemsize} bytes in a member of {size - header}"
-        )
-    data = member.read(size - header)
-    if len(data) != size - header or member.read(1):  # reading to the end checks the CRC
-        raise ValueError("a member shorter or longer than its header says")
-    return np.frombuffer(data, dtype=dtype).reshape(shape, order="F" if fortran else "C").copy()
-
-
 def _read_run_file(path: Path) -> dict[str, np.ndarray]:
     """The arrays of a run file, read within the file's own size (see the module's
-    docstring); ValueError, OSError or zipfile's errors for anything else."""
-    data = _read_regular(path)
+    docstring and granular/_npz.py); ValueError, OSError or zipfile's errors for anything
+    else."""
+    data = read_regular(path)
     arrays = {}
     with zipfile.ZipFile(io.BytesIO(data)) as zf:
-        members = zf.infolist()
-        if sum(m.file_size for m in members) > len(data):
-            raise ValueError("its members claim more bytes than the file has")
-        for m in members:
-            if m.compress_type != zipfile.ZIP_STORED or m.file_size != m.compress_size:
-                raise ValueError(f"member {m.filename!r} is compressed (run files are not)")
-            name = m.filename.removesuffix(".npy")
-            if name == m.filename or name in arrays:
-                raise ValueError(f"unexpected member {m.filename!r}")
-            with zf.open(m) as member:
-                arrays[name] = _read_npy(member, m.file_size)
+        for filename, info in check_members(zf, len(data)).items():
+            name = filename.removesuffix(".npy")
+            if name == filename:
+                raise ValueError(f"unexpected member {filename!r}")
+            # np.savez writes an array that is Fortran- but not C-contiguous as Fortran
+            arrays[name] = read_member(zf, info, _KINDS, fortran_ok=True).copy()
     return arrays
 
 
@@ -258,7 +213,7 @@ class RunStore:
         own = self.path / FINGERPRINT
         if own.exists():
             try:
-                theirs = json.loads(_read_regular(own, _MAX_FINGERPRINT_BYTES))
+                theirs = json.loads(read_regular(own, _MAX_FINGERPRINT_BYTES))
                 if not isinstance(theirs, dict):
                     raise ValueError("not a JSON object")
             # any unreadable file (I/O, not JSON, nested too deep, too large) gets one error

@@ -52,17 +52,14 @@ and its writers.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
-import secrets
-import stat
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ._files import check_kind
+from ._files import atomic_target, check_kind
 from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, split
 from .errors import GSDFileError
 from .interop import box_lengths_3d
@@ -195,26 +192,6 @@ def _frame(hoomd, traj, k, lower, upper):
     return frame
 
 
-def _temporary(path: Path) -> Path:
-    """A new empty file beside ``path`` with the mode a plain ``open(path, "w")`` would give
-    ``path``: 0o666 less the umask (``os.open`` applies it), or the mode of the file it
-    replaces.  gsd creates its files 0o660 less the umask, and keeps the mode of a file it
-    truncates; a rename keeps it too."""
-    while True:
-        tmp = path.with_name(f".tmp-{secrets.token_hex(8)}.gsd")
-        try:
-            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
-        except FileExistsError:  # 64 random bits taken: draw again
-            continue
-        try:
-            with contextlib.suppress(FileNotFoundError):
-                os.chmod(tmp, stat.S_IMODE(os.stat(path).st_mode))
-        except BaseException:
-            os.unlink(tmp)
-            raise
-        return tmp
-
-
 def write(traj: Any, path: str | os.PathLike) -> None:
     """Write a Trajectory to a GSD file (see the module docstring for the fields).
 
@@ -239,21 +216,10 @@ def write(traj: Any, path: str | os.PathLike) -> None:
     hoomd = _gsd().hoomd
     lower = np.asarray(traj.lower, dtype=np.float64)
     upper = np.asarray(traj.upper, dtype=np.float64)
-    tmp = _temporary(path)
-    try:
-        with hoomd.open(name=str(tmp), mode="w") as f:  # "w" truncates: tmp keeps its mode
-            for k in range(len(traj.times)):
-                f.append(_frame(hoomd, traj, k, lower, upper))
-        fd = os.open(tmp, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
+    # gsd creates its files 0o660 less the umask, but keeps the mode of one it truncates
+    with atomic_target(path, ".gsd") as tmp, hoomd.open(name=tmp, mode="w") as f:
+        for k in range(len(traj.times)):
+            f.append(_frame(hoomd, traj, k, lower, upper))
 
 
 class _File:
@@ -264,7 +230,7 @@ class _File:
     is a corrupt index whose chunks overlap."""
 
     def __init__(self, path: str | os.PathLike) -> None:
-        check_kind(path, "gsd")  # a checkpoint or another .npz: say what reads it
+        check_kind(path, "gsd", GSDFileError)  # a checkpoint or another .npz: say what reads it
         self.path = _check_suffix(path)
         if not self.path.is_file():
             raise FileNotFoundError(f"no GSD file at {str(self.path)!r}")

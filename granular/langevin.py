@@ -47,7 +47,6 @@ window per lag per step.  See docs/performance.md.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -55,7 +54,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _langevin_run
-from ._deprecation import REMOVAL_VERSION, _MethodWithArrayShim
+from ._deprecation import _MethodWithArrayShim, deprecated
 from ._langevin_run import INITIAL as INITIAL
 from ._langevin_run import MODELS as MODELS
 from ._langevin_run import SCHEMES as SCHEMES
@@ -73,7 +72,7 @@ from ._langevin_run import (
     _tamsd_lag_steps,
 )
 from ._langevin_run import _threads as _threads  # the CLI's benchmark asks it for the cores
-from ._results import readonly
+from ._results import _lag_indices, _no_lags, ergodicity_breaking, readonly
 from .errors import shown
 
 if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but stay light
@@ -85,57 +84,6 @@ if TYPE_CHECKING:  # for the hints only: scene imports nothing from here, but st
 # particle over a segment of its steps -- at most ~0.6 s (exact UDSBM, ~60 ns a step),
 # so Ctrl-C is prompt however few the particles and many the steps.
 _CHUNK_PARTICLE_STEPS = 10_000_000
-
-
-def _no_lags() -> ValueError:
-    """The error of a TAMSD asked of a run that accumulated none (no ``tamsd_lags``)."""
-    return ValueError(
-        "no time-averaged MSD was accumulated (the run had no tamsd_lags): ask for it "
-        "before the run, with langevin.run(..., tamsd_lags=[...]) -- lags in time, whole "
-        "steps of dt, at most t_stop (e.g. tamsd_lags=[dt, 10 * dt, 100 * dt])"
-    )
-
-
-def _lag_indices(
-    available: NDArray[np.float64], dt: float, lags: ArrayLike | None, lag_samples: ArrayLike | None
-) -> NDArray[np.intp]:
-    """Indices into ``available`` (lags in time, whole multiples of ``dt``) of the lags
-    asked for: all of them when neither ``lags`` (in time) nor ``lag_samples`` (in steps)
-    is given.  An engine that accumulates the TAMSD on the fly has it at those lags
-    only, so any other lag is refused by name, with the nearest that were accumulated."""
-    if lags is not None and lag_samples is not None:
-        raise TypeError("give at most one of lags (in time) and lag_samples (in steps)")
-    have = np.rint(np.asarray(available, dtype=np.float64) / dt).astype(np.int64)
-    if len(have) == 0:
-        raise _no_lags()
-    if lags is None and lag_samples is None:
-        return np.arange(len(have))
-    if lag_samples is not None:
-        k = np.atleast_1d(np.asarray(lag_samples))
-        if k.size and not np.issubdtype(k.dtype, np.integer):
-            if not np.all(np.isfinite(k)) or np.any(k != np.rint(k)):
-                raise ValueError(f"lag_samples must be whole numbers of steps, got {shown(k)}")
-        k = k.astype(np.int64).reshape(-1)
-    else:
-        t = np.atleast_1d(np.asarray(lags, dtype=np.float64)).reshape(-1)
-        k = np.rint(t / dt).astype(np.int64) if np.all(np.isfinite(t)) else np.full(t.shape, -1)
-        off = ~np.isclose(t, k * dt, rtol=1e-9, atol=0.0)
-        k[off] = -1  # not a whole number of steps: never accumulated
-    pos = np.searchsorted(have, k)
-    found = (pos < len(have)) & (have[np.minimum(pos, len(have) - 1)] == k)
-    if not np.all(found):
-        miss = int(np.argmin(found))
-        asked = (np.asarray(lag_samples) if lags is None else np.asarray(lags)).reshape(-1)[miss]
-        # the accumulated lags on either side of the one asked for
-        at = np.searchsorted(have, (asked if lags is None else asked / dt))
-        near = np.unique(have[[max(at - 1, 0), min(at, len(have) - 1)]])
-        unit, scale = (" steps", 1) if lags is None else ("", dt)
-        raise ValueError(
-            f"lag {shown(asked)}{unit} was not accumulated: the engine keeps the TAMSD only "
-            f"at the lags given to run(tamsd_lags=...); the nearest of those: "
-            f"{' and '.join(shown(k * scale) for k in near)}{unit} (all: {shown(have * scale)})"
-        )
-    return pos
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -230,7 +178,7 @@ class LangevinResult:
         Notes
         -----
         Used as an array, ``result.msd`` is still the (T,) MSD, with a FutureWarning: that
-        use goes in granular ``REMOVAL_VERSION``."""
+        use goes in granular 0.3.0."""
         if particles is None:
             return self.msd_per_dimension if per_dimension else self.msd_total
         if self.positions is None:
@@ -277,7 +225,7 @@ class LangevinResult:
         Notes
         -----
         Used as an array, ``result.tamsd`` is still the (L,) TAMSD, with a FutureWarning:
-        that use goes in granular ``REMOVAL_VERSION``."""
+        that use goes in granular 0.3.0."""
         pick = _lag_indices(self.tamsd_lags, self.dt, lags, lag_samples)
         if particles is None and not per_particle:
             return self.tamsd_mean[pick]
@@ -296,14 +244,12 @@ class LangevinResult:
 
         It used to be the temperature per unit mass, ``v2 / dim``; the numbers
         differ only for a mass other than 1 (a ``from_scene`` run of heavier or lighter
-        particles), which warns (FutureWarning) until granular ``REMOVAL_VERSION``."""
+        particles), which warns (FutureWarning) until granular 0.3.0."""
         if self.mass != 1.0:
-            warnings.warn(
+            deprecated(
                 f"LangevinResult.temperature is an energy now, mass * v2 / dim with this "
-                f"run's mass {shown(self.mass)}; it used to be per unit mass, which is "
-                f"result.v2 / result.dim.  This notice goes in granular {REMOVAL_VERSION}",
-                FutureWarning,
-                stacklevel=2,
+                f"run's mass {shown(self.mass)}; the temperature per unit mass it used to be",
+                "that is result.v2 / result.dim",
             )
         return self._temperature()
 
@@ -396,10 +342,7 @@ class LangevinResult:
         ----------
         lags, lag_samples, particles : as in ``tamsd``.
         """
-        from . import analysis
-
-        per = self.tamsd(lags, lag_samples=lag_samples, particles=particles, per_particle=True)
-        return analysis.ergodicity_breaking(per)
+        return ergodicity_breaking(self, lags, lag_samples, particles)
 
     def theory_ergodicity_breaking(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected EB of this run's TAMSD estimator (its window starts, every

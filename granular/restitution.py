@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core
+from ._params import check_positive
 
 # The engine owns the laws (csrc/restitution.h): their kind numbers, the viscoelastic
 # series' coefficients and range and the largest table are read from it, never copied.
@@ -45,18 +46,6 @@ C2: float = _core.VISCO_C2
 DELTA_MAX: float = _core.VISCO_DELTA_MAX
 # A table of at most this many points.
 TABLE_MAX: int = _core.LAW_TABLE_MAX
-
-
-def _positive(value: Any, name: str) -> float:
-    from .errors import shown
-
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a number, got {shown(value)}") from None
-    if not (x > 0 and math.isfinite(x)):
-        raise ValueError(f"{name} must be positive and finite, got {shown(value)}")
-    return x
 
 
 class RestitutionLaw(abc.ABC):
@@ -189,8 +178,8 @@ class Viscoelastic(RestitutionLaw):
     """
 
     def __init__(self, damping: float, kappa: float) -> None:
-        self.damping = _positive(damping, "damping (A)")
-        self.kappa = _positive(kappa, "kappa")
+        self.damping = check_positive("damping", damping, "the dissipative constant A")
+        self.kappa = check_positive("kappa", kappa, "the elastic constant kappa")
         self.scale = self.damping * self.kappa**0.4
         if not (self.scale > 0 and math.isfinite(self.scale)):
             raise ValueError(
@@ -224,9 +213,9 @@ class Viscoelastic(RestitutionLaw):
         ValueError
             If a parameter is out of range, or together they put kappa outside float64.
         """
-        y = _positive(young, "young")
-        r = _positive(radius, "radius")
-        m = _positive(mass, "mass")
+        y = check_positive("young", young, "Young's modulus")
+        r = check_positive("radius", radius, "each sphere's radius")
+        m = check_positive("mass", mass, "each sphere's mass")
         nu = float(poisson)
         if not -1.0 < nu <= 0.5:
             from .errors import shown
@@ -269,7 +258,7 @@ class Viscoelastic(RestitutionLaw):
         ValueError
             If restitution lies outside the series' range or speed is not positive.
         """
-        v = _positive(speed, "speed")
+        v = check_positive("speed", speed, "the impact speed at which restitution is given")
         e = float(restitution)
         lowest = 1.0 - C1 * DELTA_MAX + C2 * DELTA_MAX**2
         if not lowest <= e < 1.0:

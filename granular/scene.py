@@ -11,6 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _core, _edmd, gsd_io
+from ._params import check_positive
 from ._scales import SCALE_HI, SCALE_LO, check_range
 from ._scene_params import BOUNDARIES, NAMES, PARAMETERS, SIGNATURE, engine_keywords, real
 from ._scene_params import box_corners as _box_corners
@@ -41,8 +42,8 @@ BIG_RATIO: float = _core.BIG_RATIO
 
 # The collision arithmetic (csrc/collide.h) squares lengths, speeds and length x speed (the
 # contact-time quadratic) and multiplies a squared length by a mass (the impulse): each is
-# kept within granular._scales' range.
-_SCALE_LO, _SCALE_HI = SCALE_LO, SCALE_HI
+# kept within granular._scales' range (SCALE_LO to SCALE_HI).
+#
 # Coordinates must resolve a diameter far more finely than the engine's overlap
 # tolerance (a relative 1e-10 of the contact distance, csrc/validate.c): at most this
 # fraction of the smallest diameter per float64 step at the box's farthest corner.
@@ -64,15 +65,15 @@ def _check_range(name, value, lo, hi):
 @np.errstate(over="ignore", under="ignore")
 def _check_scales(radii, masses, velocities, lower, upper):
     """Refuse a scene whose scales would under- or overflow the collision formulas, or
-    whose coordinates cannot resolve its smallest diameter (see _SCALE_LO, _RESOLUTION)."""
+    whose coordinates cannot resolve its smallest diameter (see SCALE_LO, _RESOLUTION)."""
     # NumPy scalars: a product past float64 becomes inf (refused below), not OverflowError
     sigma_min, sigma_max = 2.0 * radii.min(), 2.0 * radii.max()
     m_min, m_max = masses.min(), masses.max()
     edge = np.max(upper - lower)
-    lo2, hi2 = _SCALE_LO**2, _SCALE_HI**2
-    _check_range("the smallest diameter", sigma_min, _SCALE_LO, _SCALE_HI)
-    _check_range("the largest diameter", sigma_max, _SCALE_LO, _SCALE_HI)
-    _check_range("the longest box edge", edge, _SCALE_LO, _SCALE_HI)
+    lo2, hi2 = SCALE_LO**2, SCALE_HI**2
+    _check_range("the smallest diameter", sigma_min, SCALE_LO, SCALE_HI)
+    _check_range("the largest diameter", sigma_max, SCALE_LO, SCALE_HI)
+    _check_range("the longest box edge", edge, SCALE_LO, SCALE_HI)
     _check_range("the smallest mass", m_min, lo2, hi2)
     _check_range("the largest mass", m_max, lo2, hi2)
     _check_range(
@@ -83,10 +84,10 @@ def _check_scales(radii, masses, velocities, lower, upper):
     )
     v_max = np.max(np.abs(velocities))
     # Speeds only from above: a gas too slow to resolve a contact in float64 (a diameter
-    # times its speeds below _SCALE_LO) is a valid state, e.g. one that inelastic walls
+    # times its speeds below SCALE_LO) is a valid state, e.g. one that inelastic walls
     # cooled; Simulation.run refuses to advance it (FrozenGasError).
-    _check_range("the largest speed", v_max, 0.0, _SCALE_HI)
-    _check_range("the longest box edge times the largest speed", edge * v_max, 0.0, _SCALE_HI)
+    _check_range("the largest speed", v_max, 0.0, SCALE_HI)
+    _check_range("the longest box edge times the largest speed", edge * v_max, 0.0, SCALE_HI)
     _check_range("the largest mass times speed squared", m_max * v_max**2, 0.0, hi2)
     far = float(max(np.max(np.abs(lower)), np.max(np.abs(upper))))
     step = float(np.spacing(far))
@@ -101,9 +102,9 @@ def _check_scales(radii, masses, velocities, lower, upper):
 
 def frozen_energy(radii, masses):
     """Total kinetic energy below which the speeds times the smallest diameter fall below
-    _SCALE_LO, where the contact-time arithmetic underflows and pairs would pass through
+    SCALE_LO, where the contact-time arithmetic underflows and pairs would pass through
     each other (speeds estimated with the largest mass, to be safe)."""
-    speed = _SCALE_LO / (2.0 * float(np.min(radii)))
+    speed = SCALE_LO / (2.0 * float(np.min(radii)))
     return 0.5 * len(radii) * float(np.max(masses)) * speed * speed
 
 
@@ -321,12 +322,8 @@ class Scene:
             raise ValueError(f"n must be >= 1, got {n}")
         if speed is not None and temperature is not None:
             raise ValueError("give speed or temperature, not both")
-        radii = np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,)).copy()
-        if not np.all(radii > 0) or not np.all(np.isfinite(radii)):
-            raise ValueError("radius must be positive and finite")
-        masses = np.broadcast_to(np.asarray(mass, dtype=np.float64), (n,)).copy()
-        if not np.all(masses > 0) or not np.all(np.isfinite(masses)):
-            raise ValueError("mass must be positive and finite")
+        radii = np.broadcast_to(check_positive("radius", radius), (n,)).astype(np.float64)
+        masses = np.broadcast_to(check_positive("mass", mass), (n,)).astype(np.float64)
         lo, hi = _box_corners(box, dim)
         if boundary not in BOUNDARIES:
             raise ValueError(f"boundary must be one of {BOUNDARIES}, got {boundary!r}")
@@ -427,14 +424,14 @@ class Scene:
                 seed=seed,
             )
         r, m, lo, hi = 0.1, 1.0, np.full(2, -3.0), np.full(2, 3.0)
-        big_r = 5.0 * r if tracer_radius is None else float(tracer_radius)
-        if not (big_r > 0 and math.isfinite(big_r)):
-            raise ValueError(f"tracer_radius must be positive and finite, got {tracer_radius}")
+        big_r = 5.0 * r if tracer_radius is None else check_positive("tracer_radius", tracer_radius)
         if big_r >= 3.0:
             raise ValueError(f"tracer_radius = {big_r:g} does not fit between the walls at +-3")
-        big_m = m * (big_r / r) ** 2 if tracer_mass is None else float(tracer_mass)
-        if not (big_m > 0 and math.isfinite(big_m)):
-            raise ValueError(f"tracer_mass must be positive and finite, got {tracer_mass}")
+        big_m = (
+            m * (big_r / r) ** 2
+            if tracer_mass is None
+            else check_positive("tracer_mass", tracer_mass)
+        )
         ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
         rng_pos, rng_vel, rng_tracer = (np.random.default_rng(s) for s in ss.spawn(3))
         radii = np.full(150, r)

@@ -142,6 +142,8 @@ class Simulation:
             the state also as a Scene and against its initial scene's energy and
             momentum), or was written by another granular version or engine layout (a
             run continues bit for bit only in the version that saved it).
+        FileNotFoundError, PermissionError
+            If there is no file at ``path`` or it may not be read (as ``open`` says it).
         """
         return checkpoint.load(path, cls)
 

@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import gsd_io
-from ._results import readonly
+from ._results import ergodicity_breaking, readonly
 from ._scene_params import RUN_PARAMETERS
 from .scene import Scene
 
@@ -319,10 +319,7 @@ class Trajectory:
         ----------
         lags, lag_samples, particles : as in ``tamsd``.
         """
-        from . import analysis
-
-        per = self.tamsd(lags, lag_samples=lag_samples, particles=particles, per_particle=True)
-        return analysis.ergodicity_breaking(per)
+        return ergodicity_breaking(self, lags, lag_samples, particles)
 
     def structure_factor(self, n_max: float = 2.0) -> Any:
         """Density structure factor S(k, t) at the box's smallest wave vectors, per ``|k|``

@@ -11,6 +11,7 @@ was saved and loaded at the same point: no tolerance is involved, a single diffe
 event order or rounding shows."""
 
 import copy
+import io
 import json
 import math
 import os
@@ -349,8 +350,13 @@ def test_truncated_corrupt_and_foreign_files_are_refused(saved, tmp_path):
     np.savez(other, meta=np.array(json.dumps({"format": "something else"})))
     with pytest.raises(CheckpointError, match="not a granular checkpoint"):
         Simulation.load(other)
-    with pytest.raises(CheckpointError, match="cannot read"):
+    # a missing or unreadable file is the OSError open() gives, as granular.read does
+    with pytest.raises(FileNotFoundError):
         Simulation.load(tmp_path / "missing.ckpt")
+    with pytest.raises(FileNotFoundError):
+        granular.read(tmp_path / "missing.gsd")
+    with pytest.raises(CheckpointError, match="not a regular file"):
+        Simulation.load(tmp_path)  # a directory
     with zipfile.ZipFile(tmp_path / "empty.npz", "w"):
         pass
     with pytest.raises(CheckpointError):
@@ -576,7 +582,7 @@ def test_a_state_that_cannot_continue_is_not_saved(tmp_path):
 # -- files get the permissions a plain open() gives ---------------------------------------
 
 
-@pytest.mark.parametrize("umask", [0o022, 0o077])
+@pytest.mark.parametrize("umask", [0o022, 0o027])
 def test_files_get_the_permissions_a_plain_open_gives(umask, tmp_path):
     """Checkpoints and an ensemble's run files (both written by _files.write_atomic) are
     readable by whom the user's umask lets read a file: 0o666 less the umask for a new
@@ -611,7 +617,9 @@ def test_a_gsd_file_given_to_load_and_a_checkpoint_given_to_read_are_named(saved
     Simulation.load; a lone .npy names numpy.load."""
     gsd = tmp_path / "run.gsd"
     gsd.write_bytes(b"\xdf\x65\xdf\x65\xdf\x65\xdf\x65" + bytes(200))  # GSD's magic number
-    with pytest.raises(CheckpointError, match=r"GSD trajectory file .*granular\.read") as exc:
+    with pytest.raises(
+        CheckpointError, match=r"'.*run\.gsd' .* GSD trajectory file .*granular\.read"
+    ) as exc:
         Simulation.load(gsd)
     assert "pickle" not in str(exc.value)
     npy = tmp_path / "a.npy"
@@ -620,8 +628,11 @@ def test_a_gsd_file_given_to_load_and_a_checkpoint_given_to_read_are_named(saved
         Simulation.load(npy)
     ck_file = tmp_path / "ck.npz"
     ck_file.write_bytes(saved)
-    with pytest.raises(ValueError, match=r"not a GSD .*Simulation\.load"):
+    # each reader's own error class, as the docs promise for a bad file
+    with pytest.raises(granular.GSDFileError, match=r"'.*ck\.npz' is not a GSD .*Simulation\.load"):
         granular.read(ck_file)
+    with pytest.raises(granular.GSDFileError, match=r"not a GSD .*Simulation\.load"):
+        Scene.from_gsd(ck_file)
 
 
 # -- damaged and crafted archives: CheckpointError, and no more read than the state needs --
@@ -688,6 +699,51 @@ def test_damaged_archives_raise_checkpoint_error_only(saved, tmp_path):
     with pytest.raises(CheckpointError, match="not a regular file"):
         Simulation.load("/dev/zero")
     refused(_zip(dict(members, extra=b"x")), "a checkpoint holds exactly")
+
+
+def test_checkpoints_and_run_files_are_read_by_one_set_of_rules(saved, tmp_path):
+    """The rules of granular/_npz.py, which the run files' reader has too: a FIFO is
+    refused, not waited on for a writer; an .npy member of a version np.save does not
+    write for plain arrays (3.0), or in Fortran order, is refused."""
+    import threading
+
+    fifo = tmp_path / "fifo.npz"
+    os.mkfifo(fifo)
+    got = []
+
+    def load():
+        try:
+            Simulation.load(fifo)
+        except (CheckpointError, OSError) as exc:
+            got.append(exc)
+
+    reader = threading.Thread(target=load, daemon=True)
+    reader.start()
+    reader.join(timeout=30)
+    if reader.is_alive():  # blocked in open(): give it a writer, so that it ends
+        with open(fifo, "wb"):
+            pass
+        reader.join(timeout=30)
+        pytest.fail("Simulation.load waited on a FIFO for a writer")
+    assert isinstance(got[0], CheckpointError) and "not a regular file" in str(got[0]), got
+    members = _zip_members(saved)
+    path = tmp_path / "bad.npz"
+    v2 = io.BytesIO()
+    radii = np.load(io.BytesIO(members["scene_radii.npy"]))
+    header = np.lib.format.header_data_from_array_1_0(radii)
+    np.lib.format.write_array_header_2_0(v2, header)
+    v3 = bytearray(v2.getvalue())
+    v3[6] = 3  # the same header as version 3.0 (UTF-8 where 2.0 is Latin-1: the same bytes)
+    path.write_bytes(_zip(dict(members, **{"scene_radii.npy": bytes(v3) + radii.tobytes()})))
+    with pytest.raises(CheckpointError, match=r"scene_radii\.npy: \.npy version \(3, 0\)"):
+        Simulation.load(path)
+    # the same header as version 2.0 is read: only the version differs
+    path.write_bytes(_zip(dict(members, **{"scene_radii.npy": v2.getvalue() + radii.tobytes()})))
+    Simulation.load(path)
+    fortran = dict(header, fortran_order=True)
+    path.write_bytes(_zip(dict(members, **{"scene_radii.npy": _npy(fortran, radii.tobytes())})))
+    with pytest.raises(CheckpointError, match="Fortran-ordered"):
+        Simulation.load(path)
 
 
 def test_an_extra_deflated_member_is_refused_unread(saved, tmp_path):

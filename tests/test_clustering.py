@@ -403,6 +403,10 @@ def test_effective_restitution_is_the_energy_weighted_thermal_mean():
     )
     with pytest.raises(ValueError, match="temperatures > 0"):
         clustering.effective_restitution(law, 0.0)
+    # A long series of temperatures is shown by its first entries, not in full.
+    with pytest.raises(ValueError, match=r"got T = \[0, 1, .*\(100000 in all\)\]") as err:
+        clustering.effective_restitution(law, np.arange(100000.0))
+    assert len(str(err.value)) < 300
 
 
 def test_no_warning_for_a_restitution_that_is_not_a_number():

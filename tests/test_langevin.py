@@ -505,6 +505,12 @@ def test_from_scene_uses_the_thesis_coefficients():
     "kwargs,match",
     [
         (dict(gamma0=-1.0), "gamma0 must be positive"),
+        # named with its meaning, as theory names it
+        (
+            dict(D0=-1.0),
+            r"^D0 must be positive and finite, got -1 \(D0: diffusivity per dimension at t = 0\)",
+        ),
+        (dict(mass=0.0), r"mass must be positive and finite, got 0 \(mass: particle mass\)"),
         (dict(dt=0.0), "dt must be positive"),
         (dict(t_stop=float("nan")), "t_stop must be positive"),
         (dict(model="brownian"), "model must be one of"),

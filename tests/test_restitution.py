@@ -453,7 +453,7 @@ def test_describe_refuses_a_law_it_cannot_write():
         (lambda: Viscoelastic(-0.1, 1.0), "damping"),
         (lambda: Viscoelastic(0.0, 1.0), "damping"),
         (lambda: Viscoelastic(float("nan"), 1.0), "damping"),
-        (lambda: Viscoelastic(0.1, -2.0), "kappa"),
+        (lambda: Viscoelastic(0.1, -2.0), r"kappa .*, got -2 \(kappa: the elastic constant"),
         (lambda: Viscoelastic(0.1, float("inf")), "kappa"),
         (lambda: Viscoelastic.from_material(1e3, 0.7, 0.1, 1.0, 1.0), "poisson"),
         (lambda: Viscoelastic.from_restitution(0.5, 1.0), r"\[0.7615, 1\)"),

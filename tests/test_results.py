@@ -318,7 +318,9 @@ def test_temperature_is_an_energy_on_every_result():
         sample_times=[0.0, 0.1, 0.2],
     )
     sde = model(seed=1)
-    with pytest.warns(FutureWarning, match=r"an energy now.*result\.v2 / result\.dim.*0\.3\.0"):
+    with pytest.warns(
+        FutureWarning, match=r"an energy now.*removed in .*0\.3\.0; .*result\.v2 / result\.dim"
+    ):
         sde_t = sde.temperature
     edmd = granular.Simulation(scene).run(**run)
     ensembles = [

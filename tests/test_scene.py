@@ -210,7 +210,7 @@ def make(**changes):
         ),
         (dict(positions=[[np.nan, 0.2], [0.6, 0.6]]), ValueError, "NaN"),
         (dict(velocities=[[np.inf, 0], [0, 1]]), ValueError, "NaN or infinity"),
-        (dict(radii=[0.1, -0.1]), ValueError, "radii must be positive"),
+        (dict(radii=[0.1, -0.1]), ValueError, r"radii must .*, got -0.1 in the array \(index 1\)"),
         (dict(radii=[0.1, 0.0]), ValueError, "radii must be positive"),
         (dict(masses=[1.0, 0.0]), ValueError, "masses must be positive"),
         (dict(restitution=1.5), ValueError, "restitution must lie in"),

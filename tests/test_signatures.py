@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from granular import Scene, _deprecation, _params, theory
+from granular.errors import shown
 
 pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 
@@ -211,19 +212,19 @@ def test_the_valid_values_are_valid(name, f):
 
 @pytest.mark.parametrize("f, name, bad", list(_cases()))
 def test_an_impossible_value_is_refused_by_name(f, name, bad):
-    with pytest.raises(ValueError, match=rf"^{name} must .*, got {re.escape(repr(bad))}"):
+    with pytest.raises(ValueError, match=rf"^{name} must .*, got {re.escape(shown(bad))}"):
         _call(f, **{name: bad})
 
 
 def test_a_bad_element_of_an_array_is_named():
     t = np.array([0.0, 1.0, -2.0])
-    with pytest.raises(ValueError, match=r"^t must be >= 0 and finite, got -2.0 in the array"):
+    with pytest.raises(ValueError, match=r"^t must be >= 0 and finite, got -2 in the array"):
         theory.msd_granular(t, D0=0.07, gamma0=9.26, tau0=10.0)
 
 
 def test_the_issue_examples():
     # a negative D0 gave a negative MSD; a negative radius blamed the packing fraction
-    with pytest.raises(ValueError, match=r"^D0 must be positive and finite, got -1.0"):
+    with pytest.raises(ValueError, match=r"^D0 must be positive and finite, got -1 \(D0: "):
         theory.msd_granular(1.0, D0=-1.0, gamma0=9.26, tau0=10.0)
     with pytest.raises(ValueError, match=r"^radius must be positive and finite, got -0.025"):
         theory.langevin_coefficients(
@@ -318,6 +319,22 @@ def test_old_and_new_names_together_are_refused():
         theory.haff_tau0(density=1000, radius=0.025, xi=0.8, restitution=0.8, temperature0=0.66)
     with pytest.raises(TypeError, match="multiple values for radius"):
         theory.haff_tau0(1000, 0.025, radius=0.025, restitution=0.8, temperature0=0.66)
+
+
+def test_too_many_positional_arguments_say_how_many_are_taken():
+    # the deprecated positional form takes up to the old signature's count, not the new one's
+    n_old = len(theory.haff_tau0.old_positional)
+    with pytest.raises(
+        TypeError,
+        match=rf"^haff_tau0\(\) takes at most {n_old} positional arguments \(deprecated: pass "
+        r"them by keyword\) but 8 were given",
+    ):
+        theory.haff_tau0(1000, 0.025, 0.8, 0.66, 2, 1.0, 3, 4)
+
+
+def test_a_missing_argument_names_the_function():
+    with pytest.raises(TypeError, match=r"^udsbm_increment_msd\(\) missing a required argument"):
+        theory.udsbm_increment_msd(0.5, D0=0.07, gamma0=9.26, tau0=10.0)
 
 
 def test_the_old_plot_call_warns_and_draws_the_same():
