@@ -37,6 +37,14 @@ them, its CPU time over the same span read from /proc: its setup (8 s at N = 1e6
 snapshot are not timed.  granular then runs the same number of pair collisions in one
 window after building and equilibrating the gas, which is not timed either
 (bench.edmd_workload with one window; wall and CPU time of that window).
+
+`--process-cpu` times the whole processes instead, as a harness outside the project did:
+the other code's whole run (CPU time at its exit, its set-up and final snapshot included)
+against granular in a fresh interpreter started from the other code's own init.sph, run for
+the same number of pair collisions, its Python start-up (the interpreter, NumPy, granular,
+reading the file, the scene's checks) included, which weighs on short runs (measured in
+docs/performance.md).  The windows give the engines' cost per collision, the whole
+processes that of a job of this length.
 """
 
 import argparse
@@ -44,6 +52,7 @@ import math
 import os
 import re
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -91,11 +100,13 @@ def _cpu_seconds(pid):
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
-def run_other(directory, eta):
+def run_other(directory, eta, whole=False):
     """Run ./md in directory, line-buffered; (pair collisions, wall seconds, CPU seconds)
     between its first and its last report ("Simtime: t, Collisions: c, ..."), so that
     neither its setup (8 s at N = 1e6) nor its final snapshot is timed, as granular's setup
-    is not."""
+    is not; with `whole`, of the whole process instead (its CPU time at exit), the pair
+    collisions being those of its last report."""
+    start = time.perf_counter()
     proc = subprocess.Popen(
         ["stdbuf", "-oL", "./md"], cwd=directory, stdout=subprocess.PIPE, text=True
     )
@@ -106,14 +117,59 @@ def run_other(directory, eta):
             packing = float(m.group(1))
         elif m := re.match(r"Simtime:\s*[0-9.e+-]+,\s*Collisions:\s*(\d+)", line):
             reports.append((now, _cpu_seconds(proc.pid), int(m.group(1))))
-    if proc.wait() != 0:
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - start
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
         raise RuntimeError(f"{directory}: ./md exited with status {proc.returncode}")
     if packing is None or abs(packing - eta) > 1e-3:
         raise RuntimeError(f"{directory}: packing fraction {packing}, not the workload's {eta}")
     if len(reports) < 2:
         raise RuntimeError(f"{directory}: fewer than two 'Simtime: ..., Collisions: ...' lines")
     (t0, cpu0, c0), (t1, cpu1, c1) = reports[0], reports[-1]
+    if whole:
+        return c1, wall, usage.ru_utime + usage.ru_stime
     return c1 - c0, t1 - t0, cpu1 - cpu0
+
+
+# granular's side of --process-cpu, run in a fresh interpreter: argv = init.sph, pair
+# collisions; prints the pair collisions it ran.  The radii are scaled by 1 - 2e-6: the
+# other code writes 12 digits, and two spheres in contact then overlap by ~3e-8 of the box,
+# which granular's scene check refuses.
+GRANULAR_PROCESS = """
+import sys
+import numpy as np
+from granular import Scene, Simulation
+with open(sys.argv[1]) as f:
+    n = int(f.readline())
+    box = float(f.readline().split()[0])
+    rows = [f.readline().split() for _ in range(n)]
+xyz = np.mod(np.array([[float(v) for v in r[1:4]] for r in rows]) / box, 1.0)
+radii = np.array([float(r[4]) for r in rows]) / box * (1.0 - 2e-6)
+v = np.random.default_rng(0).normal(size=xyz.shape)
+scene = Scene(positions=xyz, radii=radii, velocities=v - v.mean(axis=0), box=1.0)
+sim = Simulation(scene)
+sim.run(stop_when={"collisions_per_particle": 2.0 * int(sys.argv[2]) / n}, store=())
+print(sim.stats["pair_collisions"])
+"""
+
+
+def run_granular_process(directory, pairs):
+    """granular as a whole process (--process-cpu): a fresh interpreter starts from the
+    other code's init.sph in directory and runs `pairs` pair collisions; (pair collisions,
+    wall seconds, CPU seconds) of the whole process, start-up included."""
+    start = time.perf_counter()
+    proc = subprocess.Popen(
+        [sys.executable, "-c", GRANULAR_PROCESS, os.path.join(directory, "init.sph"), str(pairs)],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    out = proc.stdout.read()
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - start
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise RuntimeError(f"granular from {directory}/init.sph exited with status {status}")
+    return int(out.split()[-1]), wall, usage.ru_utime + usage.ru_stime
 
 
 # What the other code prints, for --tiny: its packing fraction, then a report a step.
@@ -130,7 +186,11 @@ done
 PAIRS = {}
 
 
-def run_granular(name, n, pairs):
+def run_granular(name, n, pairs, directory=None):
+    """granular's side: one timed window after building and equilibrating the gas, or with
+    `directory` (--process-cpu) a whole process from the other code's init.sph there."""
+    if directory is not None:
+        return run_granular_process(directory, pairs)
     _, eta, _ = WORKLOADS[name]
     r = edmd_workload(name, 3, n, eta, 2.0 * pairs / n, windows=1)
     return r["pair_collisions"], r["seconds"], r["cpu_seconds"]
@@ -149,6 +209,12 @@ def main():
     )
     p.add_argument("--repeats", type=int, default=2)
     p.add_argument("--plot", metavar="FILE", help="also chart the figures into FILE (PNG)")
+    p.add_argument(
+        "--process-cpu",
+        action="store_true",
+        help="time whole processes, start-up included, granular from the other code's "
+        "init.sph (as an outside harness did); default: both codes' timed windows",
+    )
     p.add_argument(
         "--write-init",
         nargs=3,
@@ -177,6 +243,15 @@ def main():
             if pairs != 3000 or not 0.0 <= cpu <= 2.0 * seconds + 0.05 or other_n(folder) != 64:
                 raise RuntimeError(f"stand-in read as {pairs} pairs, {seconds} s, {cpu} CPU s")
             print(f"{'stand-in':14s} {'other':12s} {pairs:16d} {seconds:8.2f} {cpu:8.2f}")
+            # --process-cpu's two sides: the stand-in's whole run, granular from its init.sph
+            pairs, seconds, cpu = run_other(folder, 0.065, whole=True)
+            if pairs != 4000 or not 0.0 <= cpu <= 2.0 * seconds + 0.05:
+                raise RuntimeError(f"stand-in's whole run read as {pairs} pairs, {seconds} s")
+            pairs, seconds, cpu = run_granular(None, 64, 200, directory=folder)
+            # (no bound from wall time: importing NumPy starts a BLAS thread a core)
+            if pairs < 200 or not cpu > 0.0:
+                raise RuntimeError(f"granular's process read as {pairs} pairs, {cpu} CPU s")
+            print(f"{'tiny process':14s} {'granular':12s} {pairs:16d} {seconds:8.2f} {cpu:8.2f}")
         r = edmd_workload("3d-tiny-0.065", 3, 500, 0.065, 2.0, windows=1)
         print(f"{r['name']:14s} {'granular':12s} {r['pair_collisions']:16d} {r['seconds']:8.2f}")
         return
@@ -210,6 +285,8 @@ def main():
             flush=True,
         )
 
+    if args.process_cpu:
+        print("whole processes timed, start-up included; granular from the other's init.sph")
     print(
         f"{'round':>5s} {'workload':14s} {'N':>8s} {'code':12s} {'pair collisions':>16s} "
         f"{'wall s':>8s} {'CPU s':>8s} {'M/s':>7s} {'load':>6s}"
@@ -220,13 +297,14 @@ def main():
             # during a round favours neither code; granular runs the other's N and pair
             # count (in odd rounds the count of its previous run: granular goes first)
             eta = WORKLOADS[name][1]
+            whole = others[name] if args.process_cpu else None
             if round_ % 2 == 0:
-                other = run_other(others[name], eta)
-                mine = run_granular(name, sizes[name], other[0])
+                other = run_other(others[name], eta, whole=args.process_cpu)
+                mine = run_granular(name, sizes[name], other[0], directory=whole)
                 order = (("Smallenburg", other), ("granular", mine))
             else:
-                mine = run_granular(name, sizes[name], PAIRS.get(name) or 2_000_000)
-                other = run_other(others[name], eta)
+                mine = run_granular(name, sizes[name], PAIRS.get(name) or 2_000_000, whole)
+                other = run_other(others[name], eta, whole=args.process_cpu)
                 order = (("granular", mine), ("Smallenburg", other))
             for code, (pairs, seconds, cpu) in order:
                 report(round_, name, code, pairs, seconds, cpu)
