@@ -44,7 +44,10 @@ against granular in a fresh interpreter started from the other code's own init.s
 the same number of pair collisions, its Python start-up (the interpreter, NumPy, granular,
 reading the file, the scene's checks) included, which weighs on short runs (measured in
 docs/performance.md).  The windows give the engines' cost per collision, the whole
-processes that of a job of this length.
+processes that of a job of this length.  Give this mode an equilibrated init.sph (the other
+code's snapshot_end.sph from an earlier run): from a --write-init lattice whose sites lie on
+granular's cell faces, granular's calendar starts with a bucket width near zero and its
+first 4 N events are slow (docs/performance.md).
 """
 
 import argparse
@@ -167,8 +170,9 @@ def run_granular_process(directory, pairs):
     out = proc.stdout.read()
     _, status, usage = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - start
-    if os.waitstatus_to_exitcode(status) != 0:
-        raise RuntimeError(f"granular from {directory}/init.sph exited with status {status}")
+    code = os.waitstatus_to_exitcode(status)
+    if code != 0:
+        raise RuntimeError(f"granular from {directory}/init.sph exited with status {code}")
     return int(out.split()[-1]), wall, usage.ru_utime + usage.ru_stime
 
 
