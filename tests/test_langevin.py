@@ -958,31 +958,8 @@ def test_the_engine_takes_its_arguments_by_name():
     """_core.sde_run takes every argument by name (23 numbers and arrays, many of one
     type: gamma0 and D0 swapped would run unseen): a positional call, a misspelt or a
     missing name is a TypeError naming it."""
-    x, v = np.zeros((1, 3)), np.zeros((1, 3))
-    args = dict(
-        dim=3,
-        model=0,
-        scheme=1,
-        gamma0=G0,
-        D0=D0,
-        tau0=math.inf,
-        dt=0.01,
-        key=1,
-        n=1,
-        first=0,
-        step_from=0,
-        step_to=1,
-        n_steps=1,
-        x=x,
-        v=v,
-        sample_steps=np.array([0, 1]),
-        x2=np.zeros((2, 3)),
-        v2=np.zeros((2, 3)),
-        positions=None,
-        lags=np.zeros(0, np.int64),
-        tamsd=np.zeros((1, 0)),
-        ring=np.zeros(0),
-    )
+    args = sde_reference.one_step_args(model=0, gamma0=G0, D0=D0, tau0=math.inf)
+    v = args["v"]
     _core.sde_run(**args)
     assert np.all(np.isfinite(v)) and np.any(v != 0)
     with pytest.raises(TypeError, match="positional"):

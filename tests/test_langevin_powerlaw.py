@@ -264,31 +264,7 @@ def test_bad_exponent(kwargs, match):
 
 
 def test_core_refuses_a_bad_exponent():
-    x, v = np.zeros((1, 3)), np.zeros((1, 3))
-    args = dict(
-        dim=3,
-        model=1,
-        scheme=1,
-        gamma0=G0,
-        D0=D0,
-        tau0=TAU0,
-        dt=0.01,
-        key=1,
-        n=1,
-        first=0,
-        step_from=0,
-        step_to=1,
-        n_steps=1,
-        x=x,
-        v=v,
-        sample_steps=np.array([0, 1]),
-        x2=np.zeros((2, 3)),
-        v2=np.zeros((2, 3)),
-        positions=None,
-        lags=np.zeros(0, np.int64),
-        tamsd=np.zeros((1, 0)),
-        ring=np.zeros(0),
-    )
+    args = sde_reference.one_step_args(gamma0=G0, D0=D0, tau0=TAU0)
     for bad in (0.0, -1.0, math.nan, math.inf):
         with pytest.raises(ValueError, match="exponent must be positive"):
             _core.sde_run(**args, exponent=bad)

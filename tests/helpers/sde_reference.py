@@ -234,3 +234,34 @@ def engine(
         exponent=exponent,
     )
     return positions[:, first : first + count], v, x2, tamsd[first : first + count]
+
+
+def one_step_args(**changes):
+    """Keyword arguments of ``_core.sde_run`` for one 3D particle over one exact UDSBM step
+    (fresh arrays each call), with ``changes`` applied: the base the binding's own checks
+    are tried on."""
+    args = dict(
+        dim=3,
+        model=1,
+        scheme=1,
+        gamma0=1.0,
+        D0=1.0,
+        tau0=1.0,
+        dt=0.01,
+        key=1,
+        n=1,
+        first=0,
+        step_from=0,
+        step_to=1,
+        n_steps=1,
+        x=np.zeros((1, 3)),
+        v=np.zeros((1, 3)),
+        sample_steps=np.array([0, 1]),
+        x2=np.zeros((2, 3)),
+        v2=np.zeros((2, 3)),
+        positions=None,
+        lags=np.zeros(0, np.int64),
+        tamsd=np.zeros((1, 0)),
+        ring=np.zeros(0),
+    )
+    return args | changes
