@@ -22,6 +22,9 @@ enum { GR_CQ_LIST = -1, GR_CQ_OVER = -2, GR_CQ_NONE = -3 };
 #define GR_CQ_SLOTS_PER_ID 4
 /* Key changes per id between rebuilds, at first (see rebuild()). */
 #define GR_CQ_REBUILD 4
+/* Far keys (all keys left being in the overflow list) above which the next one is found
+ * by a rebuild rather than by a walk over the list. */
+#define GR_CQ_FEW_FAR 64
 /* Keys sampled to estimate their spread when choosing the width. */
 #define GR_CQ_SAMPLE 1024
 
@@ -280,7 +283,16 @@ int32_t gr_cq_top_slow(gr_cq *q, double *t)
                 *t = INFINITY;
                 return -1;
             }
-            /* only far keys left: jump to the first of them rather than step there */
+            /* Only far keys left.  Many of them: the width is wrong for them (it was
+             * taken from keys bunched near one instant, say a lattice start whose first
+             * events are all face crossings at t ~ 0), and finding the first by a walk
+             * over the overflow list at every event would cost O(n) each.  A rebuild
+             * reads the same keys once and gives them a width from their own spread. */
+            if (q->n_over > GR_CQ_FEW_FAR) {
+                rebuild(q);
+                continue;
+            }
+            /* a few: jump to the first of them rather than step there */
             int64_t bmin = (int64_t)GR_CQ_FAR;
             for (int32_t id = q->over; id >= 0; id = q->item[id].next) {
                 int64_t b = bucket_of(q, q->item[id].t);
