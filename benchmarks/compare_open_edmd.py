@@ -45,9 +45,8 @@ the same number of pair collisions, its Python start-up (the interpreter, NumPy,
 reading the file, the scene's checks) included, which weighs on short runs (measured in
 docs/performance.md).  The windows give the engines' cost per collision, the whole
 processes that of a job of this length.  Give this mode an equilibrated init.sph (the other
-code's snapshot_end.sph from an earlier run): from a --write-init lattice whose sites lie on
-granular's cell faces, granular's calendar starts with a bucket width near zero and its
-first 4 N events are slow (docs/performance.md).
+code's snapshot_end.sph from an earlier run): both codes then start from the same
+uncorrelated state, exact N, not from a lattice that first has to melt.
 """
 
 import argparse
