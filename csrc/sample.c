@@ -19,6 +19,9 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
             if (smp->pos)
                 smp->pos[out + a] = bd_unwrap(fl_at(dyn, p[a], VEL(p, dim)[a], dt),
                                               s->image[(size_t)i * dim + a], s->L[a]);
+            if (smp->pos && a == 0 && s->le) /* boundary.h: + img_y D(t) */
+                smp->pos[out] += (double)s->image[(size_t)i * dim + 1] *
+                                 bd_le_total(s->cfg.shear_offset, s->le_u, ts);
             if (smp->vel) smp->vel[out + a] = v;
             mom[a] += m * v;
             kin += 0.5 * m * v * v;
@@ -67,6 +70,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->virial = s->virial;
     c->wall_impulse = s->wall_impulse;
     c->kinetic_time = s->kinetic_time;
+    c->shear_work = s->shear_work;
     c->kinetic = kinetic_total(s, dynamics_of(s), s->dim);
     for (int a = 0; a < 3; a++) c->ncell[a] = s->cells.nc[a];
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;

@@ -204,15 +204,25 @@ class Simulation:
 
     @property
     def scene(self) -> Scene:
-        """The current state as a new Scene (positions wrapped into a periodic box)."""
+        """The current state as a new Scene (positions wrapped into a periodic box; a
+        sheared box's image offset the one now)."""
         pos, vel, _ = self._engine.state()
-        return self._initial.replace(positions=pos, velocities=vel)
+        s = self._initial
+        if s.shear_rate != 0.0:
+            offset = shear_offset_at(s, self.time)
+            return s.replace(positions=pos, velocities=vel, shear_offset=offset)
+        return s.replace(positions=pos, velocities=vel)
 
     @property
     def unwrapped_positions(self) -> NDArray[np.float64]:
-        """(N, d) positions at the current time with periodic images undone."""
+        """(N, d) positions at the current time with periodic images undone (sheared:
+        x gains img_y times the accumulated image offset, csrc/boundary.h)."""
         pos, _, img = self._engine.state()
-        return pos + img * (self._initial.upper - self._initial.lower)
+        s = self._initial
+        out = pos + img * (s.upper - s.lower)
+        if s.shear_rate != 0.0:
+            out[:, 0] += img[:, 1] * shear_total_offset(s, self.time)
+        return out
 
     # -- running --------------------------------------------------------------------
     def run(
@@ -640,3 +650,18 @@ def _warn_clamped(count, scene):
         RuntimeWarning,
         stacklevel=3,
     )
+
+
+def shear_total_offset(scene: Scene, t: float) -> float:
+    """A sheared scene's accumulated image offset D(t) = shear_offset + shear_rate L_y t
+    [L], as the engine computes it (csrc/boundary.h bd_le_total)."""
+    return scene.shear_offset + scene.shear_rate * float(scene.upper[1] - scene.lower[1]) * t
+
+
+def shear_offset_at(scene: Scene, t: float) -> float:
+    """The image offset delta(t) = D(t) mod L_x in [0, L_x) [L] (bd_le_offset)."""
+    lx = float(scene.upper[0] - scene.lower[0])
+    d = math.fmod(shear_total_offset(scene, t), lx)
+    if d < 0.0:
+        d += lx
+    return d if d < lx else 0.0
