@@ -183,7 +183,10 @@ class Simulation:
         tc_elastic_collisions (pair collisions the TC model made elastic; a wall collision
         it made elastic is not counted), law_clamped_collisions (past a viscoelastic law's
         range, see ``granular.Viscoelastic``), virial, wall_impulse, kinetic_energy,
-        kinetic_time_integral, time, cells, shell (0: cells); and the pressure averaged over
+        kinetic_time_integral, time, cells, shell (0: cells), shear_work (the work of a
+        sheared box's sliding images, csrc/boundary.h); temperature, 2 E_kin / (d N) now,
+        in a sheared box that of the velocities less the mean flow (granular/_shear.py);
+        and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
         with the time average <E_kin>_t (exact for a cooling gas too) and W the pair
         collisions' virial.  In a periodic box V is the box volume.  In a walled box the
@@ -200,6 +203,15 @@ class Simulation:
         else:
             c["pressure"] = float("nan")
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
+        if s.shear_rate != 0.0:  # the peculiar velocities' (granular/_shear.py)
+            from ._shear import flow_temperature
+
+            pos, vel, _ = self._engine.state()
+            c["temperature"] = float(
+                flow_temperature(pos, vel, s.masses, s.lower, s.upper, s.shear_rate)
+            )
+        else:
+            c["temperature"] = 2.0 * c["kinetic_energy"] / (s.dim * s.n)
         return c
 
     @property

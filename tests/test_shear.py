@@ -245,3 +245,56 @@ def test_bad_shear_is_refused(change, match):
     s = Scene.random(10, 0.2, dim=2, box=3.0, temperature=1.0, seed=1)
     with pytest.raises(ValueError, match=match):
         s.replace(**change)
+
+
+def _with_profile(s):
+    """s with the mean flow shear_rate (y - y_c) added to its velocities along x."""
+    v = np.array(s.velocities)
+    v[:, 0] += s.shear_rate * (s.positions[:, 1] - 0.5 * (s.lower[1] + s.upper[1]))
+    return s.replace(velocities=v)
+
+
+def test_the_temperature_is_that_of_the_peculiar_velocities():
+    """Velocities that are exactly the mean flow have no temperature, in the Trajectory
+    and in stats; the plain kinetic temperature counts the flow (shear_rate^2 <(y -
+    y_c)^2> = 1/12 here, box 1, rate 1)."""
+    s = Scene.random(200, 0.02, dim=2, temperature=1.0, seed=1).replace(shear_rate=1.0)
+    s = _with_profile(s.replace(velocities=np.zeros((200, 2))))
+    sim = Simulation(s)
+    assert sim.stats["temperature"] < 1e-30
+    tr = sim.run(t_stop=0.0, sample_times=[0.0])
+    assert tr.temperature[0] < 1e-30
+    plain = 2 * tr.kinetic_energy[0] / (2 * 200)
+    assert abs(plain - 1 / 24) < 0.02  # (1/2) <v_x^2> over d = 2: 1/12 / 2
+    with pytest.raises(ValueError, match="positions and velocities"):
+        _ = sim.run(t_stop=0.1, store=()).temperature
+
+
+def test_an_inelastic_sheared_gas_reaches_a_steady_temperature():
+    """Without a thermostat the sheared inelastic gas (3D, xi = 0.7, packing 0.2) heats
+    or cools to the state where viscous heating balances collisional cooling: started
+    7 times colder and 7 times hotter than that, both runs settle (by t = 20, ~60
+    collisions per particle) to temperatures that agree, and that stay steady.  The
+    error: the temperature averaged over four blocks of 5 time units in t = 20 .. 40 of
+    each run (several relaxation times each: the runs reach the state within ~10), the
+    block-to-block spread pooled over both runs (6 degrees of freedom); tolerances are 5
+    standard errors (Student's t with 6 degrees of freedom: p = 0.0025)."""
+    n, eta, rate = 256, 0.2, 1.0
+    r = (eta / (n * 4 / 3 * math.pi)) ** (1 / 3)
+    times = np.linspace(0.0, 40.0, 161)
+    blocks = []
+    starts = []
+    for t0 in (0.001, 0.05):
+        s = Scene.random(n, r, dim=3, temperature=t0, seed=3)
+        s = _with_profile(s.replace(restitution=0.7, shear_rate=rate))
+        tr = Simulation(s).run(t_stop=40.0, sample_times=times)
+        starts.append(tr.temperature[0])
+        blocks.append(tr.temperature[times > 20.0].reshape(4, -1).mean(axis=1))
+    blocks = np.array(blocks)
+    sd = np.sqrt(((blocks - blocks.mean(axis=1, keepdims=True)) ** 2).sum() / 6)
+    cold, hot = blocks.mean(axis=1)
+    steady = 0.5 * (cold + hot)
+    assert starts[0] < steady / 5 and starts[1] > steady * 5  # far from it at the start
+    assert abs(hot - cold) < 5 * sd * math.sqrt(2 / 4)
+    early, late = blocks[:, :2].mean(), blocks[:, 2:].mean()
+    assert abs(late - early) < 5 * sd * math.sqrt(2 / 4)
