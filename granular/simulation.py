@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _edmd, checkpoint
+from . import _core, _edmd, _shear, checkpoint
 from . import restitution as _restitution
 from ._edmd import check_memory as _check_memory
 from ._scene_params import RUN_PARAMETERS
@@ -233,7 +233,10 @@ class Simulation:
         s = self._initial
         out = pos + img * (s.upper - s.lower)
         if s.shear_rate != 0.0:
-            out[:, 0] += img[:, 1] * shear_total_offset(s, self.time)
+            ly = float(s.upper[1] - s.lower[1])
+            out[:, 0] += img[:, 1] * _shear.total_offset(
+                s.shear_rate, s.shear_offset, ly, self.time
+            )
         return out
 
     # -- running --------------------------------------------------------------------
@@ -664,16 +667,9 @@ def _warn_clamped(count, scene):
     )
 
 
-def shear_total_offset(scene: Scene, t: float) -> float:
-    """A sheared scene's accumulated image offset D(t) = shear_offset + shear_rate L_y t
-    [L], as the engine computes it (csrc/boundary.h bd_le_total)."""
-    return scene.shear_offset + scene.shear_rate * float(scene.upper[1] - scene.lower[1]) * t
-
-
 def shear_offset_at(scene: Scene, t: float) -> float:
-    """The image offset delta(t) = D(t) mod L_x in [0, L_x) [L] (bd_le_offset)."""
-    lx = float(scene.upper[0] - scene.lower[0])
-    d = math.fmod(shear_total_offset(scene, t), lx)
-    if d < 0.0:
-        d += lx
-    return d if d < lx else 0.0
+    """A sheared scene's image offset delta(t) in [0, L_x) at time t [L] (csrc/boundary.h)."""
+    lengths = scene.upper - scene.lower
+    return _shear.offset(
+        scene.shear_rate, scene.shear_offset, float(lengths[0]), float(lengths[1]), t
+    )

@@ -298,3 +298,39 @@ def test_an_inelastic_sheared_gas_reaches_a_steady_temperature():
     assert abs(hot - cold) < 5 * sd * math.sqrt(2 / 4)
     early, late = blocks[:, :2].mean(), blocks[:, 2:].mean()
     assert abs(late - early) < 5 * sd * math.sqrt(2 / 4)
+
+
+def test_gsd_carries_the_sheared_box(tmp_path):
+    """A sheared run's GSD file: each frame's box has HOOMD's tilt xy = delta / L_y (the
+    image across the upper face displaced by delta, in [-L_x/2, L_x/2)), its float32
+    positions lie in that triclinic box and unwrap through its lattice vectors to the
+    run's positions (to float32's precision); read back, the Trajectory is the one
+    written and the last frame's Scene is the run's scene then, offset included."""
+    gsd = pytest.importorskip("gsd.hoomd")
+    import granular
+
+    s = _sheared(2, 0.2, 1.3, n=30, box=5.0)
+    sim = Simulation(s)
+    times = np.linspace(0.0, 2.7, 4)
+    tr = sim.run(t_stop=2.7, sample_times=times)
+    tr.write(tmp_path / "run.gsd")
+    with gsd.open(tmp_path / "run.gsd") as f:
+        for k, frame in enumerate(f):
+            lx, ly, _, xy, _, _ = frame.configuration.box
+            delta = shear_offset_at(s, times[k])
+            delta = delta - 5.0 if delta >= 2.5 else delta
+            assert xy == pytest.approx(delta / ly, rel=1e-6, abs=1e-7)
+            pos = frame.particles.position.astype(float)
+            img = frame.particles.image.astype(float)
+            frac_x = (pos[:, 0] - xy * pos[:, 1]) / lx
+            assert np.all((frac_x >= -0.5) & (frac_x < 0.5))
+            unwrapped = pos[:, 0] + img[:, 0] * lx + img[:, 1] * xy * ly + 2.5
+            np.testing.assert_allclose(unwrapped, tr.positions[k][:, 0], atol=1e-4)
+    back = granular.read(tmp_path / "run.gsd")
+    np.testing.assert_array_equal(back.positions, tr.positions)
+    assert back.scene_parameters["shear_rate"] == 1.3
+    last = Scene.from_gsd(tmp_path / "run.gsd")
+    now = sim.scene
+    assert last.shear_offset == now.shear_offset
+    np.testing.assert_allclose(last.positions, now.positions, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(last.velocities, now.velocities)
