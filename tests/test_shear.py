@@ -278,18 +278,26 @@ def test_an_inelastic_sheared_gas_reaches_a_steady_temperature():
     error: the temperature averaged over four blocks of 5 time units in t = 20 .. 40 of
     each run (several relaxation times each: the runs reach the state within ~10), the
     block-to-block spread pooled over both runs (6 degrees of freedom); tolerances are 5
-    standard errors (Student's t with 6 degrees of freedom: p = 0.0025)."""
+    standard errors (Student's t with 6 degrees of freedom: p = 0.0025).  The mean
+    velocity profile is the imposed linear one."""
     n, eta, rate = 256, 0.2, 1.0
     r = (eta / (n * 4 / 3 * math.pi)) ** (1 / 3)
     times = np.linspace(0.0, 40.0, 161)
     blocks = []
     starts = []
+    profiles = []
+    centres = (np.arange(5) + 0.5) / 5 - 0.5  # y - y_c of five bins across the box
     for t0 in (0.001, 0.05):
         s = Scene.random(n, r, dim=3, temperature=t0, seed=3)
         s = _with_profile(s.replace(restitution=0.7, shear_rate=rate))
         tr = Simulation(s).run(t_stop=40.0, sample_times=times)
         starts.append(tr.temperature[0])
-        blocks.append(tr.temperature[times > 20.0].reshape(4, -1).mean(axis=1))
+        late = times > 20.0
+        blocks.append(tr.temperature[late].reshape(4, -1).mean(axis=1))
+        y, vx = tr.positions[late][..., 1] % 1.0, tr.velocities[late][..., 0]
+        bins = np.minimum((y * 5).astype(int), 4)
+        split = np.array_split(np.arange(late.sum()), 4)
+        profiles.append([[vx[b][bins[b] == k].mean() for k in range(5)] for b in split])
     blocks = np.array(blocks)
     sd = np.sqrt(((blocks - blocks.mean(axis=1, keepdims=True)) ** 2).sum() / 6)
     cold, hot = blocks.mean(axis=1)
@@ -298,6 +306,13 @@ def test_an_inelastic_sheared_gas_reaches_a_steady_temperature():
     assert abs(hot - cold) < 5 * sd * math.sqrt(2 / 4)
     early, late = blocks[:, :2].mean(), blocks[:, 2:].mean()
     assert abs(late - early) < 5 * sd * math.sqrt(2 / 4)
+    # the mean flow: linear, rate (y - y_c) (a bin's mean is its centre's value), no
+    # banding at this size; each bin's mean over the four blocks, the block spread pooled
+    # over bins and runs (30 degrees of freedom), within 4 standard errors
+    prof = np.array(profiles)  # run, block, bin
+    spread = prof - prof.mean(axis=1, keepdims=True)
+    se = np.sqrt((spread**2).sum() / 30) / 2
+    assert np.all(np.abs(prof.mean(axis=1) - rate * centres) < 4 * se)
 
 
 def test_gsd_carries_the_sheared_box(tmp_path):
