@@ -349,3 +349,28 @@ def test_gsd_carries_the_sheared_box(tmp_path):
     assert last.shear_offset == now.shear_offset
     np.testing.assert_allclose(last.positions, now.positions, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(last.velocities, now.velocities)
+
+
+def test_the_animation_draws_particles_through_the_sliding_images():
+    """plot.animate of a sheared run: each frame's disks at the positions brought into the
+    box through the sliding images at its time (not by folding x alone, which is off by
+    img_y D(t)), and a disk's image across a y face displaced along x by the offset."""
+    pytest.importorskip("matplotlib")
+    from granular import _shear, plot
+
+    s = _sheared(2, 0.2, 1.3, n=30, box=5.0)
+    tr = Simulation(s).run(t_stop=4.0, sample_times=np.linspace(0.0, 4.0, 5))
+    anim = plot.animate(tr)
+    folded_wrong = 0
+    for k, si in enumerate(anim.samples):
+        anim.draw(k)
+        t = float(tr.times[si])
+        want, _ = _shear.wrap(tr.positions[si], s.lower, s.upper, 1.3, 0.0, t)
+        np.testing.assert_allclose(anim.disks.get_offsets(), want, rtol=0, atol=1e-12)
+        folded_wrong += np.sum(np.abs(np.mod(tr.positions[si][:, 0], 5.0) - want[:, 0]) > 1e-6)
+        below = np.asarray(anim.images[1].get_offsets())  # the copies across a y face
+        delta = shear_offset_at(s, t)
+        up = want[:, 1] > 2.5  # copied below: the image displaced by -delta
+        np.testing.assert_allclose(below[up, 0], np.mod(want[up, 0] - delta, 5.0), atol=1e-12)
+        np.testing.assert_allclose(below[up, 1], want[up, 1] - 5.0, atol=1e-12)
+    assert folded_wrong > 0  # particles did cross the sheared faces
