@@ -17,6 +17,12 @@ for viewers and analysis tools (OVITO, freud, MDAnalysis), good to about 7 digit
 - ``particles/velocity``, ``particles/diameter``, ``particles/mass``
 - ``configuration/box`` and ``configuration/dimensions``; ``configuration/step`` = the
   sample's index
+- a sheared box (``shear_rate`` != 0, docs/shear.md): the box's tilt ``xy = delta / L_y``
+  at the sample's time (HOOMD's lattice vector a2 = (xy L_y, L_y, 0), delta the x offset
+  of the image across the upper y face, in [-L_x/2, L_x/2)), positions inside that
+  triclinic box and images through its lattice vectors; reading back, the exact unwrapped
+  positions come into the box through the sliding images and the Scene of a frame gets
+  the offset at its time
 - 2D: ``configuration/dimensions`` = 2 and a box ``[Lx, Ly, max(Lx, Ly), 0, 0, 0]``.
   HOOMD itself writes Lz = 0 in 2D, but its readers take ``dimensions`` = 2 first and set
   Lz to 0 themselves (as for HOOMD 2's files, which kept an Lz), and gsd.hoomd does too;
@@ -573,7 +579,9 @@ def _foreign_scene(f: _File, k: int, make_scene: Any) -> Any:
         raise f.error(
             k,
             "configuration/box",
-            f"has tilts {box[3:].tolist()}: granular's boxes are rectangular",
+            f"has tilts {box[3:].tolist()}: granular's boxes are rectangular (a sheared "
+            "box's tilt is read only from the files granular writes, whose log holds the "
+            "shear)",
         )
     x = get("particles/position", (n, 3))[:, :dim]
     v = get("particles/velocity", (n, 3), 0.0)[:, :dim]

@@ -443,7 +443,9 @@ class Simulation:
         can put it past anything float64 can time) has nothing to be warned of."""
         from .clustering import unstable_box
 
-        found = unstable_box(self._initial)  # t* counts from the initial state, as time does
+        # (the homogeneous cooling state's instability: a sheared gas has no such state)
+        sheared = self._initial.shear_rate != 0.0
+        found = None if sheared else unstable_box(self._initial)  # t* from the initial state
         if found is None:
             self._clustering_checked = True
             return

@@ -374,3 +374,19 @@ def test_the_animation_draws_particles_through_the_sliding_images():
         np.testing.assert_allclose(below[up, 0], np.mod(want[up, 0] - delta, 5.0), atol=1e-12)
         np.testing.assert_allclose(below[up, 1], want[up, 1] - 5.0, atol=1e-12)
     assert folded_wrong > 0  # particles did cross the sheared faces
+
+
+def test_no_clustering_warning_for_a_sheared_box():
+    """The ClusteringWarning is about the homogeneous cooling state's shear instability; a
+    sheared gas has no cooling state, so the box that warns unsheared does not warn."""
+    import warnings
+
+    from granular.errors import ClusteringWarning
+
+    scene = Scene.random(200, 0.015, dim=2, restitution=0.7, temperature=1.0, seed=18)
+    with pytest.warns(ClusteringWarning):
+        Simulation(scene).run(stop_when={"collisions_per_particle": 30}, store=())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ClusteringWarning)
+        sheared = Simulation(scene.replace(shear_rate=1.0))
+        sheared.run(stop_when={"collisions_per_particle": 30}, store=())
