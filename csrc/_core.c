@@ -521,7 +521,7 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     if (!check_ready(self)) return NULL;
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
-    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d}", "time", c.t,
+    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d,s:d}", "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
                          (long long)c.crossings, "shell_exits", (long long)c.shell_exits,
@@ -530,7 +530,8 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
                          "law_clamped_collisions", (long long)c.law_clamped, "virial", c.virial,
                          "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic,
                          "kinetic_time_integral", c.kinetic_time, "cells",
-                         c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell);
+                         c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell,
+                         "shear_work", c.shear_work);
 }
 
 /* ---- checkpoints (csrc/checkpoint.c) ---- */

@@ -10,25 +10,27 @@
  * costs nothing and compiles the crossing prediction and the edge cells' neighbours apart
  * for it where it does (edmd.c predict_cross, cells.h cell_neighbours).
  *
- * Lees-Edwards (sliding images, for shear) comes next.  It needs here:
- *  - a time-dependent image shift: an image across the y faces is displaced along x by
- *    +-(shear rate) L_y t (taken modulo L_x) and moves with +-(shear rate) L_y along x, so
- *    bd_shift takes the axis, the time and the image along y, and the pair's relative
- *    velocity through such an image gains that speed (flight.h's fl_relvel stays the
- *    same for the other images);
- *  - bd_through_face across a y face also changes x (by the displacement) and v_x (by the
- *    speed), and the image counters then no longer give the unwrapped x alone (bd_unwrap
- *    adds the accumulated displacement, kept per particle);
- *  - the tables built once from fixed shifts -- the cells' nb_shift (cells.c) and the
- *    neighbour lists' image codes (nlist.c img) -- hold for x and z only: across y the
- *    shift is computed from the time at each use, and the x neighbours of a cell across a
- *    y face shift by a whole number of cells and a remainder (one more cell column to
- *    scan);
- *  - bd_nearest along x for a pair whose y separation goes through an image takes the
- *    displaced image. */
+ * Lees-Edwards (sliding images, for shear): a periodic box with a shear rate != 0 (edmd.h
+ * gr_edmd_config.shear_rate; flow along x, gradient along y, the only pair offered).  The
+ * image across the upper y face is displaced along x by delta(t) and moves with
+ * u = (shear rate) L_y along x; the one across the lower face by -delta(t), with -u.
+ *  - delta(t) = D(t) mod L_x with D(t) = shear_offset + u t, computed from the absolute
+ *    time at each use (bd_le_offset): no state that could drift, so a long run, a
+ *    checkpoint and its continuation all see the same bits.  Its resolution is that of
+ *    the time itself times u (the position error of a particle moving at u);
+ *  - a particle leaving through the upper face re-enters at the lower one with x - delta
+ *    and v_x - u (through the lower face: x + delta, v_x + u), edmd.c do_face_sheared;
+ *  - unwrapped x = x + img_x L_x + img_y D(t) (bd_le_unwrap): continuous through a
+ *    crossing (img_x takes the whole box lengths of D that delta drops) and it moves with
+ *    the particle's velocity in the unfolded lattice, v_x + img_y u;
+ *  - a pair whose y separation goes through an image sees the partner's x displaced by
+ *    -+delta and its v_x by -+u (bd_le_image);
+ *  - the cells across a y face slide: lees_edwards.h scans them and bounds how long a
+ *    prediction there may live (a "slide" event each time the images pass one cell). */
 #ifndef GR_BOUNDARY_H
 #define GR_BOUNDARY_H
 
+#include <math.h>
 #include <stdint.h>
 
 enum {
@@ -122,6 +124,35 @@ static inline int bd_outside(int periodic, double x, double r, double lo, double
                              double slack)
 {
     return periodic ? (x < lo || x > hi) : (x - r < lo - slack || x + r > hi + slack);
+}
+
+/* ---- Lees-Edwards (sliding images across the y faces) ---- */
+
+/* The accumulated image offset D(t) = d0 + u t (d0: the offset at time 0, u: the image
+ * speed (shear rate) L_y), and delta(t) = D(t) mod L_x in [0, L_x). */
+static inline double bd_le_total(double d0, double u, double t) { return d0 + u * t; }
+static inline double bd_le_offset(double d0, double u, double t, double Lx)
+{
+    double d = fmod(bd_le_total(d0, u, t), Lx);
+    if (d < 0.0) d += Lx;
+    return d < Lx ? d : 0.0; /* -tiny + Lx rounds to Lx */
+}
+
+/* The unwrapped x of a particle at x with image counters img_x, img_y (convention above). */
+static inline double bd_le_unwrap(double x, int64_t img_x, int64_t img_y, double Lx, double D)
+{
+    return bd_unwrap(x, img_x, Lx) + (double)img_y * D;
+}
+
+/* A pair with separation dr (q - p, already through the nearest image on each axis) and
+ * raw y separation dy_raw: the y image ky (-1, 0, 1) of q that touches p, dr[0] then
+ * moved to that image's x (displaced by ky delta, nearest along x).  q's image moves with
+ * v_x + ky u. */
+static inline int bd_le_image(double *dr, double dy_raw, double Ly, double Lx, double delta)
+{
+    const int ky = dy_raw > 0.5 * Ly ? -1 : dy_raw < -0.5 * Ly ? 1 : 0;
+    if (ky) dr[0] = bd_nearest(dr[0] + (double)ky * delta, Lx);
+    return ky;
 }
 
 #endif

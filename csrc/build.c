@@ -99,6 +99,11 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->dim = d;
     s->n = n;
     for (int a = 0; a < 3; a++) s->L[a] = a < d ? cfg->hi[a] - cfg->lo[a] : 1.0;
+    /* Lees-Edwards (boundary.h): cells only, every particle in them (the neighbour lists'
+     * and the big particles' image tables are fixed, the sliding images are not) */
+    s->le = cfg->periodic && cfg->shear_rate != 0.0;
+    const int sheared = s->le;
+    s->le_u = cfg->shear_rate * s->L[1];
     size_t bytes = ((size_t)n * GR_STRIDE(d) * sizeof(double) + 63) / 64 * 64;
     s->P = gr_big_alloc(bytes); /* records on cache-line boundaries: a 3D record is one line */
     s->mass = gr_big_alloc((size_t)n * sizeof *s->mass);
@@ -117,12 +122,13 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     double shell = cfg->shell * sigma_max;
     for (int a = 0; a < d; a++)
         if (cfg->periodic && !(s->L[a] > 2.0 * (sigma_max + 4.0 * shell))) shell = 0.0;
-    if (n >= GR_NL_MAX_N) shell = 0.0;
+    if (n >= GR_NL_MAX_N || s->le) shell = 0.0;
     if (status == GR_OK && shell > 0.0) {
         status = gr_nlist_init(&s->nl, d, n, shell, s->L);
         s->big.r_small = 0.5 * sigma_max; /* no big particles */
     } else if (status == GR_OK) {
-        status = gr_big_choose(&s->big, d, n, radius, s->L, cfg->big_ratio, cfg->cell_factor);
+        status = gr_big_choose(&s->big, d, n, radius, s->L, sheared ? INFINITY : cfg->big_ratio,
+                               cfg->cell_factor);
     }
     if (status == GR_OK)
         status = gr_cells_build(&s->cells, d, n, cfg->lo, s->L, cfg->periodic,
@@ -164,7 +170,8 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     s->t_prev_event = -INFINITY;
 
     status = gr_find_overlap(d, n, s->P, (size_t)GR_STRIDE(d), s->P + 2 * d + 1, (size_t)GR_STRIDE(d),
-                             cfg->periodic, s->L, &s->cells, &s->big, err);
+                             cfg->periodic, s->L, &s->cells, &s->big,
+                             sheared ? &cfg->shear_offset : NULL, err);
     if (status == GR_OK) status = gr_predict_all(s, err);
     if (status != GR_OK) {
         gr_edmd_free(s);

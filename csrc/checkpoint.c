@@ -194,6 +194,7 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, s->wall_impulse);
     IO(c, s->kinetic);
     IO(c, s->kinetic_time);
+    IO(c, s->shear_work);
     IO(c, s->order.next);
     IO(c, s->nl.broken);
 
@@ -390,8 +391,11 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
      * counters pass INT64_MAX / 2 more (the bound above), and the unwrapped positions
      * (pos + image L) stay those the run made. */
     const int64_t moves = b->periodic ? t->crossings + t->shell_exits : 0; /* <= INT64_MAX */
+    /* sheared: a y-face crossing also adds to img_x the box lengths in D(t) (boundary.h) */
+    const double Dmax = s->le ? fabs(bd_le_total(b->shear_offset, s->le_u, t->t)) / s->L[0] + 2.0 : 0.0;
     for (size_t k = 0; k < (size_t)n * d; k++)
-        if (t->image[k] < -moves || t->image[k] > moves)
+        if (s->le && k % (size_t)d == 0 ? !(fabs((double)t->image[k]) <= (double)moves * (Dmax + 1.0))
+                                        : (t->image[k] < -moves || t->image[k] > moves))
             return "a particle's image counter is larger than the cell crossings and shell "
                    "exits that could have made it";
 
@@ -427,6 +431,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
      * arithmetic is not built for. */
     if (!(t->t >= 0.0 && t->t < INFINITY) || !isfinite(t->eps_t) || !isfinite(t->kinetic) ||
         !isfinite(t->kinetic_time) || !isfinite(t->virial) || !isfinite(t->wall_impulse) ||
+        !isfinite(t->shear_work) ||
         t->t_prev_event != t->t_prev_event)
         return "its time or energy counters are not finite";
     for (int32_t i = 0; i < n; i++) {
@@ -453,7 +458,9 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
     const int32_t codes = d == 3 ? 27 : 9;
     for (int32_t i = 0; i < n; i++) {
         const gr_sched *e = &t->sched[i];
-        if (e->partner < -1 - 2 * d || e->partner >= n || e->last < -1 - 2 * d || e->last >= n)
+        /* (a sheared box's slide event: partner -2 - 2 d, lees_edwards.h) */
+        if (e->partner < -1 - 2 * d - s->le || e->partner >= n || e->last < -1 - 2 * d ||
+            e->last >= n)
             return "a particle's partner index is out of range";
         /* predictions are made from the particle's clock on (NaN is reported by the loop) */
         const double clock = TIME(rec(t, d, i), d);

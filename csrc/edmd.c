@@ -92,6 +92,10 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, d
 static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i, double t,
                                           gr_error *err);
 static void predict(gr_edmd *s, int dyn, int dim, int32_t i);
+static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
+                           double t, gr_error *err);
+static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up,
+                            int32_t old);
 
 /* The loop, for dynamics dyn (flight.h: how particles move between events), dimension
  * dim and laws = 0 (constant restitution) or 1 (a restitution law, restitution.h),
@@ -275,6 +279,7 @@ static inline int streak(gr_edmd *s, int32_t i, double t)
 static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
                                     double t, gr_error *err)
 {
+    if (s->le) return do_pair_sheared(s, dyn, dim, laws, i, j, t, err);
     double *p = rec(s, dim, i), *q = rec(s, dim, j);
     move(dyn, dim, p, t);
     move(dyn, dim, q, t);
@@ -323,6 +328,10 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
     double *p = rec(s, dim, i), *v = VEL(p, dim);
     const int a = wall >> 1, up = wall & 1;
     move(dyn, dim, p, t);
+    if (wall == 2 * dim) { /* a sheared box's slide (lees_edwards.h): rescan */
+        predict(s, dyn, dim, i);
+        return GR_OK;
+    }
     double before = kinetic_of(s, dyn, dim, i), vn = v[a];
     int64_t clamped; /* 1 if e_w is the law's at its range's end */
     const double ew = rule_wall_eps(&s->cfg, laws, vn, t, &s->sched[i], &clamped);
@@ -355,6 +364,94 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
 static void predict_cross(gr_edmd *s, int dyn, int dim, int32_t i);
 static void schedule(gr_edmd *s, int32_t i);
 
+/* ---- the events of a sheared (Lees-Edwards) box, boundary.h ---- */
+
+/* do_pair in a sheared box: a partner seen through an image across a y face is displaced
+ * along x by -+delta and moves with v_x -+ u.  The rule acts on that image's velocity;
+ * the kinetic energy in the box's velocities then changes by the work of the images, the
+ * x impulse carried across the face times u (shear_work).  A function of its own: the
+ * plain loop pays one test per pair collision for it. */
+static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
+                           double t, gr_error *err)
+{
+    double *p = rec(s, dim, i), *q = rec(s, dim, j);
+    move(dyn, dim, p, t);
+    move(dyn, dim, q, t);
+    double dr[3], vq[3];
+    for (int a = 0; a < dim; a++) dr[a] = bd_nearest(q[a] - p[a], s->L[a]);
+    const double delta = bd_le_offset(s->cfg.shear_offset, s->le_u, t, s->L[0]);
+    const int ky = bd_le_image(dr, q[1] - p[1], s->L[1], s->L[0], delta);
+    const double vx = (double)ky * s->le_u;
+    for (int a = 0; a < dim; a++) vq[a] = VEL(q, dim)[a];
+    vq[0] += vx;
+    int64_t clamped;
+    const double xi = rule_pair_eps(&s->cfg, laws, dim, dr, VEL(p, dim), vq, t, &s->sched[i],
+                                    &s->sched[j], &clamped, &s->elastic_tc);
+    const double before = kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j);
+    const double vq0 = vq[0];
+    const double vir = rule_pair_apply(dim, dr, VEL(p, dim), vq, s->mass[i], s->mass[j], xi);
+    if (vir < 0.0) { /* grazing (do_pair) */
+        s->invalid++;
+        predict(s, dyn, dim, i);
+        predict(s, dyn, dim, j);
+        return GR_OK;
+    }
+    for (int a = 0; a < dim; a++) VEL(q, dim)[a] = vq[a];
+    VEL(q, dim)[0] = vq[0] - vx;
+    /* the image's x momentum change, -m_j (vq' - vq), crossed the face: work -ky u of it */
+    s->shear_work -= vx * s->mass[j] * (vq[0] - vq0);
+    s->kinetic += kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j) - before;
+    s->virial += vir;
+    s->pair++;
+    s->law_clamped += clamped;
+    s->sched[i].count++;
+    s->sched[j].count++;
+    int collapse_i = streak(s, i, t), collapse_j = streak(s, j, t);
+    s->sched[i].last = j;
+    s->sched[j].last = i;
+    predict(s, dyn, dim, i);
+    predict(s, dyn, dim, j);
+    if (collapse_i || collapse_j) {
+        gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), uid(s, j), t, (double)GR_COLLAPSE_STREAK,
+                     GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
+                     "each within 1e-9 of a free-flight time of the previous");
+        return GR_ERR_COLLAPSE;
+    }
+    return GR_OK;
+}
+
+/* do_cross in a sheared box, for a particle i (clock at t, cell `old`) that has just left
+ * through the upper (up = 1) or lower y face and re-entered at the other (its y and img_y
+ * moved by bd_through_face): its x moves by -+delta and its v_x by -+u, its x image
+ * counter takes the whole box lengths of D(t) that delta dropped (boundary.h: unwrapped x
+ * is continuous), its cell is found anew and, its velocity changed, everything about it
+ * is predicted afresh.  The predictions of others with i stay right: i's image through
+ * the face moves on the straight line i had. */
+static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up,
+                            int32_t old)
+{
+    double *p = rec(s, dim, i), *v = VEL(p, dim);
+    int64_t *img = &s->image[(size_t)i * dim];
+    const double D = bd_le_total(s->cfg.shear_offset, s->le_u, t);
+    const double delta = bd_le_offset(s->cfg.shear_offset, s->le_u, t, s->L[0]);
+    const double sign = up ? -1.0 : 1.0, before = kinetic_of(s, dyn, dim, i), v0 = v[0];
+    p[0] += sign * delta;
+    v[0] += sign * s->le_u;
+    /* x + img_x L_x + img_y D stays (img_y moved by -sign): sign (D - delta) is a whole
+     * number of box lengths */
+    img[0] += (int64_t)llround(sign * (D - delta) / s->L[0]);
+    bd_reenter(&p[0], s->cfg.lo[0], s->cfg.hi[0], s->L[0], &img[0]);
+    s->shear_work += sign * s->le_u * s->mass[i] * 0.5 * (v0 + v[0]);
+    s->kinetic += kinetic_of(s, dyn, dim, i) - before;
+    gr_sched *e = &s->sched[i];
+    e->c[1] = up ? 0 : s->cells.nc[1] - 1;
+    cell_coords(&s->cells, 1, p, e->c); /* x only */
+    cell_remove(&s->cells, i, old);
+    cell_insert(&s->cells, i, cell_of(&s->cells, dim, e->c));
+    s->crossings++;
+    predict(s, dyn, dim, i);
+}
+
 /* Cell mode: i moves into the next cell, wrapping around a periodic box. */
 static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, double t)
 {
@@ -368,9 +465,17 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, d
     if (q >= s->cells.nc[a]) { /* out of the last cell: out of a periodic box (boundary.h) */
         q = 0;
         bd_through_face(&p[a], s->L[a], &s->image[(size_t)i * dim + a], 1);
+        if (a == 1 && s->le) {
+            do_face_sheared(s, dyn, dim, i, t, 1, old);
+            return;
+        }
     } else if (q < 0) {
         q = s->cells.nc[a] - 1;
         bd_through_face(&p[a], s->L[a], &s->image[(size_t)i * dim + a], 0);
+        if (a == 1 && s->le) {
+            do_face_sheared(s, dyn, dim, i, t, 0, old);
+            return;
+        }
     }
     c[a] = q;
     if (!s->big.is_big[i]) {

@@ -51,6 +51,9 @@ typedef struct {
     double shell;             /* > 0: neighbour lists with a shell this many largest
                                * diameters thick (no big particles then); 0: cell
                                * crossings -- a speed knob, see nlist.h */
+    double shear_rate;        /* periodic only: Lees-Edwards images across the y faces
+                               * sliding along x at shear_rate * L_y (boundary.h); 0: none */
+    double shear_offset;      /* their x offset at time 0, in [0, L_x) */
     gr_law law, wall_law;     /* kind GR_LAW_CONSTANT (zeroed): restitution and
                                * wall_restitution above; else eps(v_n) replaces them
                                * (restitution.h).  gr_edmd_new copies the tables. */
@@ -96,6 +99,8 @@ typedef struct {
     double wall_impulse;    /* sum over wall collisions of |dp_normal| */
     double kinetic;         /* total kinetic energy now */
     double kinetic_time;    /* integral over time of the total kinetic energy */
+    double shear_work;      /* Lees-Edwards: work of the sliding images, the x momentum
+                             * carried across the y faces times the velocity jump u */
     int ncell[3];           /* cells per axis */
     double shell;           /* the neighbour lists' shell in largest diameters, 0: none
                              * (a box too small for the shell asked for has none) */

@@ -57,6 +57,11 @@ struct gr_edmd {
     double kinetic;       /* total kinetic energy, updated by differences at each collision */
     double kinetic_time;  /* integral of the total kinetic energy over time, for the pressure */
     int64_t law_clamped;  /* collisions past a viscoelastic law's range (restitution.h) */
+    /* Lees-Edwards (boundary.h, lees_edwards.h): le = 1 if sheared; the images' speed
+     * u = shear_rate L_y; the work they did (counters' shear_work) */
+    int le;
+    double le_u;
+    double shear_work;
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are
@@ -131,11 +136,12 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
                        const double *radius, const double *mass, gr_error *err);
 /* The first overlap among n particles (positions pos[i * pstride ...], radii
  * radius[i * rstride]) in a box of sides L: big ones against everyone, the others
- * through grid g, whose lists must hold every particle that is not big.  GR_OK or
+ * through grid g, whose lists must hold every particle that is not big.  sheared: NULL,
+ * or a Lees-Edwards box's image offset (boundary.h; no big particles then).  GR_OK or
  * GR_ERR_OVERLAP with err filled. */
 int gr_find_overlap(int dim, int32_t n, const double *pos, size_t pstride,
                     const double *radius, size_t rstride, int periodic, const double *L,
-                    const gr_cells *g, const gr_big *b, gr_error *err);
+                    const gr_cells *g, const gr_big *b, const double *sheared, gr_error *err);
 
 /* Renumber the particles in the order of their cells (renumber.c).  GR_OK or
  * GR_ERR_NOMEM (nothing changed then). */

@@ -19,6 +19,9 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
             if (smp->pos)
                 smp->pos[out + a] = bd_unwrap(fl_at(dyn, p[a], VEL(p, dim)[a], dt),
                                               s->image[(size_t)i * dim + a], s->L[a]);
+            if (smp->pos && a == 0 && s->le) /* boundary.h: + img_y D(t) */
+                smp->pos[out] += (double)s->image[(size_t)i * dim + 1] *
+                                 bd_le_total(s->cfg.shear_offset, s->le_u, ts);
             if (smp->vel) smp->vel[out + a] = v;
             mom[a] += m * v;
             kin += 0.5 * m * v * v;
@@ -34,10 +37,46 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
     smp->next = k + 1;
 }
 
+/* gr_edmd_state of particle i in a sheared box (boundary.h): a particle due to cross a y
+ * face now re-enters with its x and v_x moved as edmd.c do_face_sheared moves them. */
+static void state_sheared(const gr_edmd *s, int32_t i, double *pos, double *vel, int64_t *image)
+{
+    const int d = s->dim, dyn = dynamics_of(s);
+    const double *p = rec(s, d, i);
+    const double dt = s->t - TIME(p, d);
+    double x[3], v[3];
+    int64_t img[3];
+    for (int a = 0; a < d; a++) {
+        x[a] = fl_at(dyn, p[a], VEL(p, d)[a], dt);
+        v[a] = fl_vel_at(dyn, VEL(p, d)[a], dt);
+        img[a] = s->image[(size_t)i * d + a];
+    }
+    const int64_t img_y = img[1];
+    if (bd_reenter(&x[1], s->cfg.lo[1], s->cfg.hi[1], s->L[1], &img[1])) {
+        const double sign = img[1] > img_y ? -1.0 : 1.0;
+        const double D = bd_le_total(s->cfg.shear_offset, s->le_u, s->t);
+        const double delta = bd_le_offset(s->cfg.shear_offset, s->le_u, s->t, s->L[0]);
+        x[0] += sign * delta;
+        v[0] += sign * s->le_u;
+        img[0] += (int64_t)llround(sign * (D - delta) / s->L[0]);
+    }
+    for (int a = 0; a < d; a++) {
+        if (a != 1) bd_reenter(&x[a], s->cfg.lo[a], s->cfg.hi[a], s->L[a], &img[a]);
+        const size_t out = (size_t)s->order.id_of[i] * d + a;
+        if (pos) pos[out] = x[a];
+        if (vel) vel[out] = v[a];
+        if (image) image[out] = img[a];
+    }
+}
+
 void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image)
 {
     const int d = s->dim, dyn = dynamics_of(s);
     for (int32_t i = 0; i < s->n; i++) {
+        if (s->le) {
+            state_sheared(s, i, pos, vel, image);
+            continue;
+        }
         const double *p = rec(s, d, i);
         double dt = s->t - TIME(p, d);
         for (int a = 0; a < d; a++) {
@@ -67,6 +106,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->virial = s->virial;
     c->wall_impulse = s->wall_impulse;
     c->kinetic_time = s->kinetic_time;
+    c->shear_work = s->shear_work;
     c->kinetic = kinetic_total(s, dynamics_of(s), s->dim);
     for (int a = 0; a < 3; a++) c->ncell[a] = s->cells.nc[a];
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;

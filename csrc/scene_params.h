@@ -16,6 +16,8 @@
 #define GR_SCENE_DOUBLES(X) \
     X(wall_restitution)     \
     X(restitution)          \
-    X(contact_duration)
+    X(contact_duration)     \
+    X(shear_rate)           \
+    X(shear_offset)
 
 #endif

@@ -21,6 +21,9 @@ static inline int rebound_now(const gr_edmd *s, int32_t i, int32_t j, double t, 
            s->sched[j].t_last == t;
 }
 
+/* the cells across a sheared face (the edge rows of a Lees-Edwards box) */
+#include "lees_edwards.h"
+
 /* One candidate j (not i) for i's next pair collision (record p): j seen through an
  * image shift (NULL: none) or, with `nearest`, through the nearest periodic image.
  * Keeps the earliest in *best / *partner; `best` is relative to i's clock and is also
@@ -117,6 +120,8 @@ static void scan_cells(gr_edmd *s, int dyn, int dim, int32_t i, int axis, int di
         if (g->prefetch_heads)
             for (int k = 0; k < m; k++) GR_PREFETCH(&g->head[full[k]]);
         for (int k = 0; k < m; k++) scan_cell(s, dyn, dim, i, p, full[k], NULL, &best, &partner);
+    } else if (s->le && le_edge_row(g, c[1])) {
+        le_scan_edge(s, dyn, dim, i, &best, &partner);
     } else {
         gr_nbr nb[27];
         int count = cell_neighbours(g, dim, c, axis, dir, nb);

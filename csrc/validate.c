@@ -50,6 +50,55 @@ static int validate_law(const gr_law *law, gr_error *err)
     }
 }
 
+/* Lees-Edwards (boundary.h): a periodic box; an offset in [0, L_x); image speeds
+ * u = shear_rate L_y that double arithmetic can carry: |u| in [1e-140, 1e140] (the
+ * scene's speeds' range), and at most 2^26 times the fastest initial speed where any
+ * particle moves (a crossing adds u to v_x and takes it off again: past that, fewer than
+ * 26 bits of the velocity would survive it). */
+static int validate_shear(const gr_edmd_config *cfg, const double *vel, gr_error *err)
+{
+    if (!isfinite(cfg->shear_rate) || !isfinite(cfg->shear_offset)) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN,
+                     isfinite(cfg->shear_rate) ? cfg->shear_offset : cfg->shear_rate,
+                     "shear_rate and shear_offset must be finite");
+        return GR_ERR_VALUE;
+    }
+    if (cfg->shear_rate == 0.0 && cfg->shear_offset == 0.0) return GR_OK;
+    if (!cfg->periodic) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shear_rate,
+                     "shear (Lees-Edwards images) needs a periodic box: walls on the gradient "
+                     "axis y cannot slide");
+        return GR_ERR_VALUE;
+    }
+    const double Lx = cfg->hi[0] - cfg->lo[0], u = cfg->shear_rate * (cfg->hi[1] - cfg->lo[1]);
+    if (!(cfg->shear_offset >= 0.0 && cfg->shear_offset < Lx)) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shear_offset,
+                     "shear_offset must lie in [0, L_x) (the box length along x)");
+        return GR_ERR_VALUE;
+    }
+    if (cfg->shear_rate == 0.0) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shear_offset,
+                     "shear_offset != 0 needs a shear rate (images displaced but at rest are "
+                     "not offered)");
+        return GR_ERR_VALUE;
+    }
+    if (!(fabs(u) >= 1e-140 && fabs(u) <= 1e140)) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, u,
+                     "the sheared images' speed |shear_rate| L_y must lie in [1e-140, 1e140]");
+        return GR_ERR_VALUE;
+    }
+    double vmax = 0.0;
+    for (int64_t k = 0; k < cfg->n * cfg->dim; k++)
+        if (fabs(vel[k]) > vmax) vmax = fabs(vel[k]);
+    if (vmax > 0.0 && fabs(u) > 0x1p26 * vmax) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, u,
+                     "the sheared images' speed |shear_rate| L_y is more than 2^26 times the "
+                     "fastest particle's: a face crossing would round the velocities away");
+        return GR_ERR_VALUE;
+    }
+    return GR_OK;
+}
+
 int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const double *vel,
                        const double *radius, const double *mass, gr_error *err)
 {
@@ -133,6 +182,8 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
             return GR_ERR_VALUE;
         }
     }
+    int status_le = validate_shear(cfg, vel, err);
+    if (status_le != GR_OK) return status_le;
     for (int32_t i = 0; i < n; i++) {
         for (int a = 0; a < d; a++) {
             double x = pos[i * d + a];
@@ -168,9 +219,45 @@ static int overlap(const double *x, const double *y, const double *shift, double
     return d2 < sigma * sigma;
 }
 
+/* Sheared box (boundary.h), for gr_find_overlap: the pairs across the y faces, through
+ * the image across the upper face displaced by offset along x.  Each particle of the top
+ * row of cells looks at the bottom row's columns whose images overlap its neighbours'
+ * (the window of lees_edwards.h, one column to spare each way). */
+static int find_overlap_sheared(int dim, int32_t n, const double *pos, size_t pstride,
+                                const double *radius, size_t rstride, const double *L,
+                                const gr_cells *g, double offset, gr_error *err)
+{
+    const int32_t nx = g->nc[0], M = (int32_t)floor(offset / g->w[0]);
+    for (int32_t i = 0; i < n; i++) {
+        const double *x = pos + (size_t)i * pstride;
+        int32_t c[3] = {0, 0, 0};
+        cell_coords(g, dim, x, c);
+        if (c[1] != g->nc[1] - 1) continue;
+        for (int kz = 0; kz < (dim == 3 ? 3 : 1); kz++) {
+            const int32_t q2 = dim == 3 ? g->nb_cell[2][3 * c[2] + kz] : 0;
+            double shift[3] = {0.0, L[1], dim == 3 ? g->nb_shift[2][3 * c[2] + kz] : 0.0};
+            for (int32_t K = c[0] - M - 3; K <= c[0] - M + 2; K++) {
+                const int32_t k = bd_cell_wrap(K, nx), q[3] = {k, 0, q2};
+                shift[0] = offset + (double)((K - k) / nx) * L[0];
+                for (int32_t j = g->head[cell_of(g, dim, q)]; j >= 0; j = g->next[j]) {
+                    double depth;
+                    if (j != i && overlap(x, pos + (size_t)j * pstride, shift,
+                                          radius[(size_t)i * rstride], radius[(size_t)j * rstride],
+                                          dim, 1, L, &depth)) {
+                        gr_error_set(err, GR_ERR_OVERLAP, i < j ? i : j, i < j ? j : i, 0.0,
+                                     depth, "in the initial configuration (through the sheared images)");
+                        return GR_ERR_OVERLAP;
+                    }
+                }
+            }
+        }
+    }
+    return GR_OK;
+}
+
 int gr_find_overlap(int dim, int32_t n, const double *pos, size_t pstride,
                     const double *radius, size_t rstride, int periodic, const double *L,
-                    const gr_cells *g, const gr_big *b, gr_error *err)
+                    const gr_cells *g, const gr_big *b, const double *sheared, gr_error *err)
 {
     double depth;
     /* the big particles with everyone, O(N) each */
@@ -195,6 +282,7 @@ int gr_find_overlap(int dim, int32_t n, const double *pos, size_t pstride,
         cell_coords(g, dim, x, c);
         int count = cell_neighbours(g, dim, c, -1, 0, nb);
         for (int k = 0; k < count; k++) {
+            if (sheared && nb[k].shift[1] != 0.0) continue; /* across a y face: below */
             for (int32_t j = g->head[nb[k].cell]; j >= 0; j = g->next[j]) {
                 if (j <= i) continue;
                 if (overlap(x, pos + (size_t)j * pstride, nb[k].shift, radius[(size_t)i * rstride],
@@ -205,6 +293,7 @@ int gr_find_overlap(int dim, int32_t n, const double *pos, size_t pstride,
             }
         }
     }
+    if (sheared) return find_overlap_sheared(dim, n, pos, pstride, radius, rstride, L, g, *sheared, err);
     return GR_OK;
 }
 
@@ -221,7 +310,8 @@ int gr_edmd_check(const gr_edmd_config *cfg, const double *pos, const double *ve
     gr_big b = {0};
     b.is_big = calloc((size_t)n, sizeof *b.is_big);
     if (!b.is_big) return GR_ERR_NOMEM;
-    status = gr_big_choose(&b, d, n, radius, L, cfg->big_ratio, cfg->cell_factor);
+    const int sheared = cfg->periodic && cfg->shear_rate != 0.0;
+    status = gr_big_choose(&b, d, n, radius, L, sheared ? INFINITY : cfg->big_ratio, cfg->cell_factor);
     if (status == GR_OK)
         status = gr_cells_build(&g, d, n, cfg->lo, L, cfg->periodic,
                                 2.0 * b.r_small * cfg->cell_factor, err);
@@ -232,7 +322,8 @@ int gr_edmd_check(const gr_edmd_config *cfg, const double *pos, const double *ve
             cell_coords(&g, d, pos + (size_t)i * d, c);
             cell_insert(&g, i, cell_of(&g, d, c));
         }
-        status = gr_find_overlap(d, n, pos, (size_t)d, radius, 1, cfg->periodic, L, &g, &b, err);
+        status = gr_find_overlap(d, n, pos, (size_t)d, radius, 1, cfg->periodic, L, &g, &b,
+                                 sheared ? &cfg->shear_offset : NULL, err);
     }
     gr_cells_free(&g);
     free(b.is_big);

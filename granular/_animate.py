@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _shear
 from ._figures import POSITION, SPEED, _matplotlib
 
 if TYPE_CHECKING:  # matplotlib is an extra, imported only when an animation is made
@@ -429,10 +430,18 @@ def animate(
 
         fig.colorbar(ScalarMappable(norm, cmap), ax=ax, shrink=0.8, label=speed_label)
 
+    # a sheared box (docs/shear.md): positions come into the box through the sliding
+    # images, and a disk's image across a y face is displaced along x by the offset then
+    rate = traj.scene_parameters.get("shear_rate", 0.0)
+    sheared = rate != 0.0 and periodic
+    offset0 = traj.scene_parameters.get("shear_offset", 0.0)
+
     def update(k):
         s = samples[k]
         x = positions[s]
-        if periodic:
+        if sheared:
+            x = _shear.wrap(x, lo, hi, rate, offset0, float(traj.times[s]))[0]
+        elif periodic:
             x = wrap(x, lo, hi)
         xy = np.ascontiguousarray(x[:, [ax0, ax1]])
         rgba = cmap(norm(speeds[s])) if speeds is not None else base.copy()
@@ -448,8 +457,20 @@ def animate(
         if periodic:
             centre = (lo + hi)[[ax0, ax1]] / 2
             shift = np.where(xy > centre, -1.0, 1.0) * length[[ax0, ax1]]
+            # the images across the y faces: displaced by -+delta in a sheared box (drawn
+            # in the x-y plane only), then their own nearest image along x
+            slid, slid_shift = xy, shift
+            if sheared and (ax0, ax1) == (0, 1):
+                delta = _shear.offset(rate, offset0, length[0], length[1], float(traj.times[s]))
+                slid = xy.copy()
+                slid[:, 0] = wrap(xy[:, 0] + np.sign(shift[:, 1]) * delta, lo[0], hi[0])
+                slid_shift = shift.copy()
+                slid_shift[:, 0] = np.where(slid[:, 0] > centre[0], -1.0, 1.0) * length[0]
             for c, mask in zip(images, ((1, 0), (0, 1), (1, 1)), strict=True):
-                c.set_offsets(xy + shift * mask)
+                if mask[1]:
+                    c.set_offsets(slid + slid_shift * mask)
+                else:
+                    c.set_offsets(xy + shift * mask)
                 c.set_facecolor(rgba)
         first = 0 if trail_length is None else max(0, s - int(trail_length))
         for line, i in zip(lines, trail_ids, strict=True):

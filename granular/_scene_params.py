@@ -331,6 +331,45 @@ PARAMETERS: tuple[SceneParameter, ...] = (
     ),
 )
 
+
+def _finite(name: str) -> Callable[[Any, int, int], float]:
+    def check(value: Any, n: int, d: int) -> float:
+        kept = float(real(value, name))
+        if not math.isfinite(kept):
+            raise ValueError(f"{name} must be finite, got {value}")
+        return kept
+
+    return check
+
+
+# Lees-Edwards shear (csrc/boundary.h; docs/shear.md): flow along x, gradient along y
+PARAMETERS += (
+    SceneParameter(
+        "shear_rate",
+        "float",
+        None,
+        0.0,
+        "sqrt(eps/m) / L",
+        "Shear rate of Lees-Edwards (sliding-brick) boundaries, periodic boxes only: the "
+        "images across the upper (lower) y face move along x with +(-) shear_rate * L_y, so "
+        "the mean flow is shear_rate * (y - y_centre) along x.  0: a plain periodic box.",
+        _finite("shear_rate"),
+        _same("shear_rate"),
+    ),
+    SceneParameter(
+        "shear_offset",
+        "float in [0, L_x)",
+        None,
+        0.0,
+        "L",
+        "The x offset of the image across the upper y face at time 0 (it grows by "
+        "shear_rate * L_y per unit time, modulo L_x); a sheared state read back carries its "
+        "own.",
+        _finite("shear_offset"),
+        _same("shear_offset"),
+    ),
+)
+
 BY_NAME: dict[str, SceneParameter] = {p.name: p for p in PARAMETERS}
 # what a trajectory samples; the other parameters are the run's, the same at every sample
 # (a Trajectory and a GSD file keep them once)

@@ -17,6 +17,12 @@ for viewers and analysis tools (OVITO, freud, MDAnalysis), good to about 7 digit
 - ``particles/velocity``, ``particles/diameter``, ``particles/mass``
 - ``configuration/box`` and ``configuration/dimensions``; ``configuration/step`` = the
   sample's index
+- a sheared box (``shear_rate`` != 0, docs/shear.md): the box's tilt ``xy = delta / L_y``
+  at the sample's time (HOOMD's lattice vector a2 = (xy L_y, L_y, 0), delta the x offset
+  of the image across the upper y face, in [-L_x/2, L_x/2)), positions inside that
+  triclinic box and images through its lattice vectors; reading back, the exact unwrapped
+  positions come into the box through the sliding images and the Scene of a frame gets
+  the offset at its time
 - 2D: ``configuration/dimensions`` = 2 and a box ``[Lx, Ly, max(Lx, Ly), 0, 0, 0]``.
   HOOMD itself writes Lz = 0 in 2D, but its readers take ``dimensions`` = 2 first and set
   Lz to 0 themselves (as for HOOMD 2's files, which kept an Lz), and gsd.hoomd does too;
@@ -59,6 +65,7 @@ from typing import Any
 
 import numpy as np
 
+from . import _shear
 from ._files import atomic_target, check_kind
 from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, split
 from .errors import GSDFileError
@@ -161,7 +168,11 @@ def _frame(hoomd, traj, k, lower, upper):
     x = traj.positions[k]
     wrapped, images = _wrap(x, lower, upper, periodic)
     position = (wrapped - centre).astype(np.float32)
-    if periodic:
+    rate = traj.scene_parameters.get("shear_rate", 0.0)
+    if rate != 0.0:
+        tilt, position, images = _sheared_frame(traj, k, lower, upper)
+        frame.configuration.box = [*box_lengths_3d(upper - lower), tilt, 0.0, 0.0]
+    elif periodic:
         # a centre just under the upper face can round to +L/2 in float32, outside
         # HOOMD's [-L/2, L/2): move it to -L/2 and count the image
         high = position >= half
@@ -190,6 +201,31 @@ def _frame(hoomd, traj, k, lower, upper):
                 log[f"granular/{field}"] = _encode(value)
     frame.log = log
     return frame
+
+
+def _sheared_frame(traj, k, lower, upper):
+    """A sheared box (csrc/boundary.h) at sample k as HOOMD draws it: the tilt xy =
+    delta / L_y of the lattice vector a2 = (xy L_y, L_y, 0) (the image across the upper y
+    face displaced by delta, taken in [-L_x/2, L_x/2)), the positions (float32) inside that
+    triclinic box centred at the origin, and the images that unwrap them there
+    (unwrapped = position + i_x a1 + i_y a2 + i_z a3)."""
+    p = traj.scene_parameters
+    lengths = upper - lower
+    lx, ly = float(lengths[0]), float(lengths[1])
+    delta = _shear.offset(p["shear_rate"], p["shear_offset"], lx, ly, float(traj.times[k]))
+    delta = delta - lx if delta >= 0.5 * lx else delta
+    x, img = _shear.wrap(
+        traj.positions[k], lower, upper, p["shear_rate"], p["shear_offset"], float(traj.times[k])
+    )
+    c = x - 0.5 * (lower + upper)
+    # unwrapped x = x + img_x L_x + img_y D, D = delta + m L_x: HOOMD's i_x takes m img_y,
+    # and the shift that brings x - xy y into [-L_x/2, L_x/2)
+    D = _shear.total_offset(p["shear_rate"], p["shear_offset"], ly, float(traj.times[k]))
+    m = np.round((D - delta) / lx)
+    shift = np.floor((c[:, 0] - delta / ly * c[:, 1]) / lx + 0.5)
+    c[:, 0] -= shift * lx
+    img[:, 0] = img[:, 0] + (m * img[:, 1]).astype(np.int64) + shift.astype(np.int64)
+    return delta / ly, c.astype(np.float32), img
 
 
 def write(traj: Any, path: str | os.PathLike) -> None:
@@ -375,11 +411,26 @@ def _wrap_checked(f: _File, k: int, x: np.ndarray, p: dict[str, Any]) -> np.ndar
 
 
 def _scene(
-    f: _File, k: int, x: np.ndarray, v: np.ndarray, p: dict[str, Any], make_scene: Any
+    f: _File,
+    k: int,
+    x: np.ndarray,
+    v: np.ndarray,
+    p: dict[str, Any],
+    make_scene: Any,
+    t: float = 0.0,
 ) -> Any:
-    """Frame ``k``'s state as a Scene (``make_scene``: the Scene class) with the run's
-    parameters ``p``, which checks it as every scene is checked (finite, the scales, inside
-    the box, no overlaps)."""
+    """Frame ``k``'s state (at time ``t``) as a Scene (``make_scene``: the Scene class) with
+    the run's parameters ``p``, which checks it as every scene is checked (finite, the
+    scales, inside the box, no overlaps).  A sheared box's (csrc/boundary.h) positions are
+    brought into the box through its images at t, and the Scene gets the offset then."""
+    if p.get("shear_rate", 0.0) != 0.0 and np.all(np.isfinite(x)):
+        lower, upper = p["box"]
+        rate, d0 = p["shear_rate"], p["shear_offset"]
+        lx, ly = float(upper[0] - lower[0]), float(upper[1] - lower[1])
+        x = _shear.wrap(
+            _wrap_checked(f, k, x, {**p, "boundary": "walls"}), lower, upper, rate, d0, t
+        )[0]
+        p = {**p, "shear_offset": _shear.offset(rate, d0, lx, ly, t)}
     x = _wrap_checked(f, k, x, p)
     try:
         return make_scene(x, v, **p)
@@ -421,7 +472,7 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
                 velocities.append(v)
             elif f.has(k, _log("velocities")):
                 raise f.error(k, _log("velocities"), "is there but frame 0 has none")
-            _scene(f, k, x, v, p, make_scene)
+            _scene(f, k, x, v, p, make_scene, t)
             positions.append(x)
             for name in _COUNTERS:
                 value = _counter(f, k, name, d, counters[name])
@@ -497,7 +548,8 @@ def scene_from_gsd(path: str | os.PathLike, frame: int, make_scene: Any, **param
             v = np.zeros((n, d))
             if f.has(k, _log("velocities")):
                 v = f.array(k, _log("velocities"), (n, d))
-            own = _scene(f, k, x, v, p, make_scene)
+            t = float(f.array(k, _log("time"), (1,))[0])
+            own = _scene(f, k, x, v, p, make_scene, t)
         else:
             own = _foreign_scene(f, k, make_scene)
     return own.replace(**params)
@@ -527,7 +579,9 @@ def _foreign_scene(f: _File, k: int, make_scene: Any) -> Any:
         raise f.error(
             k,
             "configuration/box",
-            f"has tilts {box[3:].tolist()}: granular's boxes are rectangular",
+            f"has tilts {box[3:].tolist()}: granular's boxes are rectangular (a sheared "
+            "box's tilt is read only from the files granular writes, whose log holds the "
+            "shear)",
         )
     x = get("particles/position", (n, 3))[:, :dim]
     v = get("particles/velocity", (n, 3), 0.0)[:, :dim]

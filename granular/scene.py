@@ -142,6 +142,8 @@ class Scene:
     wall_restitution: float | RestitutionLaw
     restitution: float | RestitutionLaw
     contact_duration: float
+    shear_rate: float
+    shear_offset: float
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         try:

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import _core, _edmd, checkpoint
+from . import _core, _edmd, _shear, checkpoint
 from . import restitution as _restitution
 from ._edmd import check_memory as _check_memory
 from ._scene_params import RUN_PARAMETERS
@@ -183,7 +183,10 @@ class Simulation:
         tc_elastic_collisions (pair collisions the TC model made elastic; a wall collision
         it made elastic is not counted), law_clamped_collisions (past a viscoelastic law's
         range, see ``granular.Viscoelastic``), virial, wall_impulse, kinetic_energy,
-        kinetic_time_integral, time, cells, shell (0: cells); and the pressure averaged over
+        kinetic_time_integral, time, cells, shell (0: cells), shear_work (the work of a
+        sheared box's sliding images, csrc/boundary.h); temperature, 2 E_kin / (d N) now,
+        in a sheared box that of the velocities less the mean flow (granular/_shear.py);
+        and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
         with the time average <E_kin>_t (exact for a cooling gas too) and W the pair
         collisions' virial.  In a periodic box V is the box volume.  In a walled box the
@@ -200,19 +203,41 @@ class Simulation:
         else:
             c["pressure"] = float("nan")
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
+        if s.shear_rate != 0.0:  # the peculiar velocities' (granular/_shear.py)
+            from ._shear import flow_temperature
+
+            pos, vel, _ = self._engine.state()
+            c["temperature"] = float(
+                flow_temperature(pos, vel, s.masses, s.lower, s.upper, s.shear_rate)
+            )
+        else:
+            c["temperature"] = 2.0 * c["kinetic_energy"] / (s.dim * s.n)
         return c
 
     @property
     def scene(self) -> Scene:
-        """The current state as a new Scene (positions wrapped into a periodic box)."""
+        """The current state as a new Scene (positions wrapped into a periodic box; a
+        sheared box's image offset the one now)."""
         pos, vel, _ = self._engine.state()
-        return self._initial.replace(positions=pos, velocities=vel)
+        s = self._initial
+        if s.shear_rate != 0.0:
+            offset = shear_offset_at(s, self.time)
+            return s.replace(positions=pos, velocities=vel, shear_offset=offset)
+        return s.replace(positions=pos, velocities=vel)
 
     @property
     def unwrapped_positions(self) -> NDArray[np.float64]:
-        """(N, d) positions at the current time with periodic images undone."""
+        """(N, d) positions at the current time with periodic images undone (sheared:
+        x gains img_y times the accumulated image offset, csrc/boundary.h)."""
         pos, _, img = self._engine.state()
-        return pos + img * (self._initial.upper - self._initial.lower)
+        s = self._initial
+        out = pos + img * (s.upper - s.lower)
+        if s.shear_rate != 0.0:
+            ly = float(s.upper[1] - s.lower[1])
+            out[:, 0] += img[:, 1] * _shear.total_offset(
+                s.shear_rate, s.shear_offset, ly, self.time
+            )
+        return out
 
     # -- running --------------------------------------------------------------------
     def run(
@@ -418,7 +443,9 @@ class Simulation:
         can put it past anything float64 can time) has nothing to be warned of."""
         from .clustering import unstable_box
 
-        found = unstable_box(self._initial)  # t* counts from the initial state, as time does
+        # (the homogeneous cooling state's instability: a sheared gas has no such state)
+        sheared = self._initial.shear_rate != 0.0
+        found = None if sheared else unstable_box(self._initial)  # t* from the initial state
         if found is None:
             self._clustering_checked = True
             return
@@ -639,4 +666,12 @@ def _warn_clamped(count, scene):
         "max_speed: the second-order series is not valid there (granular.Viscoelastic)",
         RuntimeWarning,
         stacklevel=3,
+    )
+
+
+def shear_offset_at(scene: Scene, t: float) -> float:
+    """A sheared scene's image offset delta(t) in [0, L_x) at time t [L] (csrc/boundary.h)."""
+    lengths = scene.upper - scene.lower
+    return _shear.offset(
+        scene.shear_rate, scene.shear_offset, float(lengths[0]), float(lengths[1]), t
     )

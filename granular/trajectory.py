@@ -164,8 +164,29 @@ class Trajectory:
 
     @property
     def temperature(self) -> NDArray[np.float64]:
-        """(T,) granular temperature 2 E_kin / (d N), k_B = 1."""
-        return 2.0 * self.kinetic_energy / (self.dim * self.n)
+        """(T,) granular temperature 2 E_kin / (d N), k_B = 1.  In a sheared box the
+        kinetic energy of the peculiar velocities, the velocities less the mean flow
+        shear_rate (y - y_c) along x (granular/_shear.py), which needs the positions and
+        velocities stored."""
+        rate = self._parameters_dict().get("shear_rate", 0.0)
+        if rate == 0.0:
+            return 2.0 * self.kinetic_energy / (self.dim * self.n)
+        if self.positions is None or self.velocities is None:
+            raise ValueError(
+                "the temperature of a sheared run is that of the velocities less the mean "
+                "flow, which needs the positions and velocities: run with "
+                "store=('positions', 'velocities')"
+            )
+        from ._shear import flow_temperature
+
+        return readonly(
+            flow_temperature(
+                self.positions, self.velocities, self.masses, self.lower, self.upper, rate
+            )
+        )
+
+    def _parameters_dict(self) -> dict[str, Any]:
+        return dict(self._parameters)
 
     @property
     def collisions_per_particle(self) -> NDArray[np.float64]:

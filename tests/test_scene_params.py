@@ -35,6 +35,20 @@ def _examples():
     }
 
 
+# parameters that need a periodic box, with their examples (the walled examples keep
+# their defaults); _examples_for gives them a periodic scene
+_PERIODIC_ONLY = {"shear_rate": 0.3, "shear_offset": 0.25}
+
+
+def _examples_for(name):
+    """_examples, with ``name``'s example if it needs a periodic box (in one)."""
+    if name not in _PERIODIC_ONLY:
+        return _examples()
+    # an offset needs a shear rate
+    rate = {"shear_rate": _PERIODIC_ONLY["shear_rate"]}
+    return {**_examples(), "boundary": "periodic", **rate, name: _PERIODIC_ONLY[name]}
+
+
 def _alternative(name):
     """Another valid value of parameter ``name`` beside the other examples: its default,
     or for the particles and the box one that _examples' values fit."""
@@ -57,7 +71,7 @@ def _same(a, b):
 
 
 def test_every_parameter_has_an_example_unlike_its_default():
-    examples = _examples()
+    examples = {**_examples(), **_PERIODIC_ONLY}
     assert set(examples) == set(NAMES), "give the new parameter an example value here"
     for p in PARAMETERS:
         assert p.default is REQUIRED or not _same(p.check(p.default, 12, 2), examples[p.name])
@@ -95,7 +109,7 @@ def test_every_parameter_reaches_the_engine_by_name():
 
 @pytest.mark.parametrize("name", NAMES)
 def test_every_parameter_goes_through_replace(name):
-    examples = _examples()
+    examples = _examples_for(name)
     base = Scene(**{**examples, name: _alternative(name)})
     p = _scene_params.BY_NAME[name]
     assert not _same(p.get(base), p.check(examples[name], 12, 2))
@@ -120,11 +134,12 @@ def test_every_parameter_survives_a_checkpoint(tmp_path):
     assert np.array_equal(a.positions, b.positions)
 
 
-def _gsd_round_trip(tmp_path, writer=None):
+def _gsd_round_trip(tmp_path, writer=None, name=None):
     """A run of a scene with every parameter set, written to a GSD file (by ``writer``,
     else ``Trajectory.write``): the parameters whose value ``Scene.from_gsd`` (of the last
-    frame) or ``granular.read`` gives back differs from the run's, and those read keeps."""
-    scene = Scene(**_examples())
+    frame) or ``granular.read`` gives back differs from the run's, and those read keeps
+    (with ``name``'s example in a periodic box if it needs one)."""
+    scene = Scene(**(_examples_for(name) if name else _examples()))
     sim = Simulation(scene)
     traj = sim.run(t_stop=0.05, sample_times=[0.0, 0.05], store=("positions", "velocities"))
     (writer or type(traj).write)(traj, tmp_path / "run.gsd")
@@ -160,7 +175,7 @@ def test_a_parameter_the_gsd_writer_skips_is_caught(tmp_path, monkeypatch, name)
             traj.write(path)
 
     try:
-        differ, _ = _gsd_round_trip(tmp_path, write)
+        differ, _ = _gsd_round_trip(tmp_path, write, name)
     except granular.errors.GSDFileError:
         return
     assert name in differ

@@ -86,7 +86,7 @@ def _scene_params(rng):
     radius = spacing * rng.uniform(0.1, 0.4)
     if boundary == "periodic":
         radius = min(radius, length / 4.5)  # the box must be > 2 diameters wide
-    return dict(
+    p = dict(
         positions=pos,
         velocities=rng.normal(size=(n, dim)),
         radii=np.full(n, radius),
@@ -97,6 +97,10 @@ def _scene_params(rng):
         restitution=float(rng.choice([1.0, 1.0, 0.9, 0.5])),
         contact_duration=float(rng.choice([0.0, 0.0, 1e-3])),
     )
+    if boundary == "periodic" and rng.random() < 0.3:  # Lees-Edwards shear (offset 0: the
+        # grid start may overlap through displaced images; the mutations try offsets)
+        p["shear_rate"] = float(rng.choice([0.5, -2.0, 5.0]))
+    return p
 
 
 def _random_params(rng, max_n=50):
@@ -296,6 +300,8 @@ SCENE_MUTATIONS = [
     _set("wall_restitution", [*EXTREME, 2.0, 1e3, *WRONG_TYPES]),
     _set("restitution", [*EXTREME, -0.1, 1.1, 1 - 1e-16, "0.5", 1j, None]),
     _set("contact_duration", [*EXTREME, "x", None]),
+    _set("shear_rate", [*EXTREME, 1e200, 1e-200, "x", None, 1j]),
+    _set("shear_offset", [*EXTREME, 0.99, 1e200, "x", None]),
     _overlap("same place"),
     _overlap("overlap 1e-9"),
     _overlap("touching"),
@@ -844,6 +850,9 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
         if k != "pressure" and isinstance(v, (int, float, np.number))
     }
     _check(all(math.isfinite(v) for v in stats.values()), f"non-finite stats: {stats}")
+    if scene.shear_rate != 0.0:
+        _check_sheared(scene, traj, sim)
+        return
     if traj.positions is not None and traj.velocities is not None:
         length = scene.upper - scene.lower
         every = max(1, len(traj.times) // 20)  # at most ~20 samples checked for overlaps
@@ -874,6 +883,30 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
 
 
 @_verified
+def _check_sheared(scene, traj, sim):
+    """_check_trajectory for a sheared box: samples brought into the box through the
+    sliding images at their time make valid scenes with the offset then (no overlap
+    through any image), and an elastic run's energy rose by the boundary's work."""
+    from granular import _shear
+
+    if traj.positions is not None and traj.velocities is not None:
+        length = scene.upper - scene.lower
+        every = max(1, len(traj.times) // 20)
+        for k in range(0, len(traj.times), every):
+            t = float(traj.times[k])
+            rate, d0 = scene.shear_rate, scene.shear_offset
+            x, _ = _shear.wrap(traj.positions[k], scene.lower, scene.upper, rate, d0, t)
+            offset = _shear.offset(rate, d0, float(length[0]), float(length[1]), t)
+            scene.replace(positions=x, velocities=traj.velocities[k], shear_offset=offset)
+    _ = sim.scene
+    st = sim.stats
+    if scene.restitution == 1 and len(traj.kinetic_energy):
+        e0 = scene.kinetic_energy
+        gap = abs(st["kinetic_energy"] - e0 - st["shear_work"])
+        scale = max(e0, st["kinetic_energy"], abs(st["shear_work"]))
+        _check(gap <= ENERGY_RTOL * scale, f"sheared elastic run: energy - work off by {gap:.3g}")
+
+
 def _check_langevin(r):
     for name in (
         "times",

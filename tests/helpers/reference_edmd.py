@@ -37,7 +37,22 @@ def pair_times(x, v, r, L, periodic):
 
 
 def run_scene(scene, t_stop, sample_times):
-    """``run`` for a granular.Scene: its state, box, restitution and wall restitution."""
+    """``run`` for a granular.Scene: its state, box, restitution and wall restitution
+    (``run_sheared`` for a sheared one)."""
+    if getattr(scene, "shear_rate", 0.0) != 0.0:
+        return run_sheared(
+            np.array(scene.positions),
+            np.array(scene.velocities),
+            scene.radii,
+            scene.masses,
+            scene.lower,
+            scene.upper,
+            scene.restitution,
+            t_stop,
+            sample_times,
+            scene.shear_rate,
+            scene.shear_offset,
+        )[:2]
     return run(
         np.array(scene.positions),
         np.array(scene.velocities),
@@ -105,3 +120,140 @@ def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0):
             v[p, a] = -v[p, a]
             v[p] *= e_w
     return np.array(out_x), np.array(out_v)
+
+
+# -- Lees-Edwards (sliding-brick) images ------------------------------------------------
+
+
+def sheared_pair_times(x, v, r, L, u, delta, kx_max=2):
+    """Every pair's next contact time over all images of a sheared periodic box: along y
+    the images ky = -1, 0, 1, displaced along x by ky * delta and moving with ky * u; along
+    x the images kx = -kx_max .. kx_max (the displacement can put the nearest one beyond
+    the first), along z -1, 0, 1.  Returns (times, image index) with images listed as
+    ``sheared_images``."""
+    n, d = x.shape
+    images = sheared_images(d, kx_max)
+    best = np.full((n, n), np.inf)
+    which = np.zeros((n, n), dtype=int)
+    sig = r[:, None] + r[None, :]
+    for k, (kx, ky, kz) in enumerate(images):
+        shift = np.zeros(d)
+        shift[0] = kx * L[0] + ky * delta
+        shift[1] = ky * L[1]
+        if d == 3:
+            shift[2] = kz * L[2]
+        dr = x[None, :, :] + shift - x[:, None, :]
+        dv = v[None, :, :] - v[:, None, :]
+        dv[..., 0] += ky * u
+        b = (dr * dv).sum(-1)
+        a = (dv * dv).sum(-1)
+        c = (dr * dr).sum(-1) - sig**2
+        disc = b * b - a * c
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = (-b - np.sqrt(disc)) / a
+        ok = (b < 0) & (disc > 0) & (t >= -1e-12)
+        t = np.where(ok, np.maximum(t, 0.0), np.inf)
+        which = np.where(t < best, k, which)
+        best = np.minimum(best, t)
+    np.fill_diagonal(best, np.inf)
+    return best, images
+
+
+def sheared_images(d, kx_max=2):
+    """The (kx, ky, kz) images ``sheared_pair_times`` tries."""
+    zs = (-1, 0, 1) if d == 3 else (0,)
+    return [(kx, ky, kz) for kx in range(-kx_max, kx_max + 1) for ky in (-1, 0, 1) for kz in zs]
+
+
+def run_sheared(x, v, r, m, lo, hi, xi, t_stop, sample_times, shear_rate, shear_offset=0.0):
+    """``run`` in a periodic box with Lees-Edwards images across the y faces (flow along x):
+    the image across the upper face is displaced along x by delta(t) = (shear_offset +
+    u t) mod L_x and moves with u = shear_rate * L_y.  A particle leaving through the upper
+    (lower) face re-enters at the lower (upper) one with x -(+) delta and v_x -(+) u.
+
+    The unwrapped positions are integrated on their own, from each particle's velocity in
+    the unfolded lattice (its box velocity plus img_y u along x), not from the engine's
+    formula.  Each step is at most the time the fastest relative motion needs to cross
+    half the narrowest side, so every image that can touch within it is among those
+    tried.  Returns (positions, velocities, kinetic energies, boundary work) at
+    sample_times; the work is summed from the momentum carried across the faces (a
+    crossing's m (v + v') / 2, a collision's impulse through an image) times the velocity
+    jump u, and the energy from the velocities."""
+    x, v = x.astype(float).copy(), v.astype(float).copy()
+    n, d = x.shape
+    L = hi - lo
+    u = shear_rate * L[1]
+    unwrapped = x.copy()
+    img_y = np.zeros(n)
+    t, work = 0.0, 0.0
+    out_x, out_v, out_k, out_w = [], [], [], []
+    samples = list(sample_times)
+
+    def delta_at(time):
+        return (shear_offset + u * time) % L[0]
+
+    while True:
+        pt, images = sheared_pair_times(x, v, r, L, u, delta_at(t))
+        i, j = np.unravel_index(np.argmin(pt), pt.shape)
+        t_pair = pt[i, j]
+        cap = 0.5 * L.min() / (abs(u) + 2.0 * np.abs(v).max() + 1e-300)
+        # the next y-face crossing: an event, so that a particle is always represented by
+        # its image inside the box (as the engine does), its velocity in that frame
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_face = np.where(
+                v[:, 1] > 0,
+                (hi[1] - x[:, 1]) / v[:, 1],
+                np.where(v[:, 1] < 0, (lo[1] - x[:, 1]) / v[:, 1], np.inf),
+            )
+        face = int(np.argmin(t_face))
+        t_face = max(t_face[face], 0.0)
+        dt = min(t_pair, cap, t_face)
+        lab = v.copy()
+        lab[:, 0] += img_y * u
+        while samples and samples[0] <= min(t + dt, t_stop):
+            ts = samples.pop(0)
+            out_x.append(unwrapped + lab * (ts - t))
+            out_v.append(v.copy())
+            out_k.append(0.5 * (m[:, None] * v * v).sum())
+            out_w.append(work)
+        if t + dt > t_stop:
+            break
+        x += v * dt
+        unwrapped += lab * dt
+        t += dt
+        # through a y face: y, then x and v_x, then x back into the box
+        ky = np.floor((x[:, 1] - lo[1]) / L[1])
+        if dt == t_face and dt < t_pair:
+            ky[face] = 1.0 if v[face, 1] > 0 else -1.0
+        for p in np.flatnonzero(ky):
+            v_before = v[p, 0]
+            x[p, 1] -= ky[p] * L[1]
+            x[p, 0] -= ky[p] * delta_at(t)
+            v[p, 0] -= ky[p] * u
+            img_y[p] += ky[p]
+            work -= ky[p] * u * m[p] * 0.5 * (v_before + v[p, 0])
+        x[:, 0] -= np.floor((x[:, 0] - lo[0]) / L[0]) * L[0]
+        if d == 3:
+            x[:, 2] -= np.floor((x[:, 2] - lo[2]) / L[2]) * L[2]
+        if t_pair > dt:
+            continue
+        # the image of j that touches i now
+        best_k, best_d = 0, np.inf
+        for k, (kx, kyy, kz) in enumerate(images):
+            shift = np.array(
+                [kx * L[0] + kyy * delta_at(t), kyy * L[1], kz * L[2] if d == 3 else 0]
+            )
+            dist = np.linalg.norm(x[j] + shift[:d] - x[i])
+            if dist < best_d:
+                best_k, best_d, dr = k, dist, x[j] + shift[:d] - x[i]
+        kyy = images[best_k][1]
+        vj = v[j].copy()
+        vj[0] += kyy * u
+        dv = vj - v[i]
+        eps = _eps(xi, -np.dot(dv, dr) / np.sqrt(np.dot(dr, dr)))
+        f = (1 + eps) * np.dot(dv, dr) / (np.dot(dr, dr) * (m[i] + m[j]))
+        v[i] += f * m[j] * dr
+        v[j] -= f * m[i] * dr
+        # i's x momentum change came across the face from j's image
+        work += kyy * u * m[i] * f * m[j] * dr[0]
+    return np.array(out_x), np.array(out_v), np.array(out_k), np.array(out_w)
