@@ -118,3 +118,29 @@ def test_stress_must_be_asked_for_and_a_bool():
         Simulation(s, stress="yes")  # type: ignore[arg-type]
     st = Simulation(s, stress=True).stats
     assert np.isnan(np.array(st["pressure_tensor"])).all()  # no time yet
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_gsd_carries_the_tensor_and_hoomds_pressure_tensor(dim, tmp_path):
+    """granular.read gives the tensor's parts back to the bit; HOOMD's log field
+    md/compute/ThermodynamicQuantities/pressure_tensor holds (xx, xy, xz, yy, yz, zz) of the
+    window average since the previous frame (zeros for z in 2D), frame 0 the kinetic part."""
+    gsd_hoomd = pytest.importorskip("gsd.hoomd")
+    import granular
+
+    s = Scene.random(50, 0.05 if dim == 2 else 0.08, dim=dim, seed=1)
+    tr = Simulation(s, stress=True).run(1.0, sample_times=np.linspace(0, 1, 6))
+    tr.write(tmp_path / "a.gsd")
+    back = granular.read(tmp_path / "a.gsd")
+    for name in ("stress_collisional", "kinetic_time_tensor", "kinetic_tensor"):
+        assert np.array_equal(getattr(back, name), getattr(tr, name)), name
+    full = np.zeros((6, 3, 3))
+    full[1:, :dim, :dim] = tr.pressure_tensor(per_window=True)
+    full[0, :dim, :dim] = tr.kinetic_pressure_tensor()[0]
+    with gsd_hoomd.open(tmp_path / "a.gsd") as f:
+        for k, frame in enumerate(f):
+            got = frame.log["md/compute/ThermodynamicQuantities/pressure_tensor"]
+            p = full[k]
+            assert np.array_equal(got, [p[0, 0], p[0, 1], p[0, 2], p[1, 1], p[1, 2], p[2, 2]])
+    Simulation(s).run(1.0, sample_times=[0.0, 1.0]).write(tmp_path / "b.gsd")
+    assert granular.read(tmp_path / "b.gsd").stress_collisional is None
