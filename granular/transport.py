@@ -179,6 +179,8 @@ def shear_viscosity(
     """The shear viscosity of an equilibrium run by Einstein-Helfand (Green-Kubo, module
     docstring), averaged over the shear components of ``shear_moments``.  T = 2 <E_kin> /
     (d (N - 1)) (the total momentum is conserved: d (N - 1) degrees of freedom), V the box.
+    In 2D the stress autocorrelation's t^-1 tail makes the Green-Kubo integral grow like
+    ln t (Alder & Wainwright): a 2D value depends on the fit window and the box.
 
     Parameters
     ----------
