@@ -227,9 +227,9 @@ static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject
 #define COUNT_OF(field) +1
 static char *edmd_names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                              "periodic", GR_SCENE_DOUBLES(NAME_OF) "cell_factor", "big_ratio",
-                             "shell", "law", "wall_law", NULL};
+                             "shell", "law", "wall_law", "stress", NULL};
 #define EDMD_REQUIRED (7 GR_SCENE_DOUBLES(COUNT_OF))
-#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOO"
+#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOOp"
 
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
@@ -248,7 +248,7 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
                                      sim ? EDMD_FORMAT ":EDMD" : EDMD_FORMAT ":edmd_check",
                                      edmd_names, &opos, &ovel, &orad, &omass, &olo, &ohi,
                                      &cfg.periodic, GR_SCENE_DOUBLES(ADDRESS_OF) &cfg.cell_factor,
-                                     &cfg.big_ratio, &cfg.shell, &olaw, &owall) ||
+                                     &cfg.big_ratio, &cfg.shell, &olaw, &owall, &cfg.stress) ||
         require_keywords(args, kw, edmd_names, EDMD_REQUIRED, sim ? "EDMD" : "edmd_check") < 0)
         return -1;
 #undef ADDRESS_OF
@@ -433,15 +433,17 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
                             "max_events", "sample_times", "next", "positions", "velocities",
                             "kinetic_energy", "momentum", "pair_collisions", "wall_collisions",
                             "virial", "wall_impulse",
+                            "stress_collisional", "kinetic_time_tensor", "kinetic_tensor",
                             NULL};
     gr_edmd_stop stop;
     long long max_events, next;
     PyObject *otimes, *opos = Py_None, *ovel = Py_None, *okin = Py_None, *omom = Py_None,
-             *opair = Py_None, *owall = Py_None, *ovir = Py_None, *oimp = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$dddLOLOOOOOOOO:advance", names, &stop.t_stop,
+             *opair = Py_None, *owall = Py_None, *ovir = Py_None, *oimp = Py_None,
+             *ostc = Py_None, *ostk = Py_None, *okt = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$dddLOLOOOOOOOOOOO:advance", names, &stop.t_stop,
                                      &stop.collisions_per_particle, &stop.kinetic_energy,
                                      &max_events, &otimes, &next, &opos, &ovel, &okin, &omom,
-                                     &opair, &owall, &ovir, &oimp) ||
+                                     &opair, &owall, &ovir, &oimp, &ostc, &ostk, &okt) ||
         require_keywords(args, kw, names, 6, "advance") < 0)
         return NULL;
     if (!check_ready(self)) return NULL;
@@ -469,9 +471,10 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         Py_DECREF(times);
         return NULL;
     }
-    npy_intp nd, td;
+    npy_intp nd, td, tdd;
     if (!mul_size(T, self->n, &nd, "positions") || !mul_size(nd, self->dim, &nd, "positions") ||
-        !mul_size(T, self->dim, &td, "momentum")) {
+        !mul_size(T, self->dim, &td, "momentum") ||
+        !mul_size(td, self->dim, &tdd, "stress_collisional")) {
         Py_DECREF(times);
         return NULL;
     }
@@ -482,7 +485,10 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         !out_buffer(opair, "pair_collisions", NPY_INT64, T, (void **)&smp.pair) ||
         !out_buffer(owall, "wall_collisions", NPY_INT64, T, (void **)&smp.wall) ||
         !out_buffer(ovir, "virial", NPY_FLOAT64, T, (void **)&smp.virial) ||
-        !out_buffer(oimp, "wall_impulse", NPY_FLOAT64, T, (void **)&smp.wall_impulse)) {
+        !out_buffer(oimp, "wall_impulse", NPY_FLOAT64, T, (void **)&smp.wall_impulse) ||
+        !out_buffer(ostc, "stress_collisional", NPY_FLOAT64, tdd, (void **)&smp.stress_collisional) ||
+        !out_buffer(ostk, "kinetic_time_tensor", NPY_FLOAT64, tdd, (void **)&smp.kinetic_time_tensor) ||
+        !out_buffer(okt, "kinetic_tensor", NPY_FLOAT64, tdd, (void **)&smp.kinetic_tensor)) {
         Py_DECREF(times);
         return NULL;
     }
@@ -521,7 +527,8 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     if (!check_ready(self)) return NULL;
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
-    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d,s:d}", "time", c.t,
+#define NINE(x) x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8]
+    PyObject *out = Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d,s:d}", "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
                          (long long)c.crossings, "shell_exits", (long long)c.shell_exits,
@@ -532,6 +539,21 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
                          "kinetic_time_integral", c.kinetic_time, "cells",
                          c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell,
                          "shear_work", c.shear_work);
+    /* the stress tensor's parts: nine numbers each, of which the first dim * dim are the
+     * dim x dim tensor row-major (zeros unless built with stress) */
+    PyObject *st = out ? Py_BuildValue("{s:(ddddddddd),s:(ddddddddd),s:(ddddddddd)}",
+                                       "stress_collisional", NINE(c.stress_collisional),
+                                       "kinetic_time_tensor", NINE(c.kinetic_time_tensor),
+                                       "kinetic_tensor", NINE(c.kinetic_tensor))
+                       : NULL;
+#undef NINE
+    if (!st || PyDict_Update(out, st) < 0) {
+        Py_XDECREF(st);
+        Py_XDECREF(out);
+        return NULL;
+    }
+    Py_DECREF(st);
+    return out;
 }
 
 /* ---- checkpoints (csrc/checkpoint.c) ---- */
@@ -578,7 +600,8 @@ static PyMethodDef EDMD_methods[] = {
      "advance(*, t_stop, collisions_per_particle, stop_kinetic_energy, max_events,"
      " sample_times, next, positions=None, velocities=None, kinetic_energy=None,"
      " momentum=None, pair_collisions=None, wall_collisions=None, virial=None,"
-     " wall_impulse=None) -> (reason, next).  Process events, writing samples into the"
+     " wall_impulse=None, stress_collisional=None, kinetic_time_tensor=None,"
+     " kinetic_tensor=None) -> (reason, next).  Process events, writing samples into the"
      " arrays given (stop_kinetic_energy: the mean to stop at, negative for none)."},
     {"state", (PyCFunction)EDMD_state, METH_NOARGS,
      "state() -> (positions wrapped in the box, velocities, image counters) at the current time"},
@@ -598,7 +621,7 @@ static PyTypeObject EDMDType = {
     .tp_dealloc = (destructor)EDMD_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
     /* the signature line (before "--") is what inspect and stubtest read */
-    .tp_doc = "EDMD(*, cell_factor=1.0, big_ratio=BIG_RATIO, shell=0.0, **scene)\n--\n\n"
+    .tp_doc = "EDMD(*, cell_factor=1.0, big_ratio=BIG_RATIO, shell=0.0, stress=False, **scene)\n--\n\n"
               "Event-driven MD engine (internal: use granular.Simulation).  The scene's "
               "keywords are EDMD_KEYWORDS (Scene._engine_keywords gives them).",
     .tp_methods = EDMD_methods,

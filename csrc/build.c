@@ -7,6 +7,7 @@
 
 #include "engine.h"
 #include "hugemem.h"
+#include "stress.h"
 
 void gr_edmd_free(gr_edmd *s)
 {
@@ -163,6 +164,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         if (!s->big.is_big[i]) cell_insert(&s->cells, i, cell_of(&s->cells, d, s->sched[i].c));
     }
     s->kinetic = 0.5 * v2m;
+    if (cfg->stress) stress_resum(s, d); /* the rest of the tensor starts at 0 (calloc) */
     /* The collapse test's notion of "one instant": a billionth of the time a particle
      * of typical speed needs to cross the smallest diameter. */
     double vrms = sqrt(v2m / msum);

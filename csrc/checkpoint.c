@@ -174,6 +174,7 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, cfg->cell_factor);
     IO(c, cfg->big_ratio);
     IO(c, cfg->shell);
+    IO(c, cfg->stress);
     io_law(c, &cfg->law);
     io_law(c, &cfg->wall_law);
     if (c->law_differs) return; /* read: the rest is not this scene's */
@@ -195,6 +196,10 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, s->kinetic);
     IO(c, s->kinetic_time);
     IO(c, s->shear_work);
+    io(c, s->st_coll, sizeof s->st_coll);
+    io(c, s->st_kin, sizeof s->st_kin);
+    io(c, s->st_kin_time, sizeof s->st_kin_time);
+    IO(c, s->stress_t);
     IO(c, s->order.next);
     IO(c, s->nl.broken);
 
@@ -359,7 +364,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         GR_SCENE_DOUBLES(DIFFERS)
 #undef DIFFERS
         !same_double(a->cell_factor, b->cell_factor) || !same_double(a->big_ratio, b->big_ratio) ||
-        !same_double(a->shell, b->shell))
+        !same_double(a->shell, b->shell) || a->stress != b->stress)
         return "its box, restitution, contact duration or engine knobs differ from the scene's";
     if (t->nl.broken != 0 && t->nl.broken != 1) return "its neighbour-list flag is corrupt";
 
@@ -434,6 +439,10 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         !isfinite(t->shear_work) ||
         t->t_prev_event != t->t_prev_event)
         return "its time or energy counters are not finite";
+    if (!(t->stress_t >= 0.0 && t->stress_t <= t->t)) return "its stress tensor's clock is out of range";
+    for (int k = 0; k < 9; k++)
+        if (!isfinite(t->st_coll[k]) || !isfinite(t->st_kin[k]) || !isfinite(t->st_kin_time[k]))
+            return "its stress tensor is not finite";
     for (int32_t i = 0; i < n; i++) {
         const double *p = rec(t, d, i);
         if (!(TIME(p, d) >= 0.0 && TIME(p, d) <= t->t)) return "a particle's clock is out of range";

@@ -30,6 +30,7 @@
 #include "engine.h"
 #include "rule.h"
 #include "search.h"
+#include "stress.h"
 
 /* Everything an event of particle i is about to read or write, requested at once.  A
  * macro, not a function: GCC takes a function that only prefetches for one without
@@ -200,6 +201,10 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
             if (count >= resum || s->kinetic <= kinetic) { /* rarely: resum <= collisions */
                 if (count >= collisions) return GR_STOP_COLLISIONS;
                 s->kinetic = kinetic_total(s, dyn, dim);
+                if (s->cfg.stress) { /* the kinetic tensor too (stress.h) */
+                    stress_sync(s, dim, s->t);
+                    stress_resum(s, dim);
+                }
                 if (count >= resum) resum = fmin(collisions, next_resum(s));
                 if (stop->energy && s->kinetic <= kinetic) return GR_STOP_ENERGY;
             }
@@ -293,6 +298,9 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
     const double xi = rule_pair_eps(&s->cfg, laws, dim, dr, VEL(p, dim), VEL(q, dim), t,
                                     &s->sched[i], &s->sched[j], &clamped, &s->elastic_tc);
     double before = kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j);
+    double vb[6]; /* the velocities before, for the stress tensor */
+    if (s->cfg.stress)
+        for (int a = 0; a < dim; a++) vb[a] = VEL(p, dim)[a], vb[3 + a] = VEL(q, dim)[a];
     double vir = rule_pair_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
     if (vir < 0.0) { /* grazing: no longer approaching at contact after rounding */
         s->invalid++;
@@ -302,6 +310,8 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
     }
     s->kinetic += kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j) - before;
     s->virial += vir;
+    if (s->cfg.stress)
+        stress_pair(s, dim, t, dr, s->mass[i], vb, VEL(p, dim), s->mass[j], vb + 3, VEL(q, dim));
     s->pair++;
     s->law_clamped += clamped; /* a collision that happened, with the clamped law's eps */
     s->sched[i].count++;
@@ -336,7 +346,11 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
     int64_t clamped; /* 1 if e_w is the law's at its range's end */
     const double ew = rule_wall_eps(&s->cfg, laws, vn, t, &s->sched[i], &clamped);
     s->law_clamped += clamped;
+    double vb[3]; /* the velocity before, for the stress tensor */
+    if (s->cfg.stress)
+        for (int k = 0; k < dim; k++) vb[k] = v[k];
     rule_wall_apply(dim, v, a, ew);
+    if (s->cfg.stress) stress_wall(s, dim, t, s->mass[i], vb, v);
     p[a] = up ? bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim))
               : bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim));
     for (int k = 0; k < dim; k++) {

@@ -57,6 +57,7 @@ typedef struct {
     gr_law law, wall_law;     /* kind GR_LAW_CONSTANT (zeroed): restitution and
                                * wall_restitution above; else eps(v_n) replaces them
                                * (restitution.h).  gr_edmd_new copies the tables. */
+    int stress;               /* 1: keep the stress tensor's accumulators (stress.h) */
 } gr_edmd_config;
 
 typedef struct {
@@ -83,6 +84,10 @@ typedef struct {
     int64_t *wall;        /* count: cumulative wall collisions */
     double *virial;       /* count: cumulative pair virial sum over collisions of r_ij . dp_j */
     double *wall_impulse; /* count: cumulative normal momentum given to the walls */
+    /* with cfg.stress (else ignored), count x dim x dim each: */
+    double *stress_collisional; /* cumulative sum over pair collisions of r_a dp_b */
+    double *kinetic_time_tensor;/* cumulative integral of sum m v_a v_b over time */
+    double *kinetic_tensor;     /* sum m v_a v_b at the sample */
 } gr_edmd_samples;
 
 typedef struct {
@@ -104,6 +109,10 @@ typedef struct {
     int ncell[3];           /* cells per axis */
     double shell;           /* the neighbour lists' shell in largest diameters, 0: none
                              * (a box too small for the shell asked for has none) */
+    /* with cfg.stress (else zeros), dim x dim row-major: */
+    double stress_collisional[9];  /* sum over pair collisions of r_a dp_b */
+    double kinetic_time_tensor[9]; /* integral over time of sum m v_a v_b */
+    double kinetic_tensor[9];      /* sum m v_a v_b now */
 } gr_edmd_counters;
 
 typedef struct gr_edmd gr_edmd;

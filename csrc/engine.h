@@ -62,6 +62,11 @@ struct gr_edmd {
     int le;
     double le_u;
     double shear_work;
+    /* the stress tensor (stress.h), kept with cfg.stress only: d x d, row-major */
+    double st_coll[9];     /* sum over pair collisions of r_a dp_b */
+    double st_kin[9];      /* the kinetic tensor sum m v_a v_b now */
+    double st_kin_time[9]; /* its integral over time up to stress_t */
+    double stress_t;
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are

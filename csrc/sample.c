@@ -4,6 +4,29 @@
 
 #include "engine.h"
 
+/* Sample k's stress tensor parts at ts (stress.h): the cumulative collisional sum and
+ * kinetic integral, and the kinetic tensor summed from the velocities at ts. */
+static void stress_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
+{
+    const int dim = s->dim, dd = dim * dim, dyn = dynamics_of(s);
+    const size_t at = (size_t)smp->next * dd;
+    for (int c = 0; c < dd; c++) {
+        if (smp->stress_collisional) smp->stress_collisional[at + c] = s->st_coll[c];
+        if (smp->kinetic_time_tensor)
+            smp->kinetic_time_tensor[at + c] = s->st_kin_time[c] + s->st_kin[c] * (ts - s->stress_t);
+    }
+    if (!smp->kinetic_tensor) return;
+    double k[9] = {0.0};
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *p = rec(s, dim, i), m = s->mass[i], dt = ts - TIME(p, dim);
+        double v[3];
+        for (int a = 0; a < dim; a++) v[a] = fl_vel_at(dyn, VEL(p, dim)[a], dt);
+        for (int a = 0; a < dim; a++)
+            for (int b = 0; b < dim; b++) k[a * dim + b] += m * v[a] * v[b];
+    }
+    for (int c = 0; c < dd; c++) smp->kinetic_tensor[at + c] = k[c];
+}
+
 void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
 {
     const int dim = s->dim, dyn = dynamics_of(s);
@@ -34,6 +57,7 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
     if (smp->wall) smp->wall[k] = s->wall;
     if (smp->virial) smp->virial[k] = s->virial;
     if (smp->wall_impulse) smp->wall_impulse[k] = s->wall_impulse;
+    if (s->cfg.stress) stress_sample(s, smp, ts);
     smp->next = k + 1;
 }
 
@@ -109,5 +133,10 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->shear_work = s->shear_work;
     c->kinetic = kinetic_total(s, dynamics_of(s), s->dim);
     for (int a = 0; a < 3; a++) c->ncell[a] = s->cells.nc[a];
+    for (int k = 0; k < 9; k++) { /* zeros without cfg.stress (calloc) */
+        c->stress_collisional[k] = s->st_coll[k];
+        c->kinetic_time_tensor[k] = s->st_kin_time[k] + s->st_kin[k] * (s->t - s->stress_t);
+        c->kinetic_tensor[k] = s->st_kin[k];
+    }
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;
 }

@@ -8,7 +8,7 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 
-from . import analysis, clustering, errors, langevin, restitution, theory
+from . import analysis, clustering, errors, langevin, restitution, theory, transport
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
     CheckpointError,
@@ -88,4 +88,5 @@ __all__ = [
     "read",
     "restitution",
     "theory",
+    "transport",
 ]

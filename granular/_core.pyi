@@ -39,6 +39,7 @@ class EDMD:
         cell_factor: float = ...,
         big_ratio: float = ...,
         shell: float = ...,
+        stress: bool = ...,
         **scene: Any,
     ) -> None: ...
     # Returns (the STOP_* reason, the next sample's index).  stop_kinetic_energy < 0: no
@@ -60,6 +61,9 @@ class EDMD:
         wall_collisions: NDArray[np.int64] | None = ...,
         virial: NDArray[np.float64] | None = ...,
         wall_impulse: NDArray[np.float64] | None = ...,
+        stress_collisional: NDArray[np.float64] | None = ...,
+        kinetic_time_tensor: NDArray[np.float64] | None = ...,
+        kinetic_tensor: NDArray[np.float64] | None = ...,
     ) -> tuple[int, int]: ...
     def state(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]: ...
     def counters(self) -> dict[str, Any]: ...

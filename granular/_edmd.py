@@ -65,7 +65,11 @@ def check_memory(need, what):
 
 
 def build(
-    scene: _Scene, cell_factor: float = 1.0, big_ratio: float = _core.BIG_RATIO, shell: Any = "auto"
+    scene: _Scene,
+    cell_factor: float = 1.0,
+    big_ratio: float = _core.BIG_RATIO,
+    shell: Any = "auto",
+    stress: bool = False,
 ) -> _core.EDMD:
     """A new engine (_core.EDMD) at a Scene's state; see Simulation for the knobs."""
     big = bool(np.max(scene.radii) > _core.big_cut(scene.radii, big_ratio))
@@ -104,6 +108,7 @@ def build(
         cell_factor=float(cell_factor),
         big_ratio=float(big_ratio),
         shell=float(shell),
+        stress=stress,
     )
 
 

@@ -72,6 +72,10 @@ QUANTITIES: dict[str, Quantity] = {
     "tracer_radius": Quantity("radius R of a heavy tracer", "L", "positive"),
     "tracer_mass": Quantity("mass M of a heavy tracer", "m", "positive"),
     "chi": Quantity("gas density at the tracer's surface over n", "dimensionless", "positive"),
+    "diffusion": Quantity(
+        "self-diffusion coefficient per dimension, <dx^2> = 2 D t", "L^2 / time", "positive"
+    ),
+    "viscosity": Quantity("shear viscosity", "m / (L^(d-2) time)", "positive"),
     # the models' coefficients
     "D0": Quantity("diffusivity per dimension at t = 0", "L^2 / time", "positive"),
     "gamma0": Quantity("friction rate at t = 0", "1 / time", "positive"),

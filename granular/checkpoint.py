@@ -177,7 +177,7 @@ def dumps(sim: _Run) -> bytes:
         "format_version": FORMAT_VERSION,
         "granular_version": _version(),
         "layout": str(_core.CHECKPOINT_LAYOUT),
-        "knobs": {k: v if isinstance(v, str) else float(v) for k, v in sim._knobs.items()},
+        "knobs": {k: v if isinstance(v, (str, bool)) else float(v) for k, v in sim._knobs.items()},
         "scene": {name: describe(getattr(scene, name)) for name in _SCENE_PARAMS},
         "engine_state_sha256": hashlib.sha256(state.data).hexdigest(),
     }

@@ -35,7 +35,13 @@ The exact float64 (and int64) values granular reads back live in the log section
 
 - every frame: ``log/granular/time`` (the real sample time), ``log/granular/unwrapped_positions``
   and ``log/granular/velocities`` (float64, (N, d)), and the counters ``kinetic_energy``,
-  ``momentum``, ``pair_collisions``, ``wall_collisions``, ``virial``, ``wall_impulse``
+  ``momentum``, ``pair_collisions``, ``wall_collisions``, ``virial``, ``wall_impulse``;
+  from a ``Simulation(stress=True)`` run also the stress tensor's parts
+  ``stress_collisional``, ``kinetic_time_tensor``, ``kinetic_tensor`` (float64, (d, d)), and
+  HOOMD's ``md/compute/ThermodynamicQuantities/pressure_tensor`` (xx, xy, xz, yy, yz, zz,
+  float64, zeros for z in 2D): the pressure tensor averaged over the window since the
+  previous frame (EDMD's collisional stress is impulses: an instant between collisions has
+  only the kinetic part, which is what frame 0, with no window, carries)
 - frame 0: ``stop_reason`` (UTF-8 bytes), ``format`` (this layout's version), and every
   parameter of the run's scene but the positions and velocities (``_scene_params``'s
   ``RUN_PARAMETERS``), each attribute the Scene keeps it in under its own name: ``lower``,
@@ -84,7 +90,12 @@ _COUNTERS = (
 _INT_COUNTERS = ("pair_collisions", "wall_collisions")
 # the log's own names beside the scene parameters' (which may not take one of them:
 # tests/test_scene_params.py checks)
-LOG_NAMES = ("format", "stop_reason", "time", "unwrapped_positions", "velocities", *_COUNTERS)
+# the stress tensor's parts ((d, d) each), present from a Simulation(stress=True) run only
+_TENSORS = ("stress_collisional", "kinetic_time_tensor", "kinetic_tensor")
+_HOOMD_PRESSURE_TENSOR = "md/compute/ThermodynamicQuantities/pressure_tensor"
+LOG_NAMES = (
+    "format", "stop_reason", "time", "unwrapped_positions", "velocities", *_COUNTERS, *_TENSORS
+)  # fmt: skip
 
 
 def _gsd():
@@ -192,6 +203,10 @@ def _frame(hoomd, traj, k, lower, upper):
     for name in _COUNTERS:
         dtype = np.int64 if name in _INT_COUNTERS else np.float64
         log[f"granular/{name}"] = np.atleast_1d(np.asarray(getattr(traj, name)[k], dtype))
+    if traj.stress_collisional is not None:
+        for name in _TENSORS:
+            log[f"granular/{name}"] = np.ascontiguousarray(getattr(traj, name)[k], np.float64)
+        log[_HOOMD_PRESSURE_TENSOR] = _hoomd_pressure_tensor(traj, k)
     if k == 0:
         log["granular/format"] = np.array([FORMAT], dtype=np.int64)
         log["granular/stop_reason"] = _text(traj.stop_reason)
@@ -226,6 +241,18 @@ def _sheared_frame(traj, k, lower, upper):
     c[:, 0] -= shift * lx
     img[:, 0] = img[:, 0] + (m * img[:, 1]).astype(np.int64) + shift.astype(np.int64)
     return delta / ly, c.astype(np.float32), img
+
+
+def _hoomd_pressure_tensor(traj, k):
+    """HOOMD's six components (xx, xy, xz, yy, yz, zz) of the pressure tensor at frame k:
+    averaged over the window since frame k - 1; frame 0 the kinetic part alone."""
+    p = np.zeros((3, 3))
+    d = traj.dim
+    if k == 0:
+        p[:d, :d] = traj.kinetic_pressure_tensor()[0]
+    else:
+        p[:d, :d] = traj.pressure_tensor(per_window=True)[k - 1]
+    return np.array([p[0, 0], p[0, 1], p[0, 2], p[1, 1], p[1, 2], p[2, 2]])
 
 
 def write(traj: Any, path: str | os.PathLike) -> None:
@@ -454,6 +481,8 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
         positions: list[np.ndarray] = []
         velocities: list[np.ndarray] = []
         counters: dict[str, list] = {name: [] for name in _COUNTERS}
+        stress = f.has(0, _log("stress_collisional"))
+        tensors: dict[str, list] = {name: [] for name in _TENSORS} if stress else {}
         for k in range(f.frames):
             t = f.array(k, _log("time"), (1,))[0]
             if not np.isfinite(t):
@@ -477,9 +506,15 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
             for name in _COUNTERS:
                 value = _counter(f, k, name, d, counters[name])
                 counters[name].append(value)
+            for name in tensors:
+                tensor = f.array(k, _log(name), (d, d))
+                if not np.all(np.isfinite(tensor)):
+                    raise f.error(k, _log(name), "contains NaN or infinity")
+                tensors[name].append(tensor)
     # the counters' keywords: arrays of floats or of counts (Any: mypy would match them
     # against every keyword of Trajectory, its strings too)
     arrays: dict[str, Any] = {name: np.array(values) for name, values in counters.items()}
+    arrays.update({name: np.array(values).reshape(-1, d, d) for name, values in tensors.items()})
     return make_trajectory(
         np.array(times),
         np.array(positions).reshape(len(times), n, d),

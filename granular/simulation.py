@@ -41,6 +41,9 @@ _COUNTED = (
     ("wall_impulse", np.float64),
 )
 _LIST_SHELL = _edmd.LIST_SHELL  # see _edmd
+# The stress tensor's parts a sample records with Simulation(stress=True), each (d, d):
+# the cumulative collisional sum, the cumulative kinetic integral, the kinetic tensor now.
+_TENSORS = ("stress_collisional", "kinetic_time_tensor", "kinetic_tensor")
 
 
 class Simulation:
@@ -68,6 +71,11 @@ class Simulation:
         cells otherwise.  A number must be 0 or at least 0.01; lists with a big particle
         are refused unless ``big_ratio=math.inf``.  ``stats["shell"]`` says which mode
         ran.
+    stress : bool
+        Keep the stress (pressure) tensor, kinetic plus collisional (see docs/stress.md):
+        samples then carry its parts (``Trajectory.pressure_tensor``) and ``stats`` its
+        average since the start.  Off by default: it costs some 100 instructions a
+        collision, about a tenth of an event.
     """
 
     def __init__(
@@ -77,12 +85,22 @@ class Simulation:
         cell_factor: float = 1.0,
         big_ratio: float = BIG_RATIO,
         shell: str | float = "auto",
+        stress: bool = False,
     ) -> None:
         if not isinstance(scene, Scene):
             raise TypeError(f"Simulation needs a granular.Scene, got {type(scene).__name__}")
+        if not isinstance(stress, (bool, np.bool_)):
+            from .errors import shown
+
+            raise TypeError(f"stress must be True or False, got {shown(stress)}")
+        stress = bool(stress)
         self._initial = scene
-        self._engine = _edmd.build(scene, cell_factor, big_ratio, shell)
-        self._knobs = dict(cell_factor=cell_factor, big_ratio=big_ratio, shell=shell)
+        self._engine = _edmd.build(scene, cell_factor, big_ratio, shell, stress)
+        self._knobs: dict[str, Any] = dict(
+            cell_factor=cell_factor, big_ratio=big_ratio, shell=shell
+        )
+        if stress:  # only when set: checkpoints of other Simulations keep their knobs
+            self._knobs["stress"] = True
         # held for a whole run: the engine's own busy flag covers one C call only, and two
         # interleaved runs would write each other's samples
         self._running = threading.Lock()
@@ -192,16 +210,33 @@ class Simulation:
         collisions' virial.  In a periodic box V is the box volume.  In a walled box the
         walls' virial is -P d V_reach, so V is the volume the centres reach, the box shrunk
         by one radius at each face (see ``Trajectory.pressure``: exact for equal radii,
-        approximate for mixtures)."""
+        approximate for mixtures).
+
+        With ``Simulation(stress=True)`` also: stress_collisional, kinetic_time_tensor,
+        kinetic_tensor (each d rows of d numbers, a tuple of tuples: ``np.array`` makes
+        the matrix; see ``Trajectory``) and pressure_tensor, their average since the start
+        in the same volume, whose trace over d is ``pressure`` to rounding."""
         c = self._engine.counters()
         s = self._initial
+        d = s.dim
+        # the engine gives nine numbers, the first d*d the tensor; stats holds plain values
+        # (tuples of rows, as "cells"), so that two stats compare with ==
+        tensors = {name: np.array(c.pop(name)[: d * d]).reshape(d, d) for name in _TENSORS}
         if c["time"] > 0:
             volume = _pressure_volume(s.lower, s.upper, s.radii, s.boundary)
             c["pressure"] = (
                 (2.0 * c["kinetic_time_integral"] + c["virial"]) / c["time"] / (s.dim * volume)
             )
+            tensors["pressure_tensor"] = (
+                (tensors["kinetic_time_tensor"] + tensors["stress_collisional"])
+                / c["time"]
+                / volume
+            )
         else:
             c["pressure"] = float("nan")
+            tensors["pressure_tensor"] = np.full((d, d), np.nan)
+        if self._knobs.get("stress"):
+            c.update({k: tuple(map(tuple, v.tolist())) for k, v in tensors.items()})
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
         if s.shear_rate != 0.0:  # the peculiar velocities' (granular/_shear.py)
             from ._shear import flow_temperature
@@ -533,6 +568,9 @@ class Simulation:
         buf["momentum"][k] = (m * vel).sum(axis=0)
         for name, _ in _COUNTED:
             buf[name][k] = c[name]
+        for name in _TENSORS:
+            if buf.get(name) is not None:
+                buf[name][k] = np.array(c[name][: vel.shape[1] ** 2]).reshape(vel.shape[1], -1)
 
     def _buffers(self, count, store):
         n, d = self._initial.n, self._initial.dim
@@ -541,6 +579,10 @@ class Simulation:
             velocities=np.zeros((count, n, d)) if "velocities" in store else None,
             momentum=np.zeros((count, d)),
             **{name: np.zeros(count, dtype=dtype) for name, dtype in _COUNTED},
+            **{
+                name: np.zeros((count, d, d)) if self._knobs.get("stress") else None
+                for name in _TENSORS
+            },
         )
 
     def _trajectory(self, times, buf, k, reason):

@@ -41,6 +41,12 @@ class Trajectory:
     pair_collisions, wall_collisions : (T,) cumulative counts since the simulation began
     virial : (T,) cumulative sum over pair collisions of r_ij . dp_j
     wall_impulse : (T,) cumulative normal momentum given to the walls
+    stress_collisional : (T, d, d) cumulative sum over pair collisions of r_a dp_b (r =
+        x_j - x_i at contact, dp the momentum j received), or None unless the Simulation
+        was built with ``stress=True``
+    kinetic_time_tensor : (T, d, d) cumulative integral over time of sum_i m_i v_a v_b,
+        or None (as above)
+    kinetic_tensor : (T, d, d) sum_i m_i v_a v_b at each sample, or None (as above)
     stop_reason : why the run ended: "time", "collisions", "kinetic_energy", "events",
         "idle" (no event will ever happen); a run cut short carries the samples so far in
         its exception's ``.trajectory``, with "error" or, after Ctrl-C, "interrupted"
@@ -62,6 +68,9 @@ class Trajectory:
     wall_collisions: NDArray[np.int64]
     virial: NDArray[np.float64]
     wall_impulse: NDArray[np.float64]
+    stress_collisional: NDArray[np.float64] | None
+    kinetic_time_tensor: NDArray[np.float64] | None
+    kinetic_tensor: NDArray[np.float64] | None
     masses: NDArray[np.float64]
     radii: NDArray[np.float64]
     lower: NDArray[np.float64]
@@ -89,6 +98,9 @@ class Trajectory:
         boundary: str,
         stop_reason: str,
         parameters: dict[str, Any] | None = None,
+        stress_collisional: NDArray[np.float64] | None = None,
+        kinetic_time_tensor: NDArray[np.float64] | None = None,
+        kinetic_tensor: NDArray[np.float64] | None = None,
     ) -> None:
         # read-only views: a caller writing into an array the trajectory hands out gets a
         # ValueError instead of changing the trajectory unseen
@@ -102,6 +114,9 @@ class Trajectory:
             wall_collisions=wall_collisions,
             virial=virial,
             wall_impulse=wall_impulse,
+            stress_collisional=stress_collisional,
+            kinetic_time_tensor=kinetic_time_tensor,
+            kinetic_tensor=kinetic_tensor,
             masses=masses,
             radii=radii,
             lower=lower,
@@ -222,6 +237,52 @@ class Trajectory:
         w = self.virial[-1] - self.virial[0]
         volume = _pressure_volume(self.lower, self.upper, self.radii, self.boundary)
         return float((2.0 * mean_k + w / span) / (self.dim * volume))
+
+    def pressure_tensor(self, per_window: bool = False) -> NDArray[np.float64]:
+        """The pressure tensor P_ab = (int sum_i m_i v_a v_b dt + sum r_a dp_b) / (V dt),
+        kinetic plus collisional (docs/stress.md), over the run between the first and the
+        last sample: exact up to rounding (the kinetic part is integrated through every
+        collision, not from the samples).  Its trace over d is ``pressure()`` to rounding;
+        V as there (the box; between walls the volume the centres reach: wall impulses do
+        not enter, as they do not enter ``pressure``).  Needs ``Simulation(stress=True)``.
+
+        Parameters
+        ----------
+        per_window : bool
+            Return (T - 1, d, d), the tensor averaged over each window between consecutive
+            samples, instead of (d, d) over the whole run.
+        """
+        coll = self._need_stress()
+        kin = self.kinetic_time_tensor
+        assert kin is not None
+        t = self.times
+        volume = _pressure_volume(self.lower, self.upper, self.radii, self.boundary)
+        if per_window:
+            if len(t) < 2:
+                raise ValueError("pressure_tensor needs at least two samples")
+            return np.asarray(
+                (np.diff(kin, axis=0) + np.diff(coll, axis=0))
+                / (np.diff(t)[:, None, None] * volume)
+            )
+        if len(t) < 2 or t[-1] <= t[0]:
+            raise ValueError("pressure_tensor needs at least two samples spanning some time")
+        return np.asarray(((kin[-1] - kin[0]) + (coll[-1] - coll[0])) / ((t[-1] - t[0]) * volume))
+
+    def kinetic_pressure_tensor(self) -> NDArray[np.float64]:
+        """(T, d, d) the instantaneous kinetic part of the pressure tensor at each sample,
+        sum_i m_i v_a v_b / V (V as in ``pressure_tensor``).  Needs
+        ``Simulation(stress=True)``."""
+        self._need_stress()
+        kin = self.kinetic_tensor
+        assert kin is not None
+        return np.asarray(kin / _pressure_volume(self.lower, self.upper, self.radii, self.boundary))
+
+    def _need_stress(self) -> NDArray[np.float64]:
+        if self.stress_collisional is None:
+            raise ValueError(
+                "this trajectory has no stress tensor: build the Simulation with stress=True"
+            )
+        return self.stress_collisional
 
     def wall_pressure(self) -> float:
         """Mechanical pressure on the walls between the first and last sample: the normal

@@ -43,6 +43,9 @@ def _assert_same_trajectory(a, b):
         "wall_collisions",
         "virial",
         "wall_impulse",
+        "stress_collisional",
+        "kinetic_time_tensor",
+        "kinetic_tensor",
     ):
         x, y = getattr(a, name), getattr(b, name)
         assert (x is None) == (y is None), name
@@ -169,6 +172,15 @@ MODES = {
             seed=13,
         ),
         {},
+    ),
+    # the stress tensor's accumulators (csrc/stress.h), with walls and with lists
+    "3d-stress-walls": lambda: (
+        Scene.random(200, 0.03, dim=3, boundary="walls", restitution=0.9, seed=15),
+        {"stress": True},
+    ),
+    "2d-stress-lists": lambda: (
+        Scene.random(300, 0.015, dim=2, seed=16),
+        {"shell": 0.25, "stress": True},
     ),
     "3d-mixture-cell-factor": lambda: (
         Scene.random(300, np.linspace(0.02, 0.035, 300), dim=3, seed=11),

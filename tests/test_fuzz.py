@@ -126,5 +126,5 @@ def test_fuzz_inputs_end_in_a_clear_error_or_a_valid_result():
         f"(tally {dict(tally)}):\n" + "\n".join(failures)
     )
     # not a vacuous run: every entry point both accepted inputs and refused some
-    for kind in ("scene", "random", "run", "langevin", "table", "checkpoint", "threads"):
+    for kind in ("scene", "random", "run", "langevin", "table", "checkpoint", "threads", "stress"):
         assert tally[kind, "ok"] >= 10 and tally[kind, "error"] >= 10, dict(tally)

@@ -11,7 +11,7 @@ import granular
 from granular import Scene, Simulation, TabulatedRestitution, Viscoelastic, _core, _scene_params
 from granular._scene_params import BY_NAME, NAMES, PARAMETERS, REQUIRED
 
-_ENGINE_KNOBS = {"cell_factor", "big_ratio", "shell"}  # Simulation's, not the scene's
+_ENGINE_KNOBS = {"cell_factor", "big_ratio", "shell", "stress"}  # Simulation's, not the scene's
 
 
 _INNER = (np.array([-1.0, 0.5]), np.array([1.5, 2.0]))

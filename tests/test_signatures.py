@@ -164,6 +164,8 @@ VALID = {
     "tracer_radius": 0.1,
     "tracer_mass": 25.0,
     "chi": 1.2,
+    "diffusion": 0.01,
+    "viscosity": 0.3,
     "D0": 0.07,
     "gamma0": 9.26,
     "tau0": 10.0,

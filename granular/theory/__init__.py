@@ -73,6 +73,12 @@ from .tracer import (
     tracer_friction,
     tracer_langevin_coefficients,
 )
+from .transport import (
+    YEH_HUMMER_XI,
+    diffusion_infinite_system,
+    enskog_diffusion,
+    enskog_viscosity,
+)
 from .udsbm import (
     msd_powerlaw_udsbm,
     msd_powerlaw_udsbm_asymptote,
@@ -102,6 +108,7 @@ from .viscoelastic import (
 __all__ = [
     "VISCOELASTIC_C1",
     "VISCOELASTIC_C2",
+    "YEH_HUMMER_XI",
     "AKappa",
     "FloatOrArray",
     "LangevinCoefficients",
@@ -112,6 +119,9 @@ __all__ = [
     "cooling_rate",
     "critical_box_size",
     "diffusion_d0",
+    "diffusion_infinite_system",
+    "enskog_diffusion",
+    "enskog_viscosity",
     "haff_tau0",
     "haff_temperature",
     "langevin_coefficients",

@@ -386,6 +386,18 @@ def _big_n(rng, p):
     return f"big: n={p['n']}"
 
 
+def _stress_params(rng):
+    """A run baseline with the stress tensor kept (Simulation(stress=True))."""
+    return dict(_run_params(rng), knobs={"stress": True})
+
+
+def _stress_knob(rng, p):
+    """Simulation(stress=...): the tensor kept (True, NumPy's True) or a refused value."""
+    v = [True, np.bool_(True), "yes", 1, None][int(rng.integers(5))]
+    p["knobs"] = {"stress": v}
+    return f"Simulation(stress={v!r})"
+
+
 RUN_MUTATIONS = [
     _scene_key("restitution", [0.0, 0.5, 0.99]),
     _scene_key("wall_restitution", [0.5, 1.2, 2.0, 1e3]),
@@ -756,6 +768,10 @@ LATER_SHARE = 0.2  # of the cases
 # (the first stream's cases stay as they were, fewer by this share).
 SCALE_KINDS = {"langevin": (_langevin_params, LANGEVIN_SCALE_MUTATIONS)}
 SCALE_SHARE = 0.06
+# Runs keeping the stress tensor (and bad values of the knob), from a fourth stream (the
+# first stream's cases stay as they were, fewer by this share).
+STRESS_KINDS = {"stress": (_stress_params, [*RUN_MUTATIONS, _stress_knob])}
+STRESS_SHARE = 0.04
 
 
 def _draw(rng, kinds, count, at_least_one=()):
@@ -781,11 +797,13 @@ def _draw(rng, kinds, count, at_least_one=()):
 def make_cases(seed, count):
     """``count`` cases as dicts {kind, params, labels}, the same for the same seed."""
     later, scales = int(LATER_SHARE * count), int(SCALE_SHARE * count)
-    first = _draw(np.random.default_rng(seed), KINDS, count - later - scales)
+    stress = int(STRESS_SHARE * count)
+    first = _draw(np.random.default_rng(seed), KINDS, count - later - scales - stress)
     return (
         first
         + _draw(np.random.default_rng([seed, 1]), LATER_KINDS, later, ("threads",))
         + _draw(np.random.default_rng([seed, 2]), SCALE_KINDS, scales, ("langevin",))
+        + _draw(np.random.default_rng([seed, 3]), STRESS_KINDS, stress)
     )
 
 
@@ -844,6 +862,11 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
     for name in ("times", "positions", "velocities", "kinetic_energy", "momentum"):
         a = getattr(traj, name)
         _check(a is None or np.all(np.isfinite(a)), f"non-finite {name} in the trajectory")
+    for name in ("stress_collisional", "kinetic_time_tensor", "kinetic_tensor"):  # stress=True
+        a = getattr(traj, name)
+        _check(a is None or np.all(np.isfinite(a)), f"non-finite {name} in the trajectory")
+        if a is not None:
+            _check(np.all(np.isfinite(sim.stats[name])), f"non-finite stats {name}")
     stats = {
         k: v
         for k, v in sim.stats.items()  # pressure: NaN is a documented answer
@@ -1009,9 +1032,9 @@ def run_case(case):
                 "the radii are not the requested ones, particle by particle",
             )
             _run_scene(s)
-        elif kind == "run":
+        elif kind in ("run", "stress"):
             scene = Scene.random(**p["scene"])
-            sim = Simulation(scene)
+            sim = Simulation(scene, **p.get("knobs", {}))
             traj = sim.run(**p["run"])
             _check_trajectory(scene, traj, sim, p["run"].get("sample_times"))
             if "again" in p:

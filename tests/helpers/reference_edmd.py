@@ -36,10 +36,12 @@ def pair_times(x, v, r, L, periodic):
     return best
 
 
-def run_scene(scene, t_stop, sample_times):
+def run_scene(scene, t_stop, sample_times, tensors=None):
     """``run`` for a granular.Scene: its state, box, restitution and wall restitution
-    (``run_sheared`` for a sheared one)."""
+    (``run_sheared`` for a sheared one, which sums no tensors)."""
     if getattr(scene, "shear_rate", 0.0) != 0.0:
+        if tensors is not None:
+            raise NotImplementedError("the sheared reference sums no stress tensors")
         return run_sheared(
             np.array(scene.positions),
             np.array(scene.velocities),
@@ -65,6 +67,7 @@ def run_scene(scene, t_stop, sample_times):
         t_stop,
         sample_times,
         wall_e=scene.wall_restitution,
+        tensors=tensors,
     )
 
 
@@ -72,15 +75,22 @@ def _eps(restitution, speed):
     return float(restitution(speed)) if callable(restitution) else restitution
 
 
-def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0):
-    """Positions (unwrapped) and velocities at sample_times."""
+def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0, tensors=None):
+    """Positions (unwrapped) and velocities at sample_times.  A dict ``tensors`` gets the
+    stress tensor's parts at the sample times: "collisional" (sum over pair collisions of
+    dr_a dp_b, dr = x_j - x_i, dp j's momentum change) and "kinetic_time" (the integral of
+    sum m v_a v_b over time, summed step by step)."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
     L = hi - lo
     image = np.zeros_like(x)
     t = 0.0
     out_x, out_v = [], []
     samples = list(sample_times)
+    d = x.shape[1]
+    coll, kin_time = np.zeros((d, d)), np.zeros((d, d))
+    coll_out, kin_out = [], []
     while True:
+        kin = np.einsum("i,ia,ib->ab", m, v, v)
         pt = pair_times(x, v, r, L, periodic)
         i, j = np.unravel_index(np.argmin(pt), pt.shape)
         t_pair = pt[i, j]
@@ -97,10 +107,13 @@ def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0):
             ts = samples.pop(0)
             out_x.append(x + v * (ts - t) + image * L)
             out_v.append(v.copy())
+            coll_out.append(coll.copy())
+            kin_out.append(kin_time + kin * (ts - t))
         if t + dt > t_stop:
             break
         x += v * dt
         t += dt
+        kin_time = kin_time + kin * dt
         if periodic:
             wrap = np.floor((x - lo) / L)
             x -= wrap * L
@@ -114,11 +127,15 @@ def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0):
             f = (1 + eps) * np.dot(dv, dr) / (np.dot(dr, dr) * (m[i] + m[j]))
             v[i] += f * m[j] * dr
             v[j] -= f * m[i] * dr
+            coll += np.outer(dr, -f * m[i] * m[j] * dr)
         else:
             p, a = wall
             e_w = _eps(wall_e, abs(v[p, a]))
             v[p, a] = -v[p, a]
             v[p] *= e_w
+    if tensors is not None:
+        tensors["collisional"] = np.array(coll_out)
+        tensors["kinetic_time"] = np.array(kin_out)
     return np.array(out_x), np.array(out_v)
 
 

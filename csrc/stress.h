@@ -1,0 +1,78 @@
+/* stress.h -- the stress (pressure) tensor's accumulators, kept only when the engine was
+ * built with cfg.stress = 1 (a d x d tensor per collision costs some 100 instructions, a
+ * tenth of an event: the plain loop pays one untaken branch per collision for it).
+ *
+ * The pressure tensor over a window [t0, t1] of a box of volume V is
+ *     P_ab = ( int_t0^t1 K_ab dt + W_ab(t1) - W_ab(t0) ) / (V (t1 - t0)),
+ *     K_ab = sum_i m_i v_ia v_ib                  (the kinetic tensor, instantaneous),
+ *     W_ab = sum over pair collisions of r_a dp_b  (r = x_j - x_i at contact, the
+ *            separation the collision used; dp = the momentum j received),
+ * Irving & Kirkwood's (J. Chem. Phys. 18, 817 (1950)) kinetic plus collisional parts for
+ * instantaneous impulses (Allen & Tildesley, Computer Simulation of Liquids, 2nd ed.,
+ * section 2.4 and 3.7.2).  Its trace over d is the scalar pressure granular already
+ * computes (2 int E_kin dt + virial, Trajectory.pressure) to rounding: trace(W) is
+ * r . dp summed in another order than the virial, trace(int K) twice the kinetic-energy
+ * integral kept by other differences.  Wall impulses do not enter, as they do not enter
+ * the scalar pressure (its walled V is the volume the centres reach).
+ *
+ * The kinetic tensor is kept by differences at each collision (the only moments a velocity
+ * changes under constant-velocity flight), with its integral brought up to the time of the
+ * last change (stress_t): the integral to any later t is st_kin_time + K (t - stress_t),
+ * exact up to rounding.  K is summed anew from the velocities whenever s->kinetic is
+ * (edmd.c, at fixed collision counts), so checkpoints continue it bit for bit. */
+#ifndef GR_STRESS_H
+#define GR_STRESS_H
+
+#include "engine.h"
+
+/* Bring the kinetic tensor's integral to time t (>= stress_t). */
+static inline void stress_sync(gr_edmd *s, int dim, double t)
+{
+    const double dt = t - s->stress_t;
+    for (int k = 0; k < dim * dim; k++) s->st_kin_time[k] += s->st_kin[k] * dt;
+    s->stress_t = t;
+}
+
+/* The kinetic tensor summed from the velocities (records hold the velocities at each
+ * particle's own clock: right for constant velocity, see kinetic_total). */
+static inline void stress_resum(gr_edmd *s, int dim)
+{
+    double k[9] = {0.0};
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *v = VEL(rec(s, dim, i), dim), m = s->mass[i];
+        for (int a = 0; a < dim; a++)
+            for (int b = 0; b < dim; b++) k[a * dim + b] += m * v[a] * v[b];
+    }
+    for (int c = 0; c < dim * dim; c++) s->st_kin[c] = k[c];
+}
+
+/* One particle's velocity changed from vb to v at t: the kinetic tensor's change. */
+static inline void stress_kick(gr_edmd *s, int dim, double m, const double *vb, const double *v)
+{
+    for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++) s->st_kin[a * dim + b] += m * (v[a] * v[b] - vb[a] * vb[b]);
+}
+
+/* A pair collision at t with separation dr = x_j - x_i: i's velocity went from vib to vi,
+ * j's from vjb to vj.  The impulse on j is taken from j's velocity change (whatever the
+ * rule: a tangential part makes W asymmetric, as it should). */
+static inline void stress_pair(gr_edmd *s, int dim, double t, const double *dr, double mi,
+                               const double *vib, const double *vi, double mj,
+                               const double *vjb, const double *vj)
+{
+    stress_sync(s, dim, t);
+    for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++) s->st_coll[a * dim + b] += dr[a] * (mj * (vj[b] - vjb[b]));
+    stress_kick(s, dim, mi, vib, vi);
+    stress_kick(s, dim, mj, vjb, vj);
+}
+
+/* A wall collision at t: only the kinetic tensor changes (walls stay out of W). */
+static inline void stress_wall(gr_edmd *s, int dim, double t, double m, const double *vb,
+                               const double *v)
+{
+    stress_sync(s, dim, t);
+    stress_kick(s, dim, m, vb, v);
+}
+
+#endif
