@@ -73,6 +73,14 @@ from .tracer import (
     tracer_friction,
     tracer_langevin_coefficients,
 )
+from .trap import (
+    barometric_density,
+    gravity_mean_displacement,
+    msd_trap,
+    msd_trap_plateau,
+    trap_position_autocorrelation,
+    trap_velocity_autocorrelation,
+)
 from .udsbm import (
     msd_powerlaw_udsbm,
     msd_powerlaw_udsbm_asymptote,
@@ -105,6 +113,7 @@ __all__ = [
     "AKappa",
     "FloatOrArray",
     "LangevinCoefficients",
+    "barometric_density",
     "collision_frequency",
     "collision_time",
     "compressibility_factor",
@@ -112,6 +121,7 @@ __all__ = [
     "cooling_rate",
     "critical_box_size",
     "diffusion_d0",
+    "gravity_mean_displacement",
     "haff_tau0",
     "haff_temperature",
     "langevin_coefficients",
@@ -124,6 +134,8 @@ __all__ = [
     "msd_logarithmic",
     "msd_powerlaw_udsbm",
     "msd_powerlaw_udsbm_asymptote",
+    "msd_trap",
+    "msd_trap_plateau",
     "msd_udsbm",
     "msd_viscoelastic",
     "msd_viscoelastic_asymptote",
@@ -137,6 +149,8 @@ __all__ = [
     "tracer_contact_value",
     "tracer_friction",
     "tracer_langevin_coefficients",
+    "trap_position_autocorrelation",
+    "trap_velocity_autocorrelation",
     "udsbm_ergodicity_breaking",
     "udsbm_increment_msd",
     "udsbm_v0_sq",
