@@ -93,7 +93,7 @@ def _fig_langevin_forces(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax.set_xscale("log")
     ax.set_xlabel("t")
     ax.set_ylabel("MSD / (2 d T / k)")
-    ax.set_title("Harmonic trap: MSD against theory.msd_trap")
+    ax.set_title("Harmonic trap: MSD (points) against theory (lines)")
     ax.legend(fontsize=8)
 
     # where Euler-Maruyama fails: its stationary <x^2> against (k/m) dt / gamma0
