@@ -164,10 +164,15 @@ typedef struct {
     int64_t table_from;      /* the step that table[0] and em_table[0] start from */
     const double *em_table;  /* Euler-Maruyama's (1 - gamma dt, sqrt(2 D dt) gamma) per step
                                 for an exponent != 1 (a pow a step saved per particle), or NULL */
-    int force;               /* external forces: run_steps_force */
-    double accel[3], stiffness[3];
-    force_coef fc[3];        /* the exact scheme's per axis */
+    const struct force_params *force; /* external forces (run_steps_force), or NULL; apart,
+                                         so that the force-free loop's data stay as they were */
 } step_params;
+
+/* The external force's per-axis data. */
+typedef struct force_params {
+    double accel[3], stiffness[3];
+    force_coef fc[3]; /* the exact scheme's */
+} force_params;
 
 /* A particle's normals drawn ahead (rng.h's gr_normal_batch): z[k * GR_NORMAL_BATCH + j]
  * is the k-th normal of step first + j (the stream (key, first + j - 1, i)). */
@@ -251,22 +256,38 @@ static GR_ALWAYS_INLINE void run_steps_force(const int d, const step_params *p, 
             gr_normal_batch(p->key, (uint64_t)(step - 1), (uint64_t)i, m, ahead->z);
         }
         const double *z = ahead->z + (step - ahead->first);
+        const force_params *fp = p->force;
         if (p->em) {
             const double a_coef = 1.0 - p->g0 * dt, b = p->b0;
             for (int a = 0; a < d; a++) {
-                const double f = p->accel[a] - p->stiffness[a] * (oi[a] + xi[a]);
+                const double f = fp->accel[a] - fp->stiffness[a] * (oi[a] + xi[a]);
                 xi[a] += vi[a] * dt;
                 vi[a] = a_coef * vi[a] + f * dt + b * z[a * GR_NORMAL_BATCH];
             }
         } else {
             for (int a = 0; a < d; a++) {
-                const force_coef e = p->fc[a];
+                const force_coef e = fp->fc[a];
                 const double z1 = z[2 * a * GR_NORMAL_BATCH], z2 = z[(2 * a + 1) * GR_NORMAL_BATCH];
-                const double f = p->accel[a] - p->stiffness[a] * (oi[a] + xi[a]);
+                const double f = fp->accel[a] - fp->stiffness[a] * (oi[a] + xi[a]);
                 xi[a] += vi[a] * e.e12 + f * e.j1 + e.kx * z1 + e.sx * z2;
                 vi[a] = e.e22 * vi[a] + e.e12 * f + e.sv * z1;
             }
         }
+    }
+}
+
+/* run_steps_force for each dimension, kept out of run_particle (never inlined there) so
+ * that the force-free loop is compiled as it was without forces. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline))
+#endif
+static void steps_force(const int d, const step_params *p, int64_t i, int64_t from, int64_t to,
+                        double *xi, double *vi, const double *oi, normals_ahead *ahead)
+{
+    switch (d) {
+    case 1: run_steps_force(1, p, i, from, to, xi, vi, oi, ahead); break;
+    case 2: run_steps_force(2, p, i, from, to, xi, vi, oi, ahead); break;
+    default: run_steps_force(3, p, i, from, to, xi, vi, oi, ahead); break;
     }
 }
 
@@ -398,11 +419,7 @@ static int run_particle(const run_shared *rs, int64_t i, double *x, double *v,
         /* steps step+1 .. next, each with its own dimension so that the axis loops
          * unroll */
         if (rs->sp->force) {
-            switch (d) {
-            case 1: run_steps_force(1, rs->sp, i, step, next, xi, vi, oi, &ahead); break;
-            case 2: run_steps_force(2, rs->sp, i, step, next, xi, vi, oi, &ahead); break;
-            default: run_steps_force(3, rs->sp, i, step, next, xi, vi, oi, &ahead); break;
-            }
+            steps_force(d, rs->sp, i, step, next, xi, vi, oi, &ahead);
         } else {
             switch (d) {
             case 1: run_steps(1, rs->sp, i, step, next, xi, vi, &ahead); break;
@@ -526,16 +543,16 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
         }
     }
 
-    step_params sp = {cfg->key, dt, g0, D0, tau0, b0, expo, udsbm, cfg->scheme == GR_SDE_EM,
-                      ex0, table, step_from, em_table, 0, {0, 0, 0}, {0, 0, 0}, {{0, 0, 0, 0, 0, 0}}};
-    if (cfg->force) {
-        sp.force = 1;
+    force_params fp;
+    memset(&fp, 0, sizeof fp);
+    if (cfg->force)
         for (int a = 0; a < d; a++) {
-            sp.accel[a] = cfg->accel[a];
-            sp.stiffness[a] = cfg->stiffness[a];
-            if (cfg->scheme == GR_SDE_EXACT) sp.fc[a] = force_exact_for(g0, D0, cfg->stiffness[a], dt);
+            fp.accel[a] = cfg->accel[a];
+            fp.stiffness[a] = cfg->stiffness[a];
+            if (cfg->scheme == GR_SDE_EXACT) fp.fc[a] = force_exact_for(g0, D0, cfg->stiffness[a], dt);
         }
-    }
+    const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, expo, udsbm, cfg->scheme == GR_SDE_EM,
+                            ex0, table, step_from, em_table, cfg->force ? &fp : NULL};
 
     /* The ensemble sums, the same bits for any split: each block of GR_SDE_BLOCK particles
      * (by global index) sums its particles in index order from zero (or from the carry a
