@@ -189,7 +189,7 @@ def test_trap_msd_matches_theory_in_every_regime(regime):
 
 
 def test_the_exact_scheme_keeps_the_stationary_state_at_any_step():
-    """Steps of 2 / gamma0 (underdamped, sqrt(w) dt = 4), far beyond any Euler-Maruyama
+    """Steps of 2 / gamma0 (underdamped, sqrt(w) dt = 2), far beyond any Euler-Maruyama
     limit: after 50 steps the positions about the balance point keep the variance T / k and
     the velocities T / m (exactness; EM is refused here).  Relative standard error of a
     variance of n Gaussian samples: sqrt(2 / n) (plus the balance point's; the mean is

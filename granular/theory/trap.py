@@ -9,7 +9,9 @@ is a linear (Ornstein-Uhlenbeck) process in (x, v): the harmonically bound Brown
 of Uhlenbeck & Ornstein, Phys. Rev. 36, 823 (1930), sec. 4 ("harmonically bound particle"),
 and of Chandrasekhar, Rev. Mod. Phys. 15, 1 (1943), ch. II sec. 3 ("The Brownian motion of
 a particle in a field of force. The harmonically bound particle") -- cited by section: we
-did not check their equation numbers against the printed papers.  Its mean propagates by
+did not check their equation numbers against the printed papers.  Norrelykke &
+Flyvbjerg, Phys. Rev. E 83, 041103 (2011) give its stationary correlations and an exact
+step of any size in the underdamped case.  Its mean propagates by
 E(t) = exp(A t), A = [[0, 1], [-w, -gamma0]]:
 
     e11(t) = exp(-gamma0 t / 2) [C(t) + (gamma0 / 2) S(t)],   e12(t) = exp(-gamma0 t / 2) S(t),
