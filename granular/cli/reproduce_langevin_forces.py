@@ -56,7 +56,7 @@ def _fig_langevin_forces(cfg, out, *, ensemble, save, fig, row, mean_row):
         t_relax = 1.0 / _slowest_rate(w)
         t_stop = 20.0 * t_relax
         times = np.unique(np.rint(np.geomspace(DT, t_stop, 40) / DT)) * DT
-        msd = []
+        per_run_msd = []
         for run in range(runs):
             r = langevin.run(
                 n,
@@ -69,8 +69,8 @@ def _fig_langevin_forces(cfg, out, *, ensemble, save, fig, row, mean_row):
                 seed=(2026, run, int(w * 1000)),
                 threads=1,
             )
-            msd.append(r.msd())
-        msd = np.array(msd)
+            per_run_msd.append(r.msd())
+        msd = np.array(per_run_msd)
         t = r.times
         plateau = theory.msd_trap_plateau(w, temperature=T, dim=DIM)
         late = t >= 10 * t_relax
@@ -117,6 +117,7 @@ def _fig_langevin_forces(cfg, out, *, ensemble, save, fig, row, mean_row):
             seed=(7, int(ratio * 100)),
             threads=1,
         )
+        assert r.initial_positions is not None
         x = r.initial_positions + r.final_positions
         measured.append(float(np.mean(x * x)))
     fine = np.linspace(0.02, 0.99, 200)
