@@ -149,13 +149,15 @@ def _forces(
         raise ValueError("trap_centre is the centre of a trap: give trap_stiffness too")
     k: tuple[float, ...] = (0.0,) * dim
     if trap_stiffness is not None:
-        ks = np.asarray(trap_stiffness, dtype=np.float64)
-        k = _vector(
-            "trap_stiffness",
-            np.full(dim, float(ks)) if ks.ndim == 0 else ks,
-            dim,
-            "the trap's stiffness per axis, force per length",
-        )
+        meaning = "the trap's stiffness per axis, force per length"
+        try:
+            ks = np.asarray(trap_stiffness, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"trap_stiffness ({meaning}) must be a number or dim numbers, got "
+                f"{trap_stiffness!r}"
+            ) from None
+        k = _vector("trap_stiffness", np.full(dim, float(ks)) if ks.ndim == 0 else ks, dim, meaning)
         if min(k) < 0:
             raise ValueError(
                 f"trap_stiffness must be >= 0 along every axis (0: no trap along it), got "

@@ -358,11 +358,30 @@ class LangevinResult:
                 total = total + free / 2 + drift * drift
         return total
 
+    def _refuse_unless_stationary(self, what: str) -> None:
+        """ValueError unless this forced run is stationary from its start."""
+        assert self.gravity is not None and self.trap_stiffness is not None
+        falls = bool(np.any((self.trap_stiffness == 0) & (self.gravity != 0)))
+        if self.initial != "thermal" or falls:
+            raise ValueError(
+                f"{what} under an external force is known here for a stationary run only "
+                "(initial='thermal', gravity only along trapped axes); this run started "
+                f"with initial={self.initial!r}"
+                + (" and falls freely along an untrapped axis" if falls else "")
+            )
+
     def theory_tamsd(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected time-averaged MSD of this run at its lags (or at ``lags``), as the
-        engine measures it: see ``theory_tamsd``."""
+        engine measures it: see ``theory_tamsd``.  Under an external force: for a stationary
+        run (``initial="thermal"``, no gravity along an untrapped axis) the MSD at the lag
+        (``theory_msd``), since the increments are stationary; any other forced run raises
+        ValueError."""
         if lags is None and len(self.tamsd_lags) == 0:
             raise _no_lags()
+        if self.has_force:
+            self._refuse_unless_stationary("theory_tamsd")
+            lag_t = np.asarray(self.tamsd_lags if lags is None else lags, dtype=np.float64)
+            return np.asarray(self._theory_msd_forced(lag_t), dtype=np.float64)
         return theory_tamsd(
             self.tamsd_lags if lags is None else lags,
             gamma0=self.gamma0,
@@ -419,6 +438,11 @@ class LangevinResult:
                 "(ergodicity_breaking) or run with initial='thermal'"
             )
 
+        if self.has_force:
+            raise ValueError(
+                "theory_ergodicity_breaking is the free Langevin/UDSBM model's; under an "
+                "external force measure it (ergodicity_breaking)"
+            )
         if lags is None and len(self.tamsd_lags) == 0:
             raise _no_lags()
         lag_t = self.tamsd_lags if lags is None else lags
