@@ -675,20 +675,23 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     static char *names[] = {"dim", "model", "scheme", "gamma0", "D0", "tau0", "dt", "key",
                             "n", "first", "step_from", "step_to", "n_steps", "x", "v",
                             "sample_steps", "x2", "v2", "positions", "lags", "tamsd", "ring",
-                            "carry", "threads", "tamsd_estimator", "exponent", NULL};
+                            "carry", "threads", "tamsd_estimator", "exponent", "accel",
+                            "stiffness", "origin", NULL};
     gr_sde_config cfg;
+    memset(&cfg, 0, sizeof cfg); /* no external force unless accel or stiffness is given */
     cfg.exponent = 1.0; /* UDSBM's (1 + t/tau0)^-exponent: optional, the thesis' 1 */
+    PyObject *oaccel = Py_None, *ostiff = Py_None, *oorigin = Py_None;
     unsigned long long key;
     long long n, first, step_from, step_to, n_steps;
     PyObject *ox, *ov, *osteps, *ox2, *ov2, *opos, *olags, *otamsd, *oring, *ocarry = Py_None;
     int threads = 1, estimator = GR_TAMSD_STRIDED;
     /* every argument a keyword, the first 22 required (see require_keywords) */
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$iiiddddKLLLLLOOOOOOOOOOiid:sde_run", names,
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$iiiddddKLLLLLOOOOOOOOOOiidOOO:sde_run", names,
                                      &cfg.dim, &cfg.model, &cfg.scheme, &cfg.gamma0, &cfg.D0,
                                      &cfg.tau0, &cfg.dt, &key, &n, &first, &step_from, &step_to,
                                      &n_steps, &ox, &ov, &osteps, &ox2, &ov2, &opos, &olags,
                                      &otamsd, &oring, &ocarry, &threads, &estimator,
-                                     &cfg.exponent) ||
+                                     &cfg.exponent, &oaccel, &ostiff, &oorigin) ||
         require_keywords(args, kw, names, 22, "sde_run") < 0)
         return NULL;
     if (!(cfg.exponent > 0.0 && cfg.exponent < INFINITY)) {
@@ -765,6 +768,19 @@ static PyObject *sde_run(PyObject *Py_UNUSED(module), PyObject *args, PyObject *
     if (ocarry != Py_None && (!mul_size(td, 2, &tdd, "carry") ||
                               !(out.carry = inout(ocarry, "carry", NPY_FLOAT64, tdd))))
         return NULL;
+    /* external forces (sde.h): accel and stiffness dim doubles each, origin count x dim */
+    if (oaccel != Py_None || ostiff != Py_None || oorigin != Py_None) {
+        const double *a = oaccel == Py_None ? NULL : inout(oaccel, "accel", NPY_FLOAT64, d);
+        const double *k = ostiff == Py_None ? NULL : inout(ostiff, "stiffness", NPY_FLOAT64, d);
+        if ((oaccel != Py_None && !a) || (ostiff != Py_None && !k)) return NULL;
+        if (oorigin != Py_None && !(cfg.origin = inout(oorigin, "origin", NPY_FLOAT64, count * d)))
+            return NULL;
+        cfg.force = 1;
+        for (npy_intp i = 0; i < d; i++) {
+            cfg.accel[i] = a ? a[i] : 0.0;
+            cfg.stiffness[i] = k ? k[i] : 0.0;
+        }
+    }
     for (npy_intp k = 0; k < T; k++)
         if (out.sample_steps[k] < 0 || (k > 0 && out.sample_steps[k] <= out.sample_steps[k - 1])) {
             PyErr_SetString(PyExc_ValueError, "sample_steps must be increasing and >= 0");
@@ -823,6 +839,19 @@ static PyObject *sde_lag_stride(PyObject *Py_UNUSED(module), PyObject *args)
     return PyLong_FromLongLong(gr_tamsd_stride(lag, estimator));
 }
 
+static PyObject *sde_force_step(PyObject *Py_UNUSED(module), PyObject *args)
+{
+    double g, D, w, dt, c[6];
+    if (!PyArg_ParseTuple(args, "dddd", &g, &D, &w, &dt)) return NULL;
+    if (!(g > 0.0) || !(D > 0.0) || !(w >= 0.0) || !(dt > 0.0) || !isfinite(g) ||
+        !isfinite(D) || !isfinite(w) || !isfinite(dt)) {
+        PyErr_SetString(PyExc_ValueError, "need gamma, D, dt > 0 and w >= 0, all finite");
+        return NULL;
+    }
+    gr_sde_force_step(g, D, w, dt, c);
+    return Py_BuildValue("(dddddd)", c[0], c[1], c[2], c[3], c[4], c[5]);
+}
+
 /* ==== SDE binding end =============================================================== */
 
 /* ------------------------------------------------------------------------------------ */
@@ -843,17 +872,23 @@ static PyMethodDef core_methods[] = {
     {"sde_run", (PyCFunction)(void (*)(void))sde_run, METH_VARARGS | METH_KEYWORDS,
      "sde_run(*, dim, model, scheme, gamma0, D0, tau0, dt, key, n, first, step_from, step_to,"
      " n_steps, x, v, sample_steps, x2, v2, positions, lags, tamsd, ring, carry=None,"
-     " threads=1, tamsd_estimator=0, exponent=1.0): advance particles first..first+len(x)"
+     " threads=1, tamsd_estimator=0, exponent=1.0, accel=None, stiffness=None, origin=None):"
+     " advance particles first..first+len(x)"
      " over the steps [step_from, step_to) of a run of n_steps on `threads` threads,"
      " accumulating into the given arrays; ring (sde_ring_size doubles) carries one particle"
      " from segment to segment, carry (2 x len(sample_steps) x dim doubles) the sums of a"
-     " block of particles left open (internal: use granular.langevin)."},
+     " block of particles left open; accel, stiffness (dim doubles: g, k/m) and origin"
+     " (len(x) x dim: the starts relative to the trap's centre) add an external force"
+     " (internal: use granular.langevin)."},
     {"sde_lag_stride", sde_lag_stride, METH_VARARGS,
      "sde_lag_stride(lag, tamsd_estimator=0): spacing of TAMSD window starts for a lag (steps;"
      " estimator 0 strided, 1 every window)"},
     {"sde_ring_size", sde_ring_size, METH_VARARGS,
      "sde_ring_size(dim, lags, tamsd_estimator=0): doubles of sde_run's ring for these lags"
      " (steps, increasing, each >= 1)"},
+    {"sde_force_step", sde_force_step, METH_VARARGS,
+     "sde_force_step(gamma, D, w, dt): the exact scheme's (e12, e22, j1, kx, sx, sv) of one axis"
+     " under a force with stiffness per mass w (for the tests)"},
     /* ==== SDE methods end ==== */
     {NULL, NULL, 0, NULL}
 };

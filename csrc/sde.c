@@ -58,6 +58,102 @@ static inline double udsbm_decay(double w, double a)
     return a == 1.0 ? 1.0 / w : pow(w, -a);
 }
 
+/* The exact step of one axis under a linear force per mass f(X) = g - w (X - c), w >= 0,
+ * written with the force at the start of the step, f0 = g - w (X0 - c):
+ *   X1 = X0 + e12 v0 + j1 f0 + kx z1 + sx z2,   v1 = e22 v0 + e12 f0 + sv z1,
+ * where E(t) = exp(A t), A = [[0, 1], [-w, -gamma]], propagates the mean (e12, e22 its
+ * second column) and J(t) = int_0^t E(s) e2 ds (j1 its first entry) the force's share:
+ * the mean is E (X0 - c, v0) + J (g + w c) around c, and E - I = (int_0^t E) A gives
+ * e11 - 1 = -w j1, e21 = -w e12, hence the form above.  The noise covariance is the
+ * Lyapunov integral
+ *   S(t) = sigma^2 int_0^t E(s) e2 e2^T E(s)^T ds,   sigma^2 = 2 D gamma^2,
+ * sampled with the velocity first (sv^2 = S_vv, kx = S_xv / sv, sx^2 = S_xx - kx^2).
+ * One method for every regime (underdamped w > gamma^2/4, critical, overdamped, w = 0):
+ * a Taylor series on a step short against both rates (r t <= 1/4, r = max(gamma,
+ * sqrt(w))), then doubling k times,
+ *   E(2t) = E(t)^2,  J(2t) = J(t) + E(t) J(t),  S(2t) = S(t) + E(t) S(t) E(t)^T,
+ * whose terms, at short times, are all non-negative: no division, no cancellation between
+ * the damping regimes, and S_xx (~ sigma^2 t^3/3) keeps its relative precision however
+ * small the step.  Once per run (the coefficients are constant), so its cost is nothing. */
+typedef struct {
+    double e12, e22, j1, kx, sx, sv;
+} force_coef;
+
+static force_coef force_exact_for(double g, double D, double w, double dt)
+{
+    const double r = g > sqrt(w) ? g : sqrt(w);
+    double t = dt;
+    int k = 0;
+    while (r * t > 0.25 && k < 4096) { /* at most ~950 halvings for the scales run allows */
+        t *= 0.5;
+        k++;
+    }
+    /* Taylor: M_n = (A t)^n / n!, E = sum M_n, J = t sum M_n e2 / (n+1); u_n = M_n e2 is
+     * the series of E(s) e2 in (s/t)^n, so S_ab = sigma^2 t sum_{n,m} u_n,a u_m,b / (n+m+1).
+     * 20 terms: the scaled norm of A t is at most 1/2, the remainder < 0.5^20/20!. */
+    enum { NT = 20 };
+    double m11 = 1, m12 = 0, m21 = 0, m22 = 1;
+    double e11 = 0, e12 = 0, e21 = 0, e22 = 0, j1 = 0, j2 = 0, u1[NT], u2[NT];
+    for (int n = 0; n < NT; n++) {
+        if (n > 0) { /* M_n = M_{n-1} (A t) / n */
+            const double a11 = -m12 * w * t, a12 = (m11 - m12 * g) * t;
+            const double a21 = -m22 * w * t, a22 = (m21 - m22 * g) * t;
+            m11 = a11 / n, m12 = a12 / n, m21 = a21 / n, m22 = a22 / n;
+        }
+        e11 += m11, e12 += m12, e21 += m21, e22 += m22;
+        j1 += m12 / (n + 1), j2 += m22 / (n + 1);
+        u1[n] = m12, u2[n] = m22;
+    }
+    j1 *= t, j2 *= t;
+    const double sig2 = 2.0 * D * g * g;
+    double sxx = 0, sxv = 0, svv = 0;
+    for (int n = NT - 1; n >= 0; n--) /* smallest terms first */
+        for (int m = NT - 1; m >= 0; m--) {
+            const double c = 1.0 / (n + m + 1);
+            sxx += u1[n] * u1[m] * c, sxv += u1[n] * u2[m] * c, svv += u2[n] * u2[m] * c;
+        }
+    sxx *= sig2 * t, sxv *= sig2 * t, svv *= sig2 * t;
+    for (int i = 0; i < k; i++) {
+        /* S + E S E^T, with E S first */
+        const double p11 = e11 * sxx + e12 * sxv, p12 = e11 * sxv + e12 * svv;
+        const double p21 = e21 * sxx + e22 * sxv, p22 = e21 * sxv + e22 * svv;
+        const double nxx = sxx + (p11 * e11 + p12 * e12);
+        const double nxv = sxv + (p11 * e21 + p12 * e22);
+        const double nvv = svv + (p21 * e21 + p22 * e22);
+        sxx = nxx, sxv = nxv, svv = nvv;
+        const double nj1 = j1 + (e11 * j1 + e12 * j2), nj2 = j2 + (e21 * j1 + e22 * j2);
+        j1 = nj1, j2 = nj2;
+        const double f11 = e11 * e11 + e12 * e21, f12 = e11 * e12 + e12 * e22;
+        const double f21 = e21 * e11 + e22 * e21, f22 = e21 * e12 + e22 * e22;
+        e11 = f11, e12 = f12, e21 = f21, e22 = f22;
+    }
+    force_coef f;
+    f.e12 = e12;
+    f.e22 = e22;
+    f.j1 = j1;
+    f.sv = svv > 0.0 ? sqrt(svv) : 0.0;
+    f.kx = f.sv > 0.0 ? sxv / f.sv : 0.0;
+    const double rest = sxx - f.kx * f.kx;
+    f.sx = rest > 0.0 ? sqrt(rest) : 0.0;
+    return f;
+}
+
+void gr_sde_force_step(double gamma, double D, double w, double dt, double out[6])
+{
+    const force_coef f = force_exact_for(gamma, D, w, dt);
+    out[0] = f.e12, out[1] = f.e22, out[2] = f.j1, out[3] = f.kx, out[4] = f.sx, out[5] = f.sv;
+}
+
+/* Euler-Maruyama in a trap, x1 = x0 + v0 dt, v1 = (1 - gamma dt) v0 - w dt x0 + noise, is
+ * the linear map [[1, dt], [-w dt, 1 - gamma dt]] on the mean (and its Kronecker square on
+ * the covariance).  Its eigenvalues solve mu^2 - (2 - gamma dt) mu + 1 - gamma dt + w dt^2
+ * = 0, inside the unit circle (Jury) iff |1 - gamma dt + w dt^2| < 1 and
+ * 4 - 2 gamma dt + w dt^2 > 0: with gamma dt < 2 (refused otherwise), iff w dt < gamma. */
+static int em_trap_stable(double g, double w, double dt)
+{
+    return w * dt < g;
+}
+
 /* What one step needs besides the particle's state. */
 typedef struct {
     uint64_t key;
@@ -68,7 +164,15 @@ typedef struct {
     int64_t table_from;      /* the step that table[0] and em_table[0] start from */
     const double *em_table;  /* Euler-Maruyama's (1 - gamma dt, sqrt(2 D dt) gamma) per step
                                 for an exponent != 1 (a pow a step saved per particle), or NULL */
+    const struct force_params *force; /* external forces (run_steps_force), or NULL; apart,
+                                         so that the force-free loop's data stay as they were */
 } step_params;
+
+/* The external force's per-axis data. */
+typedef struct force_params {
+    double accel[3], stiffness[3];
+    force_coef fc[3]; /* the exact scheme's */
+} force_params;
 
 /* A particle's normals drawn ahead (rng.h's gr_normal_batch): z[k * GR_NORMAL_BATCH + j]
  * is the k-th normal of step first + j (the stream (key, first + j - 1, i)). */
@@ -134,6 +238,56 @@ static GR_ALWAYS_INLINE void run_steps(const int d, const step_params *p, int64_
                 vi[a] = e.c * vi[a] + e.sv * z1;
             }
         }
+    }
+}
+
+/* run_steps with external forces (Langevin model only): the same normals in the same
+ * order, the force per mass f = g - w (X - c) at the start of each step, X - c = o + x
+ * from the particle's start o relative to the trap's centre. */
+static GR_ALWAYS_INLINE void run_steps_force(const int d, const step_params *p, int64_t i,
+                                             int64_t from, int64_t to, double *xi, double *vi,
+                                             const double *oi, normals_ahead *ahead)
+{
+    const double dt = p->dt;
+    const int m = p->em ? d : 2 * d;
+    for (int64_t step = from + 1; step <= to; step++) {
+        if (step - ahead->first >= GR_NORMAL_BATCH) {
+            ahead->first = step;
+            gr_normal_batch(p->key, (uint64_t)(step - 1), (uint64_t)i, m, ahead->z);
+        }
+        const double *z = ahead->z + (step - ahead->first);
+        const force_params *fp = p->force;
+        if (p->em) {
+            const double a_coef = 1.0 - p->g0 * dt, b = p->b0;
+            for (int a = 0; a < d; a++) {
+                const double f = fp->accel[a] - fp->stiffness[a] * (oi[a] + xi[a]);
+                xi[a] += vi[a] * dt;
+                vi[a] = a_coef * vi[a] + f * dt + b * z[a * GR_NORMAL_BATCH];
+            }
+        } else {
+            for (int a = 0; a < d; a++) {
+                const force_coef e = fp->fc[a];
+                const double z1 = z[2 * a * GR_NORMAL_BATCH], z2 = z[(2 * a + 1) * GR_NORMAL_BATCH];
+                const double f = fp->accel[a] - fp->stiffness[a] * (oi[a] + xi[a]);
+                xi[a] += vi[a] * e.e12 + f * e.j1 + e.kx * z1 + e.sx * z2;
+                vi[a] = e.e22 * vi[a] + e.e12 * f + e.sv * z1;
+            }
+        }
+    }
+}
+
+/* run_steps_force for each dimension, kept out of run_particle (never inlined there) so
+ * that the force-free loop is compiled as it was without forces. */
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((noinline))
+#endif
+static void steps_force(const int d, const step_params *p, int64_t i, int64_t from, int64_t to,
+                        double *xi, double *vi, const double *oi, normals_ahead *ahead)
+{
+    switch (d) {
+    case 1: run_steps_force(1, p, i, from, to, xi, vi, oi, ahead); break;
+    case 2: run_steps_force(2, p, i, from, to, xi, vi, oi, ahead); break;
+    default: run_steps_force(3, p, i, from, to, xi, vi, oi, ahead); break;
     }
 }
 
@@ -210,17 +364,19 @@ static GR_ALWAYS_INLINE void tamsd_book(const int d, const gr_tamsd_plan *p, int
  * squares are added to x2, v2 (n_samples x d each: its block's sums), its TAMSD windows
  * to out->tamsd; ring and slow_next (a step per slow lag) are the running thread's
  * scratch (the ring carries over between segments).  Returns GR_OK or GR_ERR_NONFINITE. */
-static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, double *x2,
-                        double *v2, double *ring, int64_t *slow_next)
+static int run_particle(const run_shared *rs, int64_t i, double *x, double *v,
+                        const double *o, double *x2, double *v2, double *ring,
+                        int64_t *slow_next)
 {
     const gr_sde_output *out = rs->out;
     const int d = rs->cfg->dim;
     const int64_t n = rs->n, step_from = rs->step_from, step_to = rs->step_to;
     const int64_t n_steps = rs->n_steps;
-    double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0};
+    double xi[3] = {0, 0, 0}, vi[3] = {0, 0, 0}, oi[3] = {0, 0, 0};
     for (int a = 0; a < d; a++) {
         xi[a] = x[a];
         vi[a] = v[a];
+        if (o) oi[a] = o[a];
     }
     int64_t ks = rs->ks0;
     normals_ahead ahead;
@@ -262,10 +418,14 @@ static int run_particle(const run_shared *rs, int64_t i, double *x, double *v, d
         if (step == n_steps) break;
         /* steps step+1 .. next, each with its own dimension so that the axis loops
          * unroll */
-        switch (d) {
-        case 1: run_steps(1, rs->sp, i, step, next, xi, vi, &ahead); break;
-        case 2: run_steps(2, rs->sp, i, step, next, xi, vi, &ahead); break;
-        default: run_steps(3, rs->sp, i, step, next, xi, vi, &ahead); break;
+        if (rs->sp->force) {
+            steps_force(d, rs->sp, i, step, next, xi, vi, oi, &ahead);
+        } else {
+            switch (d) {
+            case 1: run_steps(1, rs->sp, i, step, next, xi, vi, &ahead); break;
+            case 2: run_steps(2, rs->sp, i, step, next, xi, vi, &ahead); break;
+            default: run_steps(3, rs->sp, i, step, next, xi, vi, &ahead); break;
+            }
         }
         step = next;
     }
@@ -301,7 +461,8 @@ static void *work(void *arg)
     for (int64_t i = w->lo; i < w->hi; i++) {
         double *s = w->sums + (i / GR_SDE_BLOCK - b0) * row;
         const int64_t at = (i - w->first) * d;
-        int st = run_particle(w->rs, i, w->x + at, w->v + at, s,
+        const double *o = w->rs->cfg->origin ? w->rs->cfg->origin + at : NULL;
+        int st = run_particle(w->rs, i, w->x + at, w->v + at, o, s,
                               s + w->rs->out->n_samples * d, w->ring, w->slow_next);
         if (st != GR_OK) {
             w->status = st;
@@ -330,12 +491,33 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, "invalid SDE parameters");
         return GR_ERR_VALUE;
     }
+    if (cfg->force) {
+        int bad = udsbm;
+        for (int a = 0; a < d; a++)
+            bad |= !isfinite(cfg->accel[a]) || !(cfg->stiffness[a] >= 0.0) ||
+                   !(cfg->stiffness[a] < INFINITY);
+        if (bad) {
+            gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN,
+                         "external forces need the Langevin model, finite accelerations and "
+                         "finite stiffnesses >= 0");
+            return GR_ERR_VALUE;
+        }
+    }
     if (cfg->scheme == GR_SDE_EM && g0 * dt >= 2.0) {
         gr_error_set(err, GR_ERR_UNSTABLE, -1, -1, NAN, g0 * dt,
                      "Euler-Maruyama diverges for gamma0*dt >= 2; take a smaller dt or the "
                      "exact scheme (scheme='exact'), stable at any step");
         return GR_ERR_UNSTABLE;
     }
+    if (cfg->force && cfg->scheme == GR_SDE_EM)
+        for (int a = 0; a < d; a++)
+            if (!em_trap_stable(g0, cfg->stiffness[a], dt)) {
+                gr_error_set(err, GR_ERR_UNSTABLE, -1, -1, NAN, cfg->stiffness[a] * dt / g0,
+                             "Euler-Maruyama in a harmonic trap diverges for (k/m) dt >= gamma0; "
+                             "take a smaller dt or the exact scheme (scheme='exact'), stable "
+                             "at any step");
+                return GR_ERR_UNSTABLE;
+            }
     if (count == 0) return GR_OK;
     if (!gr_rng_ready) gr_rng_init();
     const double sq_dt = sqrt(dt), b0 = sqrt(2.0 * D0) * g0 * sq_dt;
@@ -361,8 +543,16 @@ int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count
         }
     }
 
+    force_params fp;
+    memset(&fp, 0, sizeof fp);
+    if (cfg->force)
+        for (int a = 0; a < d; a++) {
+            fp.accel[a] = cfg->accel[a];
+            fp.stiffness[a] = cfg->stiffness[a];
+            if (cfg->scheme == GR_SDE_EXACT) fp.fc[a] = force_exact_for(g0, D0, cfg->stiffness[a], dt);
+        }
     const step_params sp = {cfg->key, dt, g0, D0, tau0, b0, expo, udsbm, cfg->scheme == GR_SDE_EM,
-                            ex0, table, step_from, em_table};
+                            ex0, table, step_from, em_table, cfg->force ? &fp : NULL};
 
     /* The ensemble sums, the same bits for any split: each block of GR_SDE_BLOCK particles
      * (by global index) sums its particles in index order from zero (or from the carry a

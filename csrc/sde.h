@@ -9,6 +9,12 @@
  * Schemes: Euler-Maruyama exactly as the thesis' (2.92)/(2.110), or the exact update of
  * the Ornstein-Uhlenbeck process over a step (coefficients frozen at the step's midpoint
  * for UDSBM: exact for the OU step, O((dt/tau0)^2) per step for the time dependence).
+ * External forces (Langevin model only): per axis a uniform acceleration g_a and a harmonic
+ * trap of stiffness per unit mass w_a = k_a/m >= 0 about a centre, so that
+ *   dv_a = [g_a - w_a (X_a - c_a) - gamma0 v_a] dt + sqrt(2 D0) gamma0 dW_a.
+ * The drift is linear in (X, v): the exact scheme stays exact (the step of a linear SDE is
+ * Gaussian with a closed-form mean and covariance, see sde.c); Euler-Maruyama takes the
+ * force at the start of the step.
  * Random numbers come from rng.h, keyed by (step, particle): results do not depend on
  * chunking or threads.  The caller owns the inputs, outputs and the carried scratch; a
  * call allocates only its threads' scratch and the block sums (freed before it returns). */
@@ -31,6 +37,15 @@ typedef struct {
                                 1/(1 + t/tau0) exactly as before (no pow) */
     double dt;
     uint64_t key;            /* random stream key */
+    /* External forces; force = 0 (all the rest unread) is the force-free run, its bits and
+     * cost those of a build without forces. */
+    int force;
+    double accel[3];         /* g_a: uniform acceleration (force per mass), finite */
+    double stiffness[3];     /* w_a = k_a / m >= 0, finite: the trap's force per mass and
+                                length (0: no trap along a) */
+    const double *origin;    /* count x dim: each particle's start X - c relative to the
+                                trap's centre (the state x is the displacement from the
+                                start), or NULL for all at the centre */
 } gr_sde_config;
 
 /* Largest step count of a run: step counters plus a lag's stride then stay far from
@@ -79,10 +94,16 @@ typedef struct {
  * results to the bit.  A segment that is not the whole run takes one particle (count <= 1)
  * and the ring its previous segment left.  The particles are split into `threads` (>= 1)
  * POSIX threads by whole blocks; the results are the same to the bit for any count.
- * Returns GR_OK, GR_ERR_VALUE, GR_ERR_NOMEM, GR_ERR_NONFINITE or GR_ERR_UNSTABLE
- * (Euler-Maruyama with gamma0 dt >= 2). */
+ * Returns GR_OK, GR_ERR_VALUE (also: a force with UDSBM, a non-finite force, a negative
+ * stiffness), GR_ERR_NOMEM, GR_ERR_NONFINITE or GR_ERR_UNSTABLE (Euler-Maruyama with
+ * gamma0 dt >= 2, or in a trap with w_a dt >= gamma0: sde.c). */
 int gr_sde_run(const gr_sde_config *cfg, int64_t n, int64_t first, int64_t count,
                int64_t step_from, int64_t step_to, int64_t n_steps, double *x, double *v,
                gr_sde_output *out, int threads, gr_error *err);
+
+/* The exact scheme's coefficients of one axis under a force (sde.c's force_exact_for):
+ * out = (e12, e22, j1, kx, sx, sv) for friction gamma, diffusivity D, stiffness per mass
+ * w >= 0 and step dt -- for the tests, which compare them with slower methods. */
+void gr_sde_force_step(double gamma, double D, double w, double dt, double out[6]);
 
 #endif

@@ -92,6 +92,129 @@ class _Run:
     threads: int
     mass: float
     tamsd_estimator: str
+    forces: _Forces | None = None  # external forces (Langevin model only), or None
+
+
+@dataclass(frozen=True)
+class _Forces:
+    """External forces of a Langevin run, checked: per axis the uniform acceleration g
+    (``gravity``), the trap's stiffness k and centre c; the force on a particle is
+    m g - k (X - c)."""
+
+    gravity: tuple[float, ...]
+    trap_stiffness: tuple[float, ...]
+    trap_centre: tuple[float, ...]
+
+    def per_mass(self, mass: float) -> NDArray[np.float64]:
+        """w = k / m per axis, the engine's stiffness."""
+        return np.array(self.trap_stiffness, dtype=np.float64) / mass
+
+
+def _vector(name: str, value: ArrayLike, dim: int, meaning: str) -> tuple[float, ...]:
+    """A length-``dim`` vector of finite floats, or ValueError naming ``name``."""
+    try:
+        a = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} ({meaning}) must be numbers, got {value!r}") from None
+    if a.shape != (dim,):
+        raise ValueError(
+            f"{name} ({meaning}) must have dim = {dim} components, got shape {a.shape}"
+        )
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} ({meaning}) must be finite, got {shown(a)}")
+    return tuple(float(x) for x in a)
+
+
+def _forces(
+    gravity: ArrayLike | None,
+    trap_stiffness: ArrayLike | None,
+    trap_centre: ArrayLike | None,
+    *,
+    dim: int,
+    model: str,
+) -> _Forces | None:
+    """``run``'s force arguments checked (None for none of them): ``gravity`` and
+    ``trap_centre`` length-dim vectors, ``trap_stiffness`` one number for every axis or
+    one per axis, each >= 0 (0: no trap along that axis)."""
+    if gravity is None and trap_stiffness is None and trap_centre is None:
+        return None
+    if model != "langevin":
+        raise ValueError(
+            "external forces (gravity, trap_stiffness) are in the Langevin model only "
+            f"(tau0 = inf), got model={model!r}: UDSBM's time-dependent temperature has no "
+            "closed-form step in a trap here"
+        )
+    g = (0.0,) * dim if gravity is None else _vector("gravity", gravity, dim, "an acceleration")
+    if trap_centre is not None and trap_stiffness is None:
+        raise ValueError("trap_centre is the centre of a trap: give trap_stiffness too")
+    k: tuple[float, ...] = (0.0,) * dim
+    if trap_stiffness is not None:
+        meaning = "the trap's stiffness per axis, force per length"
+        try:
+            ks = np.asarray(trap_stiffness, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"trap_stiffness ({meaning}) must be a number or dim numbers, got "
+                f"{trap_stiffness!r}"
+            ) from None
+        k = _vector("trap_stiffness", np.full(dim, float(ks)) if ks.ndim == 0 else ks, dim, meaning)
+        if min(k) < 0:
+            raise ValueError(
+                f"trap_stiffness must be >= 0 along every axis (0: no trap along it), got "
+                f"{shown(np.array(k))}"
+            )
+    c = (
+        (0.0,) * dim
+        if trap_centre is None
+        else _vector("trap_centre", trap_centre, dim, "the trap's centre")
+    )
+    return _Forces(gravity=g, trap_stiffness=k, trap_centre=c)
+
+
+def _check_forces(p: _Run) -> None:
+    """The forces' scales and Euler-Maruyama's stability limit in a trap.
+
+    Per axis EM's map on the mean is [[1, dt], [-w dt, 1 - gamma0 dt]], w = k/m; with
+    gamma0 dt < 2 its eigenvalues lie inside the unit circle iff w dt < gamma0 (Jury's
+    conditions; docs/langevin_forces.md): beyond, the variance grows without bound, and
+    the run is refused (UnstableStepError), as gamma0 dt >= 2 is.  The exact scheme is
+    stable at any step."""
+    f = p.forces
+    if f is None:
+        return
+    lo, hi = SCALE_LO, SCALE_HI
+    w = f.per_mass(p.mass)
+    arithmetic = "the Langevin arithmetic (displacements, squared and summed)"
+    for a in range(p.dim):
+        if w[a] > 0:
+            check_range(
+                f"trap_stiffness / mass along axis {a}",
+                float(w[a]),
+                lo * lo,
+                hi * hi,
+                arithmetic,
+                "a squared trap frequency k/m nearer the squared rates gamma0^2",
+            )
+        check_range(
+            f"|gravity| t_stop^2 along axis {a} (the fall's length)",
+            abs(f.gravity[a]) * p.t_stop * p.t_stop,
+            0.0,
+            hi,
+            arithmetic,
+            "a smaller gravity or a shorter t_stop",
+        )
+        check_range(f"|trap_centre| along axis {a}", abs(f.trap_centre[a]), 0.0, hi, arithmetic, "")
+    if p.scheme == "em" and np.any(w * p.dt >= p.gamma0):
+        from .errors import UnstableStepError
+
+        a = int(np.argmax(w * p.dt / p.gamma0))
+        raise UnstableStepError(
+            f"Euler-Maruyama in a harmonic trap diverges for (k/m) dt >= gamma0: along axis "
+            f"{a} k/m = {shown(float(w[a]))}, dt = {shown(p.dt)}, (k/m) dt / gamma0 = "
+            f"{w[a] * p.dt / p.gamma0:.4g}; take dt < gamma0 m / k = "
+            f"{p.gamma0 / w[a]:.4g} or scheme='exact', which is stable at any step",
+            value=float(w[a] * p.dt / p.gamma0),
+        )
 
 
 def _checked(
@@ -109,6 +232,9 @@ def _checked(
     threads: int | None,
     mass: float,
     tamsd_estimator: str,
+    gravity: ArrayLike | None = None,
+    trap_stiffness: ArrayLike | None = None,
+    trap_centre: ArrayLike | None = None,
 ) -> _Run:
     """``run``'s scalar arguments, each checked in turn (the first out of its range raises,
     by name) and normalised: floats, the model chosen from tau0, tau0 infinite for the
@@ -175,6 +301,7 @@ def _checked(
         threads=n_threads,
         mass=mass,
         tamsd_estimator=tamsd_estimator,
+        forces=_forces(gravity, trap_stiffness, trap_centre, dim=dim, model=model),
     )
 
 
@@ -217,11 +344,29 @@ def _tamsd_lag_steps(tamsd_lags: ArrayLike | None, dt: float, n_steps: int) -> N
     return lags
 
 
+def _initial_positions(p: _Run, initial: str, rng: np.random.Generator) -> NDArray[np.float64]:
+    """(N, d) starting positions in the lab frame: the origin, but for a thermal start in a
+    trap, where each trapped axis starts in its stationary (Boltzmann) density, Gaussian
+    about the force's balance c + g m / k with variance T / k = D0 gamma0 m / k, so that the
+    run is stationary from the start.  Drawn after the velocities, from their stream, so
+    that the velocities are those of a run without force."""
+    x0 = np.zeros((p.n, p.dim))
+    f = p.forces
+    if f is None or initial != "thermal":
+        return x0
+    w = f.per_mass(p.mass)
+    for a in np.flatnonzero(w > 0):
+        mean = f.trap_centre[a] + f.gravity[a] / w[a]
+        x0[:, a] = mean + math.sqrt(p.D0 * p.gamma0 / w[a]) * rng.normal(size=p.n)
+    return x0
+
+
 def _initial_state(
     p: _Run, initial: str, speed: float | None, seed: Any
-) -> tuple[int, NDArray[np.float64], NDArray[np.float64], float]:
-    """The engine's noise key, and the start: (N, d) positions at the origin, (N, d)
-    velocities drawn as ``initial`` says, and their mean square per component v0_sq.
+) -> tuple[int, NDArray[np.float64], NDArray[np.float64], float, NDArray[np.float64]]:
+    """The engine's noise key, and the start: (N, d) displacements from the start (zero),
+    (N, d) velocities drawn as ``initial`` says, their mean square per component v0_sq,
+    and the (N, d) starting positions in the lab frame (``_initial_positions``).
     ``seed`` gives two independent streams, the key and the velocities'."""
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     key_seq, vel_seq = ss.spawn(2)
@@ -257,7 +402,8 @@ def _initial_state(
         v0_sq = s * s / dim
     else:
         raise ValueError(f"initial must be one of {INITIAL}, got {initial!r}")
-    return key, np.zeros((n, dim)), v, v0_sq
+    # the start in the lab frame, drawn after the velocities
+    return key, np.zeros((n, dim)), v, v0_sq, _initial_positions(p, initial, rng)
 
 
 def _initial_speed(initial: str, speed: float | None, dim: int, v0_sq: float) -> tuple[str, float]:
@@ -416,13 +562,22 @@ def _integrate(
     sums: _Sums,
     progress: bool,
     work: int,
+    x0: NDArray[np.float64] | None = None,
 ) -> None:
-    """Step every particle from ``x``, ``v`` (overwritten with the final state) to the
-    last step, in calls of about ``work`` particle-steps (``_chunks``) so that Ctrl-C,
-    which Python acts on between two calls into C, stops a run promptly; the progress bar
-    is closed however the run ends."""
+    """Step every particle from ``x``, ``v`` (overwritten with the final state; ``x0`` the
+    starts in the lab frame, which a force needs) to the last step, in calls of about
+    ``work`` particle-steps (``_chunks``) so that Ctrl-C, which Python acts on between two
+    calls into C, stops a run promptly; the progress bar is closed however the run ends."""
     per_call, steps_per_call = _chunks(p.n_steps, p.threads, work)
     model, scheme = MODELS.index(p.model), SCHEMES.index(p.scheme)
+    force: dict[str, NDArray[np.float64]] = {}
+    origin = None
+    if p.forces is not None:  # the engine's g, k/m, and starts relative to the centre
+        force = {
+            "accel": np.array(p.forces.gravity, dtype=np.float64),
+            "stiffness": p.forces.per_mass(p.mass),
+        }
+        origin = np.ascontiguousarray(x0 - np.array(p.forces.trap_centre))
     estimator = _estimator_code(p.tamsd_estimator)
     bar = None
     if progress:
@@ -433,6 +588,8 @@ def _integrate(
         for first in range(0, p.n, per_call):
             xs = np.ascontiguousarray(x[first : first + per_call])
             vs = np.ascontiguousarray(v[first : first + per_call])
+            if origin is not None:
+                force["origin"] = np.ascontiguousarray(origin[first : first + per_call])
             for step_from in range(0, p.n_steps, steps_per_call):
                 step_to = min(step_from + steps_per_call, p.n_steps)
                 _core.sde_run(
@@ -462,6 +619,7 @@ def _integrate(
                     threads=p.threads,
                     tamsd_estimator=estimator,
                     exponent=p.exponent,
+                    **force,
                 )
                 if bar is not None:
                     bar.update(len(xs) * (step_to - step_from))

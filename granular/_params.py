@@ -84,6 +84,10 @@ QUANTITIES: dict[str, Quantity] = {
         "exponent a of the power-law coefficients (1 + t/tau0)^-a", "dimensionless", "positive"
     ),
     "v0_sq": Quantity("initial mean squared velocity per component", "eps/m", "nonnegative"),
+    # external forces in the Langevin model (theory.trap)
+    "stiffness": Quantity("stiffness k of a harmonic trap, per axis", "eps/L^2", "positive"),
+    "gravity": Quantity("acceleration g of a uniform force (a component or magnitude)", "L/time^2"),
+    "height": Quantity("height z above a wall", "L"),
     "order": Quantity("order of the restitution series, 1 or 2", "dimensionless"),
     "points": Quantity("quadrature nodes", "dimensionless count"),
     # data drawn by plot

@@ -60,6 +60,7 @@ from ._langevin_run import MODELS as MODELS
 from ._langevin_run import SCHEMES as SCHEMES
 from ._langevin_run import TAMSD_ESTIMATORS as TAMSD_ESTIMATORS
 from ._langevin_run import (
+    _check_forces,
     _check_scales,
     _checked,
     _estimator_code,
@@ -121,7 +122,18 @@ class LangevinResult:
     mass : the particles' mass (``run(mass=...)``; the scene's for ``from_scene``): the
         dynamics depend on D0 and gamma0 only, the temperature is ``mass`` times
         ``D0 gamma0`` in equilibrium
+    gravity, trap_stiffness, trap_centre : (d,) the external force's g, k and c (zeros
+        without force; ``run``), None on results made before forces existed
+    initial_positions : (N, d) the starts in the lab frame (the origin, or in a trap the
+        stationary draw of ``run``); positions and the MSD are displacements from them
     """
+
+    @property
+    def has_force(self) -> bool:
+        """Whether an external force acted (a gravity or a trap stiffness not zero)."""
+        return any(
+            a is not None and bool(np.any(a != 0)) for a in (self.gravity, self.trap_stiffness)
+        )
 
     times: NDArray[np.float64]
     steps: NDArray[np.int64]
@@ -148,6 +160,10 @@ class LangevinResult:
     exponent: float = 1.0
     initial: str = "thermal"
     mass: float = 1.0
+    gravity: NDArray[np.float64] | None = None
+    trap_stiffness: NDArray[np.float64] | None = None
+    trap_centre: NDArray[np.float64] | None = None
+    initial_positions: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         # read-only views: a caller writing into an array the result hands out gets a
@@ -279,6 +295,9 @@ class LangevinResult:
             out["positions"] = self.positions
         for name in ("gamma0", "D0", "tau0", "dt", "t_stop", "v0_sq", "exponent", "mass"):
             out[name] = np.asarray(getattr(self, name))
+        for name in ("gravity", "trap_stiffness", "trap_centre", "initial_positions"):
+            if getattr(self, name) is not None:
+                out[name] = getattr(self, name)
         return out
 
     def theory_msd(
@@ -286,10 +305,13 @@ class LangevinResult:
         t: float | NDArray[np.float64] | None = None,
     ) -> float | NDArray[np.float64]:
         """The analytic ensemble MSD of this model from ``granular.theory`` (with this
-        run's initial speed) at the sample times or at t."""
+        run's initial speed) at the sample times or at t; with an external force axis by
+        axis from ``theory.trap`` (``msd_trap``, ``gravity_mean_displacement``)."""
         from . import theory
 
         t = self.times if t is None else t
+        if self.has_force:
+            return self._theory_msd_forced(t)
         if self.model == "langevin":
             return theory.msd_langevin(
                 t, D0=self.D0, gamma0=self.gamma0, dim=self.dim, v0_sq=self.v0_sq
@@ -308,11 +330,58 @@ class LangevinResult:
             t, D0=self.D0, gamma0=self.gamma0, tau0=self.tau0, dim=self.dim, v0_sq=self.v0_sq
         )
 
+    def _theory_msd_forced(self, t: float | NDArray[np.float64]) -> float | NDArray[np.float64]:
+        """The MSD under this run's forces, axis by axis (theory.trap): a trapped axis from
+        its stationary start (``initial="thermal"``) or from the origin with this run's
+        v0_sq; a free axis as the free model's plus the squared drift under gravity."""
+        from . import theory
+        from .theory import trap
+
+        assert self.gravity is not None and self.trap_stiffness is not None
+        assert self.trap_centre is not None
+        total: float | NDArray[np.float64] = 0.0
+        for a in range(self.dim):
+            g, w = float(self.gravity[a]), float(self.trap_stiffness[a]) / self.mass
+            if w > 0 and self.initial == "thermal":
+                e11 = trap._propagator(t, self.gamma0, w)[0]
+                total = total + 2.0 * self.D0 * self.gamma0 / w * (1.0 - e11)
+            elif w > 0:  # from the origin: offset from the balance point c + g/w
+                offset = -(float(self.trap_centre[a]) + g / w)
+                total = total + trap._msd_trap_axis(
+                    t, D0=self.D0, gamma0=self.gamma0, w=w, v0_sq=self.v0_sq, offset=offset
+                )
+            else:
+                free = theory.msd_langevin(
+                    t, D0=self.D0, gamma0=self.gamma0, dim=2, v0_sq=self.v0_sq
+                )
+                drift = theory.gravity_mean_displacement(t, gravity=g, gamma0=self.gamma0)
+                total = total + free / 2 + drift * drift
+        return total
+
+    def _refuse_unless_stationary(self, what: str) -> None:
+        """ValueError unless this forced run is stationary from its start."""
+        assert self.gravity is not None and self.trap_stiffness is not None
+        falls = bool(np.any((self.trap_stiffness == 0) & (self.gravity != 0)))
+        if self.initial != "thermal" or falls:
+            raise ValueError(
+                f"{what} under an external force is known here for a stationary run only "
+                "(initial='thermal', gravity only along trapped axes); this run started "
+                f"with initial={self.initial!r}"
+                + (" and falls freely along an untrapped axis" if falls else "")
+            )
+
     def theory_tamsd(self, lags: ArrayLike | None = None) -> NDArray[np.float64]:
         """The expected time-averaged MSD of this run at its lags (or at ``lags``), as the
-        engine measures it: see ``theory_tamsd``."""
+        engine measures it: see ``theory_tamsd``.  Under an external force: for a stationary
+        run (``initial="thermal"``, no gravity along an untrapped axis) the MSD at the lag
+        (``theory_msd``), since the increments are stationary; any other forced run raises
+        ValueError."""
         if lags is None and len(self.tamsd_lags) == 0:
             raise _no_lags()
+        if self.has_force:
+            self._refuse_unless_stationary("theory_tamsd")
+            lag_t = np.asarray(self.tamsd_lags if lags is None else lags, dtype=np.float64)
+            return np.asarray(self._theory_msd_forced(lag_t), dtype=np.float64)
         return theory_tamsd(
             self.tamsd_lags if lags is None else lags,
             gamma0=self.gamma0,
@@ -369,6 +438,11 @@ class LangevinResult:
                 "(ergodicity_breaking) or run with initial='thermal'"
             )
 
+        if self.has_force:
+            raise ValueError(
+                "theory_ergodicity_breaking is the free Langevin/UDSBM model's; under an "
+                "external force measure it (ergodicity_breaking)"
+            )
         if lags is None and len(self.tamsd_lags) == 0:
             raise _no_lags()
         lag_t = self.tamsd_lags if lags is None else lags
@@ -402,7 +476,20 @@ class LangevinResult:
         return (
             f"LangevinResult(model={self.model!r}, scheme={self.scheme!r}, n={self.n}, "
             f"dim={self.dim}, dt={self.dt}, t_stop={self.t_stop}, samples={len(self.times)}, "
-            f"lags={len(self.tamsd_lags)})"
+            f"lags={len(self.tamsd_lags)}{self._force_repr()})"
+        )
+
+    def _force_repr(self) -> str:
+        """The external force for ``repr``: empty without one."""
+        if not self.has_force:
+            return ""
+
+        def vec(a: NDArray[np.float64] | None) -> str:
+            return "(" + ", ".join(f"{float(x):g}" for x in np.asarray(a)) + ")"
+
+        return (
+            f", gravity={vec(self.gravity)}, trap_stiffness={vec(self.trap_stiffness)}, "
+            f"trap_centre={vec(self.trap_centre)}"
         )
 
 
@@ -415,9 +502,12 @@ def _result(
     x: NDArray[np.float64],
     v: NDArray[np.float64],
     v0_sq: float,
+    x0: NDArray[np.float64],
 ) -> LangevinResult:
     """The result of a run: the engine's sums divided into means (the TAMSD by each lag's
     number of windows), with what the run was given."""
+    f = p.forces
+    zero = (0.0,) * p.dim
     n, L = p.n, len(lags)
     estimator = _estimator_code(p.tamsd_estimator)
     strides = np.array([_core.sde_lag_stride(int(k), estimator) for k in lags], dtype=np.int64)
@@ -449,6 +539,10 @@ def _result(
         exponent=p.exponent if p.model == "udsbm" else 1.0,
         initial=initial,
         mass=p.mass,
+        gravity=np.array(f.gravity if f else zero),
+        trap_stiffness=np.array(f.trap_stiffness if f else zero),
+        trap_centre=np.array(f.trap_centre if f else zero),
+        initial_positions=x0,
     )
 
 
@@ -538,8 +632,12 @@ def run(
     threads: int | None = None,
     tamsd_estimator: str = "strided",
     mass: float = 1.0,
+    gravity: ArrayLike | None = None,
+    trap_stiffness: ArrayLike | None = None,
+    trap_centre: ArrayLike | None = None,
 ) -> LangevinResult:
-    """Integrate N independent particles from a common start at the origin.
+    """Integrate N independent particles from a common start at the origin (in a trap,
+    from its stationary density: ``initial``).
 
     Parameters
     ----------
@@ -586,6 +684,17 @@ def run(
     mass : the particles' mass (default 1): the dynamics take D0 and gamma0 only (the
         temperature per unit mass is D0 gamma0), the mass makes ``result.temperature``
         an energy, ``mass * v2 / dim``, as every result's is
+    gravity : length-dim vector g, a uniform acceleration (force m g on every particle),
+        L/time^2; the Langevin model only (docs/langevin_forces.md)
+    trap_stiffness : k of a harmonic trap, potential k (X - c)^2 / 2 per axis, force per
+        length (m/time^2): one number for every axis or one per axis, each >= 0 (0: no
+        trap along that axis); the Langevin model only.  With a trap, ``initial="thermal"``
+        also draws each trapped axis' start from its stationary (Boltzmann) density,
+        Gaussian about c + m g / k with variance T / k (T = m D0 gamma0), so the run is
+        stationary from t = 0 and its MSD is ``theory.msd_trap``; the other starts begin
+        at the origin.  ``result.initial_positions`` holds the starts; the MSD, positions
+        and final_positions are displacements from them
+    trap_centre : length-dim vector c, the trap's centre (default the origin)
 
     Returns
     -------
@@ -599,7 +708,8 @@ def run(
         and the mass within 1e-280 .. 1e280, the initial speed and speed times t_stop at
         most 1e140 (so that squared displacements and speeds stay within float64).
     UnstableStepError
-        Euler-Maruyama with gamma0 dt >= 2.
+        Euler-Maruyama with gamma0 dt >= 2, or in a trap with (k/m) dt >= gamma0 along an
+        axis (its stability limit there).
     MemoryError
         Stored positions or the every-window TAMSD's rings that would not fit.
     """
@@ -617,14 +727,18 @@ def run(
         threads=threads,
         mass=mass,
         tamsd_estimator=tamsd_estimator,
+        gravity=gravity,
+        trap_stiffness=trap_stiffness,
+        trap_centre=trap_centre,
     )
     steps = _sample_steps(sample_times, p.dt, p.n_steps)
     lags = _tamsd_lag_steps(tamsd_lags, p.dt, p.n_steps)
-    key, x, v, v0_sq = _initial_state(p, initial, speed, seed)
+    key, x, v, v0_sq, x0 = _initial_state(p, initial, speed, seed)
     _check_scales(p, *_initial_speed(initial, speed, p.dim, v0_sq))
+    _check_forces(p)
     sums = _new_sums(p, steps, lags, store_positions)
-    _integrate(p, key, x, v, steps, lags, sums, progress, work=_CHUNK_PARTICLE_STEPS)
-    return _result(p, initial, steps, lags, sums, x, v, v0_sq)
+    _integrate(p, key, x, v, steps, lags, sums, progress, work=_CHUNK_PARTICLE_STEPS, x0=x0)
+    return _result(p, initial, steps, lags, sums, x, v, v0_sq, x0)
 
 
 def coefficients_from_scene(scene: Scene) -> LangevinCoefficients:

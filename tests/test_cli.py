@@ -536,8 +536,14 @@ def test_figure_text_problems_are_found():
 
 # the experiments that take more than 3 s at quick sizes
 SLOW_FIGURES = (
-    "4.8+4.10", "4.11-4.16+F", "4.17-4.23", "clustering", "viscoelastic", "transport"
-)  # fmt: skip
+    "4.8+4.10",
+    "4.11-4.16+F",
+    "4.17-4.23",
+    "clustering",
+    "viscoelastic",
+    "transport",
+    "langevin-forces",
+)
 
 
 @pytest.mark.parametrize(

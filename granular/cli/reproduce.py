@@ -7,7 +7,9 @@ Public entry points
     ``"4.8+4.10"``, ``"4.9"``, ``"4.11-4.16+F"``, ``"4.17-4.23"``, then ``"clustering"``
     (where the homogeneous cooling of Fig. 4.10 ends; ``reproduce_clustering``) and
     ``"viscoelastic"`` (the viscoelastic gas and its power-law UDSBM; ``reproduce_visco``),
-    ``"transport"`` (elastic viscosity and self-diffusion; ``reproduce_transport``).
+    ``"transport"`` (elastic viscosity and self-diffusion; ``reproduce_transport``),
+    ``"langevin-forces"`` (the Langevin model in a harmonic trap;
+    ``reproduce_langevin_forces``).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -677,6 +679,13 @@ def _fig_transport(cfg, out):
     return reproduce_transport._fig_transport(cfg, out, **_tools())
 
 
+def _fig_langevin_forces(cfg, out):
+    """External forces in the Langevin model: see ``reproduce_langevin_forces``."""
+    from . import reproduce_langevin_forces
+
+    return reproduce_langevin_forces._fig_langevin_forces(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -688,6 +697,7 @@ FIGURES = {
     "clustering": _fig_clustering,
     "viscoelastic": _fig_visco,
     "transport": _fig_transport,
+    "langevin-forces": _fig_langevin_forces,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -706,6 +716,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
     "transport": ("elastic hard spheres: Green-Kubo viscosity and self-diffusion", 30.0, 8.0),
+    "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),
 }
 
 

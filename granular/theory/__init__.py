@@ -79,6 +79,14 @@ from .transport import (
     enskog_diffusion,
     enskog_viscosity,
 )
+from .trap import (
+    barometric_density,
+    gravity_mean_displacement,
+    msd_trap,
+    msd_trap_plateau,
+    trap_position_autocorrelation,
+    trap_velocity_autocorrelation,
+)
 from .udsbm import (
     msd_powerlaw_udsbm,
     msd_powerlaw_udsbm_asymptote,
@@ -112,6 +120,7 @@ __all__ = [
     "AKappa",
     "FloatOrArray",
     "LangevinCoefficients",
+    "barometric_density",
     "collision_frequency",
     "collision_time",
     "compressibility_factor",
@@ -122,6 +131,7 @@ __all__ = [
     "diffusion_infinite_system",
     "enskog_diffusion",
     "enskog_viscosity",
+    "gravity_mean_displacement",
     "haff_tau0",
     "haff_temperature",
     "langevin_coefficients",
@@ -134,6 +144,8 @@ __all__ = [
     "msd_logarithmic",
     "msd_powerlaw_udsbm",
     "msd_powerlaw_udsbm_asymptote",
+    "msd_trap",
+    "msd_trap_plateau",
     "msd_udsbm",
     "msd_viscoelastic",
     "msd_viscoelastic_asymptote",
@@ -147,6 +159,8 @@ __all__ = [
     "tracer_contact_value",
     "tracer_friction",
     "tracer_langevin_coefficients",
+    "trap_position_autocorrelation",
+    "trap_velocity_autocorrelation",
     "udsbm_ergodicity_breaking",
     "udsbm_increment_msd",
     "udsbm_v0_sq",

@@ -477,6 +477,11 @@ LANGEVIN_MUTATIONS = [
     _set("speed", EXTREME + WRONG_TYPES),
     _set("seed", [-1, "abc", 1.5, NAN]),
     _set("store_positions", ["yes", None]),
+    # external forces (Langevin model only): lengths that fit one dim but not another, NaN,
+    # huge, negative, and stiffnesses past Euler-Maruyama's limit at dt = 0.01
+    _set("gravity", [[0.0, 0.0, -9.8], [0.0, -9.8], [-9.8], [NAN], "down", [1e300], [1e300] * 3]),
+    _set("trap_stiffness", [1.0, 0.0, -1.0, NAN, 1e300, [1.0, 2.0], [5.0] * 3, 2000.0, None]),
+    _set("trap_centre", [[0.5], [0.0, 1.0], [NAN] * 3, [1e300] * 2]),
 ]
 
 
@@ -942,6 +947,7 @@ def _check_langevin(r):
         "positions",
         "final_positions",
         "final_velocities",
+        "initial_positions",
     ):
         a = getattr(r, name, None)
         _check(a is None or np.all(np.isfinite(a)), f"non-finite {name}")
