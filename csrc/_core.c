@@ -14,6 +14,7 @@
 #include "cells.h"
 #include "checkpoint.h"
 #include "common.h"
+#include "drive.h"
 #include "edmd.h"
 #include "rng.h"
 #include "scene_params.h"
@@ -521,7 +522,8 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     if (!check_ready(self)) return NULL;
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
-    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d}", "time", c.t,
+    return Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d,s:L,s:d}",
+                         "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
                          (long long)c.crossings, "shell_exits", (long long)c.shell_exits,
@@ -530,7 +532,8 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
                          "law_clamped_collisions", (long long)c.law_clamped, "virial", c.virial,
                          "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic,
                          "kinetic_time_integral", c.kinetic_time, "cells",
-                         c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell);
+                         c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell, "kicks",
+                         (long long)c.kicks, "drive_energy", c.drive_energy);
 }
 
 /* ---- checkpoints (csrc/checkpoint.c) ---- */
@@ -907,6 +910,12 @@ PyMODINIT_FUNC PyInit__core(void)
         PyModule_AddIntConstant(m, "LAW_TABLE_MAX", GR_LAW_TABLE_MAX) < 0 ||
         add_double(m, "VISCO_C1", GR_VISCO_C1) < 0 || add_double(m, "VISCO_C2", GR_VISCO_C2) < 0 ||
         add_double(m, "VISCO_DELTA_MAX", GR_VISCO_DELTA_MAX) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    /* ==== random driving (drive.h): granular/driving.py reads these ==== */
+    if (PyModule_AddIntConstant(m, "DRIVE_WHITE_NOISE", GR_DRIVE_WHITE_NOISE) < 0 ||
+        PyModule_AddIntConstant(m, "DRIVE_THERMOSTAT", GR_DRIVE_THERMOSTAT) < 0) {
         Py_DECREF(m);
         return NULL;
     }

@@ -57,6 +57,11 @@ struct gr_edmd {
     double kinetic;       /* total kinetic energy, updated by differences at each collision */
     double kinetic_time;  /* integral of the total kinetic energy over time, for the pressure */
     int64_t law_clamped;  /* collisions past a viscoelastic law's range (restitution.h) */
+    /* the random driving force (drive.c): the time of kick number `kicks`, the kicks done,
+     * the kinetic energy they gave */
+    double drive_next;
+    int64_t kicks;
+    double drive_energy;
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are
@@ -150,5 +155,12 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts);
 
 /* The first predictions of every particle (edmd.c); lists and cells must be built. */
 int gr_predict_all(gr_edmd *s, gr_error *err);
+/* Predict particle i anew after its velocity changed outside a collision (edmd.c); its
+ * clock must be the current time. */
+void gr_predict_one(gr_edmd *s, int32_t i);
+/* The constant-velocity loop, chosen as gr_edmd_advance chooses it (edmd.c), without the
+ * driving force: drive.c runs it between kicks. */
+int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err);
 
 #endif

@@ -70,4 +70,6 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->kinetic = kinetic_total(s, dynamics_of(s), s->dim);
     for (int a = 0; a < 3; a++) c->ncell[a] = s->cells.nc[a];
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;
+    c->kicks = s->kicks;
+    c->drive_energy = s->drive_energy;
 }

@@ -16,6 +16,10 @@
 #define GR_SCENE_DOUBLES(X) \
     X(wall_restitution)     \
     X(restitution)          \
-    X(contact_duration)
+    X(contact_duration)     \
+    X(drive_kind)           \
+    X(drive_rate)           \
+    X(drive_strength)       \
+    X(drive_seed)
 
 #endif

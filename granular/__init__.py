@@ -8,7 +8,8 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 
-from . import analysis, clustering, errors, langevin, restitution, theory
+from . import analysis, clustering, driving, errors, langevin, restitution, theory
+from .driving import PairThermostat, WhiteNoise
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
     CheckpointError,
@@ -73,6 +74,7 @@ __all__ = [
     "NonFiniteError",
     "OutsideBoxError",
     "OverlapError",
+    "PairThermostat",
     "ProcessBackendError",
     "Scene",
     "Simulation",
@@ -80,8 +82,10 @@ __all__ = [
     "Trajectory",
     "UnstableStepError",
     "Viscoelastic",
+    "WhiteNoise",
     "analysis",
     "clustering",
+    "driving",
     "ensemble",
     "errors",
     "langevin",

@@ -183,7 +183,9 @@ class Simulation:
         tc_elastic_collisions (pair collisions the TC model made elastic; a wall collision
         it made elastic is not counted), law_clamped_collisions (past a viscoelastic law's
         range, see ``granular.Viscoelastic``), virial, wall_impulse, kinetic_energy,
-        kinetic_time_integral, time, cells, shell (0: cells); and the pressure averaged over
+        kinetic_time_integral, time, cells, shell (0: cells), kicks and drive_energy (a
+        random driving's kicks and the kinetic energy they gave: the energy input per unit
+        time is ``drive_energy / time``); and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
         with the time average <E_kin>_t (exact for a cooling gas too) and W the pair
         collisions' virial.  In a periodic box V is the box volume.  In a walled box the
@@ -419,7 +421,8 @@ class Simulation:
         from .clustering import unstable_box
 
         found = unstable_box(self._initial)  # t* counts from the initial state, as time does
-        if found is None:
+        # a driven gas has no homogeneous cooling state to become unstable (docs/driven.md)
+        if found is None or self._initial.driving is not None:
             self._clustering_checked = True
             return
         message, t_star, cpp = found
