@@ -8,7 +8,7 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 
-from . import analysis, clustering, driving, errors, langevin, restitution, theory
+from . import analysis, clustering, driving, errors, langevin, moments, restitution, theory
 from .driving import PairThermostat, WhiteNoise
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
@@ -89,6 +89,7 @@ __all__ = [
     "ensemble",
     "errors",
     "langevin",
+    "moments",
     "read",
     "restitution",
     "theory",

@@ -82,6 +82,12 @@ QUANTITIES: dict[str, Quantity] = {
     "v0_sq": Quantity("initial mean squared velocity per component", "eps/m", "nonnegative"),
     "order": Quantity("order of the restitution series, 1 or 2", "dimensionless"),
     "points": Quantity("quadrature nodes", "dimensionless count"),
+    "strength": Quantity(
+        "white-noise strength xi0^2 (velocity variance per component per time)",
+        "eps/(m time)",
+        "positive",
+    ),
+    "approximation": Quantity("which approximation of a theory (its docstring lists them)", "-"),
     # data drawn by plot
     "times": Quantity("sample times of the data drawn", TIME),
     "lags": Quantity("lags of the time-averaged MSD drawn", TIME),

@@ -171,6 +171,8 @@ VALID = {
     "v0_sq": 0.5,
     "order": 1,
     "points": 50,
+    "strength": 0.5,
+    "approximation": "linear",
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],

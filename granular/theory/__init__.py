@@ -68,6 +68,11 @@ from .msd import (
     msd_langevin,
     msd_logarithmic,
 )
+from .sonine import (
+    driven_temperature,
+    sonine_a2_cooling,
+    sonine_a2_driven,
+)
 from .tracer import (
     tracer_contact_value,
     tracer_friction,
@@ -112,6 +117,7 @@ __all__ = [
     "cooling_rate",
     "critical_box_size",
     "diffusion_d0",
+    "driven_temperature",
     "haff_tau0",
     "haff_temperature",
     "langevin_coefficients",
@@ -134,6 +140,8 @@ __all__ = [
     "shear_mode_growth",
     "shear_mode_level",
     "shear_viscosity",
+    "sonine_a2_cooling",
+    "sonine_a2_driven",
     "tracer_contact_value",
     "tracer_friction",
     "tracer_langevin_coefficients",
