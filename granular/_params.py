@@ -88,6 +88,11 @@ QUANTITIES: dict[str, Quantity] = {
         "positive",
     ),
     "approximation": Quantity("which approximation of a theory (its docstring lists them)", "-"),
+    "kick": Quantity(
+        "one random kick's velocity variance per component over T/m (0: white noise)",
+        "dimensionless",
+        "nonnegative",
+    ),
     # data drawn by plot
     "times": Quantity("sample times of the data drawn", TIME),
     "lags": Quantity("lags of the time-averaged MSD drawn", TIME),

@@ -75,11 +75,23 @@ def _velocities(data: Any) -> NDArray[np.float64]:
     return v
 
 
-def _power_sums(v: NDArray[np.float64]) -> tuple[float, float, int]:
-    """sum |v - u|^2, sum |v - u|^4 over samples and particles (u each sample's mean), count."""
+def _power_sums(v: NDArray[np.float64], each: bool = False) -> tuple[float, float, int]:
+    """sum |v - u|^2, sum |v - u|^4 over samples and particles (u each sample's mean), count;
+    ``each``: every sample scaled to a mean |v - u|^2 of 1 first."""
     w = v - v.mean(axis=1, keepdims=True)
     s2 = np.einsum("snd,snd->sn", w, w)
+    if each:
+        mean = s2.mean(axis=1, keepdims=True)
+        if not np.all(mean > 0):
+            raise ValueError("a sample is at rest: no velocity distribution to measure")
+        s2 = s2 / mean
     return float(s2.sum()), float((s2 * s2).sum()), s2.size
+
+
+def _shell_corrected(a2: float, n: int, dim: int) -> float:
+    """a2 of samples each scaled to its own energy, with the energy shell's finite-N bias
+    (microcanonical_a2) taken out: (1 + a2) / (1 + a2_shell) - 1."""
+    return (1.0 + a2) / (1.0 + microcanonical_a2(n, dim)) - 1.0
 
 
 def _from_sums(m2: float, m4: float, count: int, dim: int) -> tuple[float, float]:
@@ -102,19 +114,25 @@ def kurtosis(velocities: Any) -> float:
     return _from_sums(*_power_sums(v), v.shape[2])[0]
 
 
-def sonine_a2(velocities: Any) -> float:
+def sonine_a2(velocities: Any, *, each_sample: bool = False) -> float:
     """The second Sonine coefficient ``a2 = d <|v|^4> / ((d+2) <|v|^2>^2) - 1``.
 
     Parameters
     ----------
     velocities : array_like (N, d) or (S, N, d), or a Trajectory
         Particle velocities [sqrt(eps/m)].
+    each_sample : bool
+        Scale every sample to its own mean |v|^2 before pooling them: for a gas whose
+        temperature changes between samples (a cooling gas), where pooled samples would
+        mix temperatures (a scale mixture, whose a2 is too large).  Each sample then lies
+        on its own energy shell, whose finite-N bias ``microcanonical_a2`` is taken out.
     """
     v = _velocities(velocities)
-    return _from_sums(*_power_sums(v), v.shape[2])[1]
+    a2 = _from_sums(*_power_sums(v, each_sample), v.shape[2])[1]
+    return _shell_corrected(a2, v.shape[1], v.shape[2]) if each_sample else a2
 
 
-def velocity_moments(data: Any, *, blocks: int = 10) -> MomentEstimate:
+def velocity_moments(data: Any, *, blocks: int = 10, each_sample: bool = False) -> MomentEstimate:
     """Kurtosis and a2 with error bars (module docstring).
 
     Parameters
@@ -124,6 +142,8 @@ def velocity_moments(data: Any, *, blocks: int = 10) -> MomentEstimate:
         independent runs (one value each).
     blocks : int
         Blocks of one run, >= 2, at most its number of samples.
+    each_sample : bool
+        Scale every sample to its own mean |v|^2 first (a cooling gas; ``sonine_a2``).
 
     Returns
     -------
@@ -146,16 +166,21 @@ def velocity_moments(data: Any, *, blocks: int = 10) -> MomentEstimate:
     if len(dims) != 1:
         raise ValueError(f"the runs have different dimensions {sorted(dims)}")
     dim = dims.pop()
-    sums = [_power_sums(p) for p in parts]
+    sums = [_power_sums(p, each_sample) for p in parts]
     values = np.array([_from_sums(*s, dim) for s in sums])
-    total = _from_sums(
-        sum(s[0] for s in sums), sum(s[1] for s in sums), sum(s[2] for s in sums), dim
+    total = np.array(
+        [_from_sums(sum(s[0] for s in sums), sum(s[1] for s in sums), sum(s[2] for s in sums), dim)]
     )
+    if each_sample:  # the shell's bias out of a2, and the kurtosis that goes with it
+        n = parts[0].shape[1]
+        for x in (values, total):
+            x[:, 1] = [_shell_corrected(a, n, dim) for a in x[:, 1]]
+            x[:, 0] = (dim + 2) / dim * (1.0 + x[:, 1])
     err = values.std(axis=0, ddof=1) / math.sqrt(len(parts))
     return MomentEstimate(
-        kurtosis=total[0],
+        kurtosis=float(total[0, 0]),
         kurtosis_error=float(err[0]),
-        a2=total[1],
+        a2=float(total[0, 1]),
         a2_error=float(err[1]),
         blocks=len(parts),
         method=method,

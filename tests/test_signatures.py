@@ -173,6 +173,7 @@ VALID = {
     "points": 50,
     "strength": 0.5,
     "approximation": "linear",
+    "kick": 0.05,
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],

@@ -121,7 +121,11 @@ def sonine_a2_cooling(
 
 @keyword_only()
 def sonine_a2_driven(
-    *, restitution: FloatOrArray, dim: int = 3, approximation: str = "linear"
+    *,
+    restitution: FloatOrArray,
+    dim: int = 3,
+    approximation: str = "linear",
+    kick: FloatOrArray = 0.0,
 ) -> FloatOrArray:
     """Second Sonine coefficient a2 of the steady state heated by white noise (module
     docstring; granular.WhiteNoise drives a gas so).
@@ -137,6 +141,12 @@ def sonine_a2_driven(
         ``16 (1 - xi)(1 - 2 xi^2) / (73 + 56 d - 3 xi (35 + 8 d) + 30 xi^2 (1 - xi))``
         (the moment equation mu4 = (d+2) mu2 is linear in a2 to this order, so it has no
         "nonlinear" form); "maxwell": 0.
+    kick : float or array
+        For kicks of finite size (granular.WhiteNoise at a finite rate): one kick's velocity
+        variance per component over T/m, ``m strength / (rate T)`` (0: white noise).  Each
+        kick adds ``d (d+2) s^4`` to <v^4> besides the diffusion's ``2 (d+2) s^2 <v^2>``, so
+        the steady state needs mu4 = (d + 2)(1 + kick/2) mu2 exactly (the fourth
+        Kramers-Moyal term), which this solves to the same first order.
 
     Returns
     -------
@@ -149,13 +159,24 @@ def sonine_a2_driven(
     alpha = np.asarray(_constant_xi(restitution), dtype=np.float64)
     if approximation == "maxwell":
         return _scalar(np.zeros_like(alpha))
-    a2 = (
-        16.0
-        * (1.0 - alpha)
-        * (1.0 - 2.0 * alpha**2)
-        / (73.0 + 56.0 * dim - 3.0 * alpha * (35.0 + 8.0 * dim) + 30.0 * alpha**2 * (1.0 - alpha))
-    )
-    return _scalar(a2)
+    if np.all(np.asarray(kick) == 0.0):
+        a2 = (
+            16.0
+            * (1.0 - alpha)
+            * (1.0 - 2.0 * alpha**2)
+            / (
+                73.0
+                + 56.0 * dim
+                - 3.0 * alpha * (35.0 + 8.0 * dim)
+                + 30.0 * alpha**2 * (1.0 - alpha)
+            )
+        )
+        return _scalar(a2)
+    a0, a1, b0, b1 = _coefficients(alpha, dim)
+    g = (dim + 2) * (1.0 + 0.5 * np.asarray(kick, dtype=np.float64))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a2 = (b0 - g * a0) / (g * a1 - b1)
+    return _scalar(np.where(alpha == 1.0, 0.0, a2))
 
 
 @keyword_only()
@@ -169,6 +190,7 @@ def driven_temperature(
     dim: int = 3,
     eta: FloatOrArray | None = None,
     approximation: str = "linear",
+    kick: FloatOrArray = 0.0,
 ) -> FloatOrArray:
     """Steady temperature of a gas heated by white noise of strength xi0^2: the heating
     ``dT/dt = m xi0^2`` equals the collisional cooling ``zeta T`` with
@@ -196,6 +218,9 @@ def driven_temperature(
         Packing fraction for the contact value (default: from density and radius).
     approximation : {"linear", "maxwell"}
         a2 from ``sonine_a2_driven`` (first order), or 0 (the Maxwellian estimate).
+    kick : float or array
+        One kick's velocity variance per component over T/m (``sonine_a2_driven``); 0:
+        white noise.  The energy input does not depend on it, only a2 does.
 
     Returns
     -------
@@ -204,7 +229,7 @@ def driven_temperature(
     """
     _approximation(approximation, ("linear", "maxwell"))
     xi = np.asarray(_constant_xi(restitution), dtype=np.float64)
-    a2 = sonine_a2_driven(restitution=xi, dim=dim, approximation=approximation)
+    a2 = sonine_a2_driven(restitution=xi, dim=dim, approximation=approximation, kick=kick)
     omega1 = collision_frequency(
         density=density, radius=radius, temperature=1.0, mass=mass, dim=dim, eta=eta
     )
