@@ -75,3 +75,16 @@ def test_bad_input_is_refused():
         moments.velocity_moments([np.ones((2, 10, 3))])
     with pytest.raises(ValueError, match="too few speeds"):
         moments.speed_tail(np.random.default_rng(1).normal(size=(20, 2)), c_min=3.0)
+
+
+def test_each_sample_undoes_a_cooling_gas_temperature():
+    """Maxwellian samples at temperatures falling by 100x pooled: a scale mixture with a2
+    far above 0; scaled each to its own temperature (each_sample) a2 is 0 within 5 sigma
+    (the shell's -2/(d(N-1)+2) taken out)."""
+    rng = np.random.default_rng(6)
+    scale = np.geomspace(1.0, 0.1, 30)[:, None, None]
+    v = rng.normal(size=(30, 500, 3)) * scale
+    assert moments.sonine_a2(v) > 0.3
+    est = moments.velocity_moments(v, blocks=10, each_sample=True)
+    assert abs(est.a2) < 5 * est.a2_error
+    assert moments.sonine_a2(v, each_sample=True) == pytest.approx(est.a2)

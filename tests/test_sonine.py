@@ -92,3 +92,20 @@ def test_driven_temperature_balances_heating(d):
     zeta = theory.cooling_rate(temperature=t, **kw) * (1 + 3 * a2 / 16)
     assert zeta * t == pytest.approx(0.3, rel=1e-12)
     assert theory.driven_temperature(strength=0.3, **{**kw, "restitution": 1.0}) == math.inf
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_finite_kicks_solve_their_moment_equation(d):
+    """With kicks of variance kick T/m the steady state needs mu4 = (d+2)(1 + kick/2) mu2;
+    kick = 0 is the white-noise formula."""
+    alpha = np.linspace(0.0, 0.99, 7)
+    a0, a1, b0, b1 = _coefficients(alpha, d)
+    for kick in (1e-9, 0.02, 0.5):
+        a2 = theory.sonine_a2_driven(restitution=alpha, dim=d, kick=kick)
+        g = (d + 2) * (1 + kick / 2)
+        np.testing.assert_allclose(g * (a0 + a1 * a2) - b0 - b1 * a2, 0.0, atol=1e-13)
+    np.testing.assert_allclose(
+        theory.sonine_a2_driven(restitution=alpha, dim=d, kick=1e-12),
+        theory.sonine_a2_driven(restitution=alpha, dim=d),
+        atol=1e-12,
+    )
