@@ -31,9 +31,21 @@ from typing import Any
 
 from . import _core
 from ._params import check_positive
+from ._scales import SCALE_HI, SCALE_LO
 
 # integers below 2^53 are held exactly by the engine's double (csrc/drive.h)
 SEED_LIMIT = 2**53
+
+
+def _scale(name: str, value: float, meaning: str) -> float:
+    """``value`` if within the scale limits float64's collision arithmetic carries
+    (granular/_scales.py), else ValueError naming it."""
+    if not SCALE_LO <= value <= SCALE_HI:
+        raise ValueError(
+            f"{name} {value:g} is outside {SCALE_LO:g} .. {SCALE_HI:g} ({meaning}): choose "
+            "units nearer the gas' own"
+        )
+    return value
 
 
 def _seed(seed: Any) -> int:
@@ -82,6 +94,9 @@ class WhiteNoise:
             self, "rate", check_positive("rate", self.rate, "kicks per particle per unit time")
         )
         object.__setattr__(self, "seed", _seed(self.seed))
+        _scale("strength", self.strength, "the noise's xi0^2")
+        _scale("rate", self.rate, "kicks per particle per unit time")
+        _scale("strength / rate", self.strength / self.rate, "one kick's velocity variance")
 
     def heating(self, dim: int, mass: float = 1.0) -> float:
         """Mean energy input per particle per unit time, ``dim * mass * strength / 2``
@@ -145,6 +160,8 @@ class PairThermostat:
             self, "rate", check_positive("rate", self.rate, "redraws per particle per unit time")
         )
         object.__setattr__(self, "seed", _seed(self.seed))
+        _scale("temperature", self.temperature, "the thermostat's temperature")
+        _scale("rate", self.rate, "redraws per particle per unit time")
 
     def _engine(self) -> dict[str, float]:
         return {

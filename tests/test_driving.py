@@ -145,6 +145,9 @@ def test_thermostat_holds_an_elastic_gas_at_its_temperature():
         (lambda: WhiteNoise(1.0, 1.0, seed=-1), "seed"),
         (lambda: WhiteNoise(1.0, 1.0, seed=2**53), "seed"),
         (lambda: PairThermostat(0.0, 1.0), "temperature"),
+        (lambda: WhiteNoise(1e100, 1e-100), "strength / rate"),
+        (lambda: PairThermostat(1e300, 1.0), "temperature"),
+        (lambda: WhiteNoise(1.0, 1e-300), "rate"),
     ],
 )
 def test_bad_values_are_refused(make, match):

@@ -706,7 +706,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
-    "driven": ("a2 of cooling and white-noise driven gases, driven temperature", 60.0, 15.0),
+    "driven": ("a2 of cooling and white-noise driven gases, driven temperature", 101.6, 18.7),
 }
 
 
