@@ -122,7 +122,7 @@ def sonine_a2(velocities: Any, *, each_sample: bool = False) -> float:
     velocities : array_like (N, d) or (S, N, d), or a Trajectory
         Particle velocities [sqrt(eps/m)].
     each_sample : bool
-        Scale every sample to its own mean |v|^2 before pooling them: for a gas whose
+        Scale every sample to its own mean ``|v|^2`` before pooling them: for a gas whose
         temperature changes between samples (a cooling gas), where pooled samples would
         mix temperatures (a scale mixture, whose a2 is too large).  Each sample then lies
         on its own energy shell, whose finite-N bias ``microcanonical_a2`` is taken out.
@@ -143,7 +143,7 @@ def velocity_moments(data: Any, *, blocks: int = 10, each_sample: bool = False) 
     blocks : int
         Blocks of one run, >= 2, at most its number of samples.
     each_sample : bool
-        Scale every sample to its own mean |v|^2 first (a cooling gas; ``sonine_a2``).
+        Scale every sample to its own mean ``|v|^2`` first (a cooling gas; ``sonine_a2``).
 
     Returns
     -------
