@@ -183,9 +183,9 @@ class Simulation:
         tc_elastic_collisions (pair collisions the TC model made elastic; a wall collision
         it made elastic is not counted), law_clamped_collisions (past a viscoelastic law's
         range, see ``granular.Viscoelastic``), virial, wall_impulse, kinetic_energy,
-        kinetic_time_integral, time, cells, shell (0: cells), kicks and drive_energy (a
-        random driving's kicks and the kinetic energy they gave: the energy input per unit
-        time is ``drive_energy / time``); and the pressure averaged over
+        kinetic_time_integral, time, cells, shell (0: cells), kicks, drive_energy and
+        drive_power (a random driving's kicks, the kinetic energy they gave, and that per
+        unit time since the start); and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
         with the time average <E_kin>_t (exact for a cooling gas too) and W the pair
         collisions' virial.  In a periodic box V is the box volume.  In a walled box the
@@ -202,6 +202,8 @@ class Simulation:
         else:
             c["pressure"] = float("nan")
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
+        # the random driving's energy input per unit time (0 before any time has passed)
+        c["drive_power"] = c["drive_energy"] / c["time"] if c["time"] > 0 else 0.0
         return c
 
     @property

@@ -212,3 +212,26 @@ def test_finite_kicks_shift_a2_as_the_fourth_moment_balance_says():
     err = np.std(values, ddof=1) / 2
     assert abs(np.mean(values) - expected) < 5 * err + 0.1 * expected
     assert abs(np.mean(values) - theory.sonine_a2_driven(restitution=xi)) > 10 * err
+
+
+def test_ensemble_runs_draw_their_own_kicks():
+    """An ensemble of a driven Scene shuffles velocities per run (the thesis' method) and
+    gives each run's driving a seed of its own: otherwise every run would be kicked at the
+    same times with the same numbers.  The same run seed gives the same driving."""
+    from granular.ensemble import _shuffle_velocities
+
+    s = _driven(WhiteNoise(1.0, 10.0, seed=3), n=20)
+    seeds = {_shuffle_velocities(s, np.random.default_rng(k)).driving.seed for k in range(5)}
+    assert len(seeds) == 5
+    again = _shuffle_velocities(s, np.random.default_rng(2)).driving
+    assert again == _shuffle_velocities(s, np.random.default_rng(2)).driving
+    assert again.strength == 1.0 and again.rate == 10.0
+
+
+def test_drive_power_is_the_energy_input_per_time():
+    s = _driven(WhiteNoise(1.0, 10.0, seed=3), n=20)
+    sim = Simulation(s)
+    assert sim.stats["drive_power"] == 0.0
+    sim.run(t_stop=2.0, store=())
+    st = sim.stats
+    assert st["drive_power"] == st["drive_energy"] / st["time"] and st["kicks"] > 0
