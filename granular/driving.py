@@ -25,7 +25,6 @@ file store them as their JSON description (``describe``).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -219,18 +218,3 @@ def from_description(description: dict[str, Any]) -> WhiteNoise | PairThermostat
     if name not in _KINDS:
         raise ValueError(f"unknown driving {name!r}")
     return _KINDS[name](**args)
-
-
-def steady_kick_rate(
-    strength: float, temperature: float, *, mass: float = 1.0, factor: float = 20.0
-) -> float:
-    """A kick rate that makes one kick's velocity variance ``1/factor`` of ``T / m`` at
-    the steady ``temperature``: ``factor * mass * strength / temperature``."""
-    if not (factor > 0 and math.isfinite(factor)):
-        raise ValueError(f"factor must be positive and finite, got {factor}")
-    return (
-        factor
-        * mass
-        * check_positive("strength", strength)
-        / check_positive("temperature", temperature)
-    )
