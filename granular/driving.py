@@ -15,9 +15,11 @@ picks a random pair and gives it equal and opposite momenta (the total momentum 
 exactly), then predicts the pair's events anew.  White noise is the limit of many small
 kicks: one kick's velocity variance per component is ``s^2 = xi0^2 / rate``, and the
 first correction to the white-noise Fokker-Planck equation is of relative order
-``s^2 m / (2 T)`` (the fourth Kramers-Moyal term), so choose ``rate >> m xi0^2 / T``.
-Kicks cost about what collisions do (each predicts two particles): a rate of 5-20 times
-``m xi0^2 / T`` keeps the correction at a few per cent of ``a2`` or less (docs/driven.md).
+``s^2 m / (2 T)`` (the fourth Kramers-Moyal term).  The heating is exact for any kick
+size, but a2 is small: kicks of variance T/(50 m) shift it by +0.003 at xi = 0.8 in 3D,
+a third of a2.  So either take ``rate >~ 500 m xi0^2 / T``, or compare with
+``theory.sonine_a2_driven(kick=m xi0^2 / (rate T))``, which includes the kicks' size.
+Kicks cost about what collisions do (each predicts two particles; docs/driven.md).
 
 Both are small immutable values that compare by value and pickle; a checkpoint and a GSD
 file store them as their JSON description (``describe``).
