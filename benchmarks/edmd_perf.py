@@ -10,6 +10,11 @@ public API (Scene, Simulation and its stats), as a user's script would.
     python benchmarks/edmd_perf.py            # every workload
     python benchmarks/edmd_perf.py --only 3d-1e5-0.065 --repeats 5
     python benchmarks/edmd_perf.py --tiny     # every workload at N = 500, seconds (CI)
+    python benchmarks/edmd_perf.py --kicks 1  # driven: a random kick per pair collision
+
+``--kicks K`` times a driven gas (``granular.PairThermostat`` at the equilibrated gas'
+temperature, which keeps an elastic gas where it is) with K kicks per pair collision, to set
+beside the plain loop's rate at the same N and packing.
 """
 
 import argparse
@@ -17,7 +22,7 @@ import time
 
 import numpy as np
 
-from granular import Scene, Simulation
+from granular import PairThermostat, Scene, Simulation
 
 WORKLOADS = [
     # name, dim, N, packing fraction
@@ -43,7 +48,7 @@ def radius_for(n, d, eta):
     return (eta / (n * np.pi)) ** 0.5
 
 
-def run(name, d, n, eta, cell_factor, shell, equilibrate, events, repeats, seed):
+def run(name, d, n, eta, cell_factor, shell, equilibrate, events, repeats, seed, kicks=0.0):
     rng = np.random.default_rng(seed)
     vel = rng.normal(size=(n, d))
     vel -= vel.mean(0)
@@ -53,6 +58,13 @@ def run(name, d, n, eta, cell_factor, shell, equilibrate, events, repeats, seed)
     t0 = time.perf_counter()
     sim.run(stop_when={"collisions_per_particle": equilibrate}, store=())
     t_eq = time.perf_counter() - t0
+    if kicks > 0:  # each particle's pair collisions per unit time, 2 pairs / (N t), times K
+        stats = sim.stats
+        rate = kicks * 2 * stats["pair_collisions"] / (n * stats["time"])
+        thermostat = PairThermostat(sim.scene.temperature, rate, seed=seed)
+        sim = Simulation(
+            sim.scene.replace(driving=thermostat), cell_factor=cell_factor, shell=shell
+        )
     e_start = sim.stats["kinetic_energy"]
     best = None
     for _ in range(repeats):
@@ -96,6 +108,9 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument(
+        "--kicks", type=float, default=0.0, help="random kicks per pair collision (0: none)"
+    )
+    ap.add_argument(
         "--tiny",
         action="store_true",
         help=f"every workload at N = {TINY['n']}, {TINY['events']} events: that it runs, "
@@ -128,6 +143,7 @@ def main():
             args.events,
             args.repeats,
             args.seed,
+            args.kicks,
         )
         print(
             f"{name:14s} {b['rate'] / 1e6:8.3f} {b['ev_per_pair']:8.2f} {b['ns_per_event']:7.1f} "

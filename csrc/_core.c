@@ -14,6 +14,7 @@
 #include "cells.h"
 #include "checkpoint.h"
 #include "common.h"
+#include "drive.h"
 #include "edmd.h"
 #include "rng.h"
 #include "scene_params.h"
@@ -528,7 +529,7 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
 #define NINE(x) x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8]
-    PyObject *out = Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d,s:d}", "time", c.t,
+    PyObject *out = Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d,s:d,s:L,s:d}", "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
                          (long long)c.crossings, "shell_exits", (long long)c.shell_exits,
@@ -538,7 +539,8 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
                          "wall_impulse", c.wall_impulse, "kinetic_energy", c.kinetic,
                          "kinetic_time_integral", c.kinetic_time, "cells",
                          c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell,
-                         "shear_work", c.shear_work);
+                         "shear_work", c.shear_work, "kicks", (long long)c.kicks,
+                         "drive_energy", c.drive_energy);
     /* the stress tensor's parts: nine numbers each, of which the first dim * dim are the
      * dim x dim tensor row-major (zeros unless built with stress) */
     PyObject *st = out ? Py_BuildValue("{s:(ddddddddd),s:(ddddddddd),s:(ddddddddd)}",
@@ -966,6 +968,12 @@ PyMODINIT_FUNC PyInit__core(void)
         PyModule_AddIntConstant(m, "LAW_TABLE_MAX", GR_LAW_TABLE_MAX) < 0 ||
         add_double(m, "VISCO_C1", GR_VISCO_C1) < 0 || add_double(m, "VISCO_C2", GR_VISCO_C2) < 0 ||
         add_double(m, "VISCO_DELTA_MAX", GR_VISCO_DELTA_MAX) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    /* ==== random driving (drive.h): granular/driving.py reads these ==== */
+    if (PyModule_AddIntConstant(m, "DRIVE_WHITE_NOISE", GR_DRIVE_WHITE_NOISE) < 0 ||
+        PyModule_AddIntConstant(m, "DRIVE_THERMOSTAT", GR_DRIVE_THERMOSTAT) < 0) {
         Py_DECREF(m);
         return NULL;
     }

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drive.h"
 #include "engine.h"
 #include "hugemem.h"
 #include "stress.h"
@@ -170,6 +171,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     double vrms = sqrt(v2m / msum);
     s->eps_t = vrms > 0.0 ? 1e-9 * sigma_min / vrms : 0.0;
     s->t_prev_event = -INFINITY;
+    s->drive_next = cfg->drive_kind != GR_DRIVE_NONE ? gr_drive_wait(cfg, 0) : INFINITY;
 
     status = gr_find_overlap(d, n, s->P, (size_t)GR_STRIDE(d), s->P + 2 * d + 1, (size_t)GR_STRIDE(d),
                              cfg->periodic, s->L, &s->cells, &s->big,

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "checkpoint.h"
+#include "drive.h"
 #include "engine.h"
 #include "hugemem.h"
 #include "scene_params.h"
@@ -202,6 +203,9 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, s->stress_t);
     IO(c, s->order.next);
     IO(c, s->nl.broken);
+    IO(c, s->drive_next);
+    IO(c, s->kicks);
+    IO(c, s->drive_energy);
 
     io(c, s->P, (size_t)n * GR_STRIDE(s->dim) * sizeof *s->P);
     io(c, s->mass, (size_t)n * sizeof *s->mass);
@@ -379,7 +383,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         GR_COUNTER(events),      GR_COUNTER(pair),       GR_COUNTER(wall),
         GR_COUNTER(invalid),     GR_COUNTER(elastic_tc), GR_COUNTER(law_clamped),
         GR_COUNTER(crossings),   GR_COUNTER(shell_exits), GR_COUNTER(same_instant),
-        GR_COUNTER(order.next),
+        GR_COUNTER(order.next),  GR_COUNTER(kicks),
     };
 #undef GR_COUNTER
     for (size_t k = 0; k < sizeof counters / sizeof counters[0]; k++)
@@ -443,6 +447,11 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
     for (int k = 0; k < 9; k++)
         if (!isfinite(t->st_coll[k]) || !isfinite(t->st_kin[k]) || !isfinite(t->st_kin_time[k]))
             return "its stress tensor is not finite";
+    /* the next kick lies ahead (none without driving), and the energy kicks gave is finite */
+    if (!isfinite(t->drive_energy) ||
+        (b->drive_kind != GR_DRIVE_NONE ? !(t->drive_next >= t->t && t->drive_next < INFINITY)
+                                        : t->drive_next != INFINITY || t->kicks != 0))
+        return "its random driving's state (next kick, kicks, energy given) is corrupt";
     for (int32_t i = 0; i < n; i++) {
         const double *p = rec(t, d, i);
         if (!(TIME(p, d) >= 0.0 && TIME(p, d) <= t->t)) return "a particle's clock is out of range";

@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "drive.h"
 #include "engine.h"
 #include "rule.h"
 #include "search.h"
@@ -235,6 +236,14 @@ static int advance_3d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
 }
 
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
+{
+    /* a driven gas runs the plain loop between kicks (drive.c): nothing per event here */
+    if (s->cfg.drive_kind != GR_DRIVE_NONE) return gr_drive_advance(s, stop, smp, err);
+    return gr_edmd_advance_plain(s, stop, smp, err);
+}
+
+int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
 {
     if (s->nl.broken) {
         gr_error_set(err, GR_ERR_NOMEM, -1, -1, s->t, (double)s->nl.cap,
@@ -686,4 +695,11 @@ int gr_predict_all(gr_edmd *s, gr_error *err)
 {
     const int dyn = dynamics_of(s);
     return s->dim == 2 ? start(s, dyn, 2, err) : start(s, dyn, 3, err);
+}
+
+void gr_predict_one(gr_edmd *s, int32_t i)
+{
+    const int dyn = dynamics_of(s);
+    if (s->dim == 2) predict(s, dyn, 2, i); /* the clones the loops use */
+    else predict(s, dyn, 3, i);
 }

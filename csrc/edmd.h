@@ -58,6 +58,12 @@ typedef struct {
                                * wall_restitution above; else eps(v_n) replaces them
                                * (restitution.h).  gr_edmd_new copies the tables. */
     int stress;               /* 1: keep the stress tensor's accumulators (stress.h) */
+    /* The random driving force (drive.h): kicks to random pairs at the times of a Poisson
+     * process.  drive_kind GR_DRIVE_NONE (0) turns it off, and the others are then unused;
+     * drive_rate: kicks each particle receives per unit time on average (> 0); drive_strength:
+     * the white noise's xi0^2 (GR_DRIVE_WHITE_NOISE) or the thermostat's temperature
+     * (GR_DRIVE_THERMOSTAT); drive_seed: the random numbers' key, an integer in [0, 2^53). */
+    double drive_kind, drive_rate, drive_strength, drive_seed;
 } gr_edmd_config;
 
 typedef struct {
@@ -113,6 +119,8 @@ typedef struct {
     double stress_collisional[9];  /* sum over pair collisions of r_a dp_b */
     double kinetic_time_tensor[9]; /* integral over time of sum m v_a v_b */
     double kinetic_tensor[9];      /* sum m v_a v_b now */
+    int64_t kicks;          /* random driving: kicks done (each to one pair) */
+    double drive_energy;    /* random driving: kinetic energy the kicks gave, summed */
 } gr_edmd_counters;
 
 typedef struct gr_edmd gr_edmd;

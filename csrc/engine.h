@@ -67,6 +67,11 @@ struct gr_edmd {
     double st_kin[9];      /* the kinetic tensor sum m v_a v_b now */
     double st_kin_time[9]; /* its integral over time up to stress_t */
     double stress_t;
+    /* the random driving force (drive.c): the time of kick number `kicks`, the kicks done,
+     * the kinetic energy they gave */
+    double drive_next;
+    int64_t kicks;
+    double drive_energy;
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are
@@ -161,5 +166,12 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts);
 
 /* The first predictions of every particle (edmd.c); lists and cells must be built. */
 int gr_predict_all(gr_edmd *s, gr_error *err);
+/* Predict particle i anew after its velocity changed outside a collision (edmd.c); its
+ * clock must be the current time. */
+void gr_predict_one(gr_edmd *s, int32_t i);
+/* The constant-velocity loop, chosen as gr_edmd_advance chooses it (edmd.c), without the
+ * driving force: drive.c runs it between kicks. */
+int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err);
 
 #endif

@@ -139,4 +139,6 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
         c->kinetic_tensor[k] = s->st_kin[k];
     }
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;
+    c->kicks = s->kicks;
+    c->drive_energy = s->drive_energy;
 }

@@ -18,6 +18,10 @@
     X(restitution)          \
     X(contact_duration)     \
     X(shear_rate)           \
-    X(shear_offset)
+    X(shear_offset)         \
+    X(drive_kind)           \
+    X(drive_rate)           \
+    X(drive_strength)       \
+    X(drive_seed)
 
 #endif

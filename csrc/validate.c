@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "drive.h"
 #include "engine.h"
 
 /* A restitution law (restitution.h) the engine can evaluate: kind known, parameters
@@ -138,6 +139,8 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
                      "contact duration must be finite and >= 0");
         return GR_ERR_VALUE;
     }
+    status = gr_drive_check(cfg, err);
+    if (status != GR_OK) return status;
     if (!(cfg->big_ratio >= 1.0)) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->big_ratio, "big_ratio must be >= 1 (inf: none)");
         return GR_ERR_VALUE;

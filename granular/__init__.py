@@ -8,7 +8,18 @@ that checks them against theory.
 >>> traj = granular.Simulation(scene).run(t_stop=10.0, sample_times=[0, 1, 10])
 """
 
-from . import analysis, clustering, errors, langevin, restitution, theory, transport
+from . import (
+    analysis,
+    clustering,
+    driving,
+    errors,
+    langevin,
+    moments,
+    restitution,
+    theory,
+    transport,
+)
+from .driving import PairThermostat, WhiteNoise
 from .ensemble import EnsembleResult, ensemble
 from .errors import (
     CheckpointError,
@@ -73,6 +84,7 @@ __all__ = [
     "NonFiniteError",
     "OutsideBoxError",
     "OverlapError",
+    "PairThermostat",
     "ProcessBackendError",
     "Scene",
     "Simulation",
@@ -80,11 +92,14 @@ __all__ = [
     "Trajectory",
     "UnstableStepError",
     "Viscoelastic",
+    "WhiteNoise",
     "analysis",
     "clustering",
+    "driving",
     "ensemble",
     "errors",
     "langevin",
+    "moments",
     "read",
     "restitution",
     "theory",

@@ -10,6 +10,8 @@ from numpy.typing import ArrayLike, NDArray
 BIG_MAX: int
 BIG_RATIO: float
 CHECKPOINT_LAYOUT: int
+DRIVE_THERMOSTAT: int
+DRIVE_WHITE_NOISE: int
 EDMD_KEYWORDS: tuple[str, ...]
 HEADS_CACHED: int
 LAW_CONSTANT: int

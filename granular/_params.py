@@ -90,6 +90,17 @@ QUANTITIES: dict[str, Quantity] = {
     "height": Quantity("height z above a wall", "L"),
     "order": Quantity("order of the restitution series, 1 or 2", "dimensionless"),
     "points": Quantity("quadrature nodes", "dimensionless count"),
+    "strength": Quantity(
+        "white-noise strength xi0^2 (velocity variance per component per time)",
+        "eps/(m time)",
+        "positive",
+    ),
+    "approximation": Quantity("which approximation of a theory (its docstring lists them)", "-"),
+    "kick": Quantity(
+        "one random kick's velocity variance per component over T/m (0: white noise)",
+        "dimensionless",
+        "nonnegative",
+    ),
     # data drawn by plot
     "times": Quantity("sample times of the data drawn", TIME),
     "lags": Quantity("lags of the time-averaged MSD drawn", TIME),

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from . import driving as _driving
 from ._params import check_positive
 from ._scales import SCALE_HI, SCALE_LO
 from .restitution import ConstantRestitution, RestitutionLaw, engine_law
@@ -328,6 +329,18 @@ PARAMETERS: tuple[SceneParameter, ...] = (
         "elastic, which prevents inelastic collapse.  0 turns it off.",
         _contact_duration,
         _same("contact_duration"),
+    ),
+    SceneParameter(
+        "driving",
+        "None, WhiteNoise or PairThermostat",
+        None,
+        None,
+        "",
+        "A random driving force (``granular.driving``): kicks to random pairs at random "
+        "times, momentum kept, that heat the gas as white noise (``WhiteNoise``, van Noije "
+        "& Ernst 1998) or thermostat it (``PairThermostat``).  None: no driving.",
+        lambda value, n, d: _driving.check(value),
+        _driving.engine_keywords,
     ),
 )
 

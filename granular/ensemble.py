@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import ast
 import contextlib
+import dataclasses
 import math
 import os
 import pickle
@@ -416,13 +417,20 @@ class _Accumulator:
 
 def _shuffle_velocities(scene, rng):
     """The thesis' way (3.8) to make independent runs from one equilibrated scene: give the
-    velocity vectors to the particles in a random order."""
+    velocity vectors to the particles in a random order (and a random driving a seed of
+    the run's own)."""
     if not np.all(scene.masses == scene.masses[0]):
         raise ValueError(
             "shuffling velocities among particles of different masses would "
             "change the energy; pass a function seed -> Scene instead"
         )
-    return scene.replace(velocities=scene.velocities[rng.permutation(scene.n)])
+    shuffled = scene.replace(velocities=scene.velocities[rng.permutation(scene.n)])
+    if scene.driving is None:
+        return shuffled
+    # a random driving's kicks are its seed's: each run draws its own, or every run would
+    # be kicked at the same times with the same numbers
+    seed = int(rng.integers(0, 2**53))
+    return shuffled.replace(driving=dataclasses.replace(scene.driving, seed=seed))
 
 
 def _edmd_quantities(scene, run_kwargs, quantities):

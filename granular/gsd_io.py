@@ -74,6 +74,7 @@ import numpy as np
 from . import _shear
 from ._files import atomic_target, check_kind
 from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, split
+from .driving import PairThermostat, WhiteNoise
 from .errors import GSDFileError
 from .interop import box_lengths_3d
 from .restitution import RestitutionLaw, describe, from_description
@@ -132,7 +133,7 @@ def _encode(value: Any) -> np.ndarray:
     its JSON description (``restitution.describe``, as checkpoints store it)."""
     if isinstance(value, str):
         return _text(value)
-    if isinstance(value, RestitutionLaw):
+    if isinstance(value, RestitutionLaw | WhiteNoise | PairThermostat):
         return _text(json.dumps(describe(value)))
     return np.atleast_1d(np.asarray(value, dtype=np.float64))
 
@@ -213,7 +214,8 @@ def _frame(hoomd, traj, k, lower, upper):
         params = traj.scene_parameters
         for p in RUN_PARAMETERS:
             for field, value in split(p, params[p.name]).items():
-                log[f"granular/{field}"] = _encode(value)
+                if value is not None:  # None (no driving) is the default a reader gives
+                    log[f"granular/{field}"] = _encode(value)
     frame.log = log
     return frame
 

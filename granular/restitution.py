@@ -420,10 +420,10 @@ _LAWS: dict[str, Callable[..., RestitutionLaw]] = {
 }
 
 
-def describe(restitution: float | RestitutionLaw) -> float | dict:
+def describe(restitution: Any) -> Any:
     """A number as it is; a law as ``{"law": class name, its arguments}``, whose floats JSON
     writes in their shortest round-tripping form (so ``from_description`` gives the law back
-    bit for bit)."""
+    bit for bit); a scene's driving as its own ``describe()``; None as None."""
     if isinstance(restitution, Viscoelastic):
         return {"law": "Viscoelastic", "damping": restitution.damping, "kappa": restitution.kappa}
     if isinstance(restitution, TabulatedRestitution):
@@ -436,13 +436,19 @@ def describe(restitution: float | RestitutionLaw) -> float | dict:
         return restitution.value
     if isinstance(restitution, RestitutionLaw):
         raise TypeError(f"no description for the restitution law {restitution!r}")
+    if hasattr(restitution, "describe"):  # a scene's driving (granular/driving.py)
+        return restitution.describe()
     return restitution
 
 
-def from_description(description: float | dict) -> float | RestitutionLaw:
+def from_description(description: Any) -> Any:
     """The inverse of ``describe``; raises ValueError for a description it does not know."""
     if not isinstance(description, dict):
         return description
+    if "driving" in description:  # a scene's driving (granular/driving.py)
+        from .driving import from_description as driving
+
+        return driving(description)
     args = dict(description)
     name = args.pop("law", None)
     if name not in _LAWS:

@@ -16,6 +16,7 @@ from ._scales import SCALE_HI, SCALE_LO, check_range
 from ._scene_params import BOUNDARIES, NAMES, PARAMETERS, SIGNATURE, engine_keywords, real
 from ._scene_params import box_corners as _box_corners
 from ._scene_params import docstring as _parameters_doc
+from .driving import PairThermostat, WhiteNoise
 from .placement import draw_velocities, lattice_order, place_lattice, place_rsa
 from .restitution import RestitutionLaw
 
@@ -144,6 +145,7 @@ class Scene:
     contact_duration: float
     shear_rate: float
     shear_offset: float
+    driving: WhiteNoise | PairThermostat | None
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         try:

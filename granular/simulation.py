@@ -202,9 +202,10 @@ class Simulation:
         it made elastic is not counted), law_clamped_collisions (past a viscoelastic law's
         range, see ``granular.Viscoelastic``), virial, wall_impulse, kinetic_energy,
         kinetic_time_integral, time, cells, shell (0: cells), shear_work (the work of a
-        sheared box's sliding images, csrc/boundary.h); temperature, 2 E_kin / (d N) now,
-        in a sheared box that of the velocities less the mean flow (granular/_shear.py);
-        and the pressure averaged over
+        sheared box's sliding images, csrc/boundary.h); kicks, drive_energy and drive_power
+        (a random driving's kicks, the kinetic energy they gave, and that per unit time since
+        the start); temperature, 2 E_kin / (d N) now, in a sheared box that of the velocities
+        less the mean flow (granular/_shear.py); and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
         with the time average <E_kin>_t (exact for a cooling gas too) and W the pair
         collisions' virial.  In a periodic box V is the box volume.  In a walled box the
@@ -247,6 +248,8 @@ class Simulation:
             )
         else:
             c["temperature"] = 2.0 * c["kinetic_energy"] / (s.dim * s.n)
+        # the random driving's energy input per unit time (0 before any time has passed)
+        c["drive_power"] = c["drive_energy"] / c["time"] if c["time"] > 0 else 0.0
         return c
 
     @property
@@ -478,9 +481,11 @@ class Simulation:
         can put it past anything float64 can time) has nothing to be warned of."""
         from .clustering import unstable_box
 
-        # (the homogeneous cooling state's instability: a sheared gas has no such state)
+        # (the homogeneous cooling state's instability: a sheared gas has no such state,
+        # nor has a driven one, docs/driven.md)
         sheared = self._initial.shear_rate != 0.0
-        found = None if sheared else unstable_box(self._initial)  # t* from the initial state
+        driven = self._initial.driving is not None
+        found = None if sheared or driven else unstable_box(self._initial)
         if found is None:
             self._clustering_checked = True
             return

@@ -127,6 +127,17 @@ REPRODUCE_MARGINS = {
     # dt: 2.2e-5 relative in <x^2> at dt = 0.05 for a = 5/6 (docs/powerlaw_udsbm.md), ours is
     # dt = 0.04 tau0' = 0.048; bound 1e-3
     "visco.udsbm.": 0.001,
+    # a2 in the first Sonine approximation (reproduce_driven): it neglects a3 and beyond,
+    # which Brilliantov & Poeschel (2006) find of the size of a2 itself towards xi = 0.5
+    # (the nonlinear root of the same truncation is only 1% away: no measure of that); the
+    # full reproduction (N = 1000, 20 runs) measured +4 +- 4% at xi = 0.5 in the cooling
+    # state and +7.5 +- 2% in the driven one.  Margin 15% of a2.  The driven temperature:
+    # Enskog's collision frequency neglects the velocity correlations a driven gas builds
+    # up: the full reproduction measured +0.37 +- 0.12% (xi = 0.8) and +1.17 +- 0.09%
+    # (xi = 0.5) above theory; margin 2%
+    "hcs.a2.": 0.15,
+    "driven.a2.": 0.15,
+    "driven.temperature.": 0.02,
 }
 # <v^2> is not a comparison: the theory row is the runs' own temperature, so they agree to
 # rounding (checked as such)
@@ -257,6 +268,8 @@ def test_reproduce_quick(tmp_path):
         + ["cluster.lc.xi0.5", "cluster.lc.xi0.3", "cluster.haff.small.xi0.3", *NOT_COMPARED]
         + ["visco.haff.exponent", "visco.msd.exponent", "visco.udsbm.msd.exponent", *COUNTS]
         + list(TRANSPORT)
+        + [f"hcs.a2.xi{x}" for x in ("0.9", "0.8", "0.5")]
+        + [f"driven.{q}.xi{x}" for q in ("temperature", "a2") for x in ("0.8", "0.5")]
     )
     assert set(required) <= set(rows)
     for r in rows.values():
@@ -292,6 +305,7 @@ def test_reproduce_quick(tmp_path):
     assert len(pngs) >= 27 and "fig4_23_ergodicity_udsbm_tstop.png" in pngs
     assert {"cluster_haff_and_flow.png", "cluster_tau0_vs_box.png"} <= pngs
     assert {"visco_cooling_msd.png", "visco_collapse.png"} <= pngs
+    assert "driven_a2.png" in pngs
     onset = rows["cluster.onset.xi0.3"]
     assert onset["runs"] >= 10 and 0 < onset["ours"] < 40  # within the run's ~37 collisions
     assert (
@@ -535,15 +549,7 @@ def test_figure_text_problems_are_found():
 
 
 # the experiments that take more than 3 s at quick sizes
-SLOW_FIGURES = (
-    "4.8+4.10",
-    "4.11-4.16+F",
-    "4.17-4.23",
-    "clustering",
-    "viscoelastic",
-    "transport",
-    "langevin-forces",
-)
+SLOW_FIGURES = ("4.8+4.10", "4.11-4.16+F", "4.17-4.23", "clustering", "viscoelastic", "driven")
 
 
 @pytest.mark.parametrize(

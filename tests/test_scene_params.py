@@ -20,7 +20,8 @@ _RADII = np.array([0.03, 0.05] * 6)
 
 def _examples():
     """A value for every declared parameter, none its default: a walled 2D box off the
-    origin, unequal radii and masses, laws for the restitutions, the TC model on."""
+    origin, unequal radii and masses, laws for the restitutions, the TC model on, a random
+    driving force."""
     base = Scene.random(12, _RADII, dim=2, box=_INNER, boundary="walls", seed=4)
     return {
         "positions": base.positions,
@@ -32,6 +33,7 @@ def _examples():
         "wall_restitution": Viscoelastic.from_restitution(0.9, 1.0),
         "restitution": TabulatedRestitution([0.0, 1.0, 3.0], [1.0, 0.9, 0.7]),
         "contact_duration": 1e-3,
+        "driving": granular.WhiteNoise(0.5, 20.0, seed=3),
     }
 
 

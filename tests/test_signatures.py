@@ -176,6 +176,9 @@ VALID = {
     "stiffness": 4.0,
     "gravity": 2.0,
     "height": 0.5,
+    "strength": 0.5,
+    "approximation": "linear",
+    "kick": 0.05,
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],

@@ -153,3 +153,21 @@ def test_gsd_carries_the_tensor_and_hoomds_pressure_tensor(dim, tmp_path):
             assert np.array_equal(got, [p[0, 0], p[0, 1], p[0, 2], p[1, 1], p[1, 2], p[2, 2]])
     Simulation(s).run(1.0, sample_times=[0.0, 1.0]).write(tmp_path / "b.gsd")
     assert granular.read(tmp_path / "b.gsd").stress_collisional is None
+
+
+def test_a_driven_gas_keeps_its_kinetic_tensor_through_the_kicks():
+    """A random kick is an outside force: it changes the kinetic tensor (sum m v_a v_b, kept
+    by differences) and nothing collisional.  After many kicks the kept tensor is still the
+    velocities' own, and trace / d still the scalar pressure, to rounding."""
+    from granular import WhiteNoise
+
+    s = Scene.random(100, 0.03, dim=3, restitution=0.8, temperature=1.0, seed=2)
+    s = s.replace(driving=WhiteNoise(0.5, 20.0, 7))
+    sim = Simulation(s, stress=True)
+    tr = sim.run(2.0, sample_times=np.linspace(0.0, 2.0, 5))
+    assert sim.stats["kicks"] > 1000
+    k = np.einsum("i,tia,tib->tab", s.masses, tr.velocities, tr.velocities)
+    np.testing.assert_allclose(tr.kinetic_tensor, k, rtol=1e-12, atol=1e-12 * np.abs(k).max())
+    st = sim.stats
+    trace = np.trace(np.array(st["pressure_tensor"])) / 3
+    assert trace == pytest.approx(st["pressure"], rel=1e-12)

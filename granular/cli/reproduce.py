@@ -6,10 +6,11 @@ Public entry points
     The experiments in the thesis' order, by name: ``"4.1"``, ``"4.2-4.4"``, ``"4.5-4.7"``,
     ``"4.8+4.10"``, ``"4.9"``, ``"4.11-4.16+F"``, ``"4.17-4.23"``, then ``"clustering"``
     (where the homogeneous cooling of Fig. 4.10 ends; ``reproduce_clustering``) and
-    ``"viscoelastic"`` (the viscoelastic gas and its power-law UDSBM; ``reproduce_visco``),
-    ``"transport"`` (elastic viscosity and self-diffusion; ``reproduce_transport``),
-    ``"langevin-forces"`` (the Langevin model in a harmonic trap;
-    ``reproduce_langevin_forces``).
+    ``"viscoelastic"`` (the viscoelastic gas and its power-law UDSBM; ``reproduce_visco``);
+    then the experiments beyond the thesis, each in its own module ``reproduce_<name>``:
+    ``"transport"`` (elastic viscosity and self-diffusion), ``"langevin-forces"`` (the
+    Langevin model in a harmonic trap), ``"driven"`` (a2 of the cooling and the white-noise
+    driven state, the driven temperature).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -686,6 +687,13 @@ def _fig_langevin_forces(cfg, out):
     return reproduce_langevin_forces._fig_langevin_forces(cfg, out, **_tools())
 
 
+def _fig_driven(cfg, out):
+    """Velocity distributions of cooling and driven gases: see ``reproduce_driven``."""
+    from . import reproduce_driven
+
+    return reproduce_driven._fig_driven(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -698,6 +706,7 @@ FIGURES = {
     "viscoelastic": _fig_visco,
     "transport": _fig_transport,
     "langevin-forces": _fig_langevin_forces,
+    "driven": _fig_driven,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -717,6 +726,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
     "transport": ("elastic hard spheres: Green-Kubo viscosity and self-diffusion", 30.0, 8.0),
     "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),
+    "driven": ("a2 of cooling and white-noise driven gases, driven temperature", 101.6, 18.7),
 }
 
 

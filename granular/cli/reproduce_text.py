@@ -219,6 +219,18 @@ def _visco_notes(cfg, by_id):
     return reproduce_visco.notes(by_id)
 
 
+def _hcs_notes(cfg, by_id):
+    from . import reproduce_driven
+
+    return reproduce_driven.hcs_notes(by_id)
+
+
+def _driven_notes(cfg, by_id):
+    from . import reproduce_driven
+
+    return reproduce_driven.driven_notes(by_id)
+
+
 # The sections of the report: (title, row id prefix, notes(cfg, by_id) -> sentences)
 SECTIONS = (
     ("Energy (Fig. 4.2)", "energy.", _energy_notes),
@@ -229,6 +241,8 @@ SECTIONS = (
     ("Ergodicity (Figs 4.21-4.23)", "ergodicity.", _ergodicity_notes),
     ("Where homogeneous cooling ends (clustering)", "cluster.", _clustering_notes),
     ("Viscoelastic gases", "visco.", _visco_notes),
+    ("The cooling state's velocity distribution (a2)", "hcs.", _hcs_notes),
+    ("Gases driven by white noise", "driven.", _driven_notes),
 )
 
 

@@ -68,6 +68,11 @@ from .msd import (
     msd_langevin,
     msd_logarithmic,
 )
+from .sonine import (
+    driven_temperature,
+    sonine_a2_cooling,
+    sonine_a2_driven,
+)
 from .tracer import (
     tracer_contact_value,
     tracer_friction,
@@ -129,6 +134,7 @@ __all__ = [
     "critical_box_size",
     "diffusion_d0",
     "diffusion_infinite_system",
+    "driven_temperature",
     "enskog_diffusion",
     "enskog_viscosity",
     "gravity_mean_displacement",
@@ -156,6 +162,8 @@ __all__ = [
     "shear_mode_growth",
     "shear_mode_level",
     "shear_viscosity",
+    "sonine_a2_cooling",
+    "sonine_a2_driven",
     "tracer_contact_value",
     "tracer_friction",
     "tracer_langevin_coefficients",

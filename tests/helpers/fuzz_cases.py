@@ -96,11 +96,26 @@ def _scene_params(rng):
         wall_restitution=float(rng.choice([1.0, 1.0, 0.9])),
         restitution=float(rng.choice([1.0, 1.0, 0.9, 0.5])),
         contact_duration=float(rng.choice([0.0, 0.0, 1e-3])),
+        driving=_driving(rng, n),
     )
     if boundary == "periodic" and rng.random() < 0.3:  # Lees-Edwards shear (offset 0: the
         # grid start may overlap through displaced images; the mutations try offsets)
         p["shear_rate"] = float(rng.choice([0.5, -2.0, 5.0]))
     return p
+
+
+def _driving(rng, n):
+    """A random driving force now and then (pairs: n >= 2), kicking a few times per unit
+    time so that a short run sees kicks and collisions alike."""
+    from granular import PairThermostat, WhiteNoise
+
+    u = rng.random()
+    if n < 2 or u < 0.7:
+        return None
+    seed = int(rng.integers(0, 2**53))
+    if u < 0.85:
+        return WhiteNoise(float(rng.uniform(0.1, 2.0)), float(rng.uniform(1.0, 50.0)), seed)
+    return PairThermostat(float(rng.uniform(0.1, 2.0)), float(rng.uniform(1.0, 50.0)), seed)
 
 
 def _random_params(rng, max_n=50):
@@ -273,6 +288,24 @@ def _mass_spread(rng, p):
     return "masses alternating 1e-300 and 1e300"
 
 
+def _bad_driving():
+    """Drivings the classes accept and the engine or the run must refuse or survive: huge
+    kicks, a total rate too small to time (rate N / 2 below 1e-140), heating that blows the
+    gas up, kicks far more frequent than the event budget."""
+    from granular import PairThermostat, WhiteNoise
+
+    return [
+        WhiteNoise(1e130, 1e130),
+        WhiteNoise(1e120, 1e-10),
+        PairThermostat(1e-130, 1e-130),
+        PairThermostat(1e130, 1.0),
+        WhiteNoise(1.0, 1e8),
+        WhiteNoise(1.0, 1e-139, seed=2**53 - 1),
+    ]
+
+
+_BAD_DRIVING = _bad_driving()
+
 SCENE_MUTATIONS = [
     _entry("positions", [NAN, INF, -INF]),
     _shape("positions"),
@@ -302,6 +335,7 @@ SCENE_MUTATIONS = [
     _set("contact_duration", [*EXTREME, "x", None]),
     _set("shear_rate", [*EXTREME, 1e200, 1e-200, "x", None, 1j]),
     _set("shear_offset", [*EXTREME, 0.99, 1e200, "x", None]),
+    _set("driving", ["x", 0.5, {"strength": 1.0}, *_BAD_DRIVING]),
     _overlap("same place"),
     _overlap("overlap 1e-9"),
     _overlap("touching"),
@@ -656,6 +690,7 @@ _META_PATHS = [
     ("scene", "restitution"),
     ("scene", "wall_restitution"),
     ("scene", "contact_duration"),
+    ("scene", "driving"),
     ("engine_state_sha256",),
 ]
 _META_VALUES = [
@@ -674,6 +709,9 @@ _META_VALUES = [
     {"law": "TabulatedRestitution", "speeds": [1.0, 0.0], "values": [2.0]},
     {"law": "Viscoelastic", "damping": -1.0, "kappa": 1.0},
     {"law": "os.system", "command": "true"},
+    {"driving": "WhiteNoise", "strength": -1.0, "rate": 1.0, "seed": 0},
+    {"driving": "PairThermostat", "temperature": 1.0, "rate": 1.0, "seed": 1.5},
+    {"driving": "os.system", "command": "true"},
 ]
 _RECORD_VALUES = [NAN, INF, -INF, 1e140, -1e140, 1e300, 2.0, -1.0, 0.5, 0.0, 5e-324]
 _IMAGE_VALUES = [-(2**63), 2**63 - 1, 2**62, -1, 1, 10**12]
@@ -898,14 +936,17 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
                 boundary=scene.boundary,
             )
     _ = sim.scene  # the final state, checked the same way (the property builds a Scene)
-    elastic = scene.restitution == 1 and (
-        scene.boundary == "periodic" or scene.wall_restitution == 1
+    elastic = scene.driving is None and (
+        scene.restitution == 1 and (scene.boundary == "periodic" or scene.wall_restitution == 1)
     )
     e = np.asarray(traj.kinetic_energy, dtype=float)
     if elastic and len(e):
         drift = np.max(np.abs(e - e[0])) / e[0] if e[0] > 0 else np.max(np.abs(e))
         _check(drift <= ENERGY_RTOL, f"elastic run: kinetic energy drifted by {drift:.3g}")
-    if len(e) and (scene.boundary == "periodic" or not heats(scene.wall_restitution)):
+    heated = scene.driving is not None or (
+        scene.boundary == "walls" and heats(scene.wall_restitution)
+    )
+    if len(e) and not heated:
         rise = (np.max(e) - e[0]) / e[0] if e[0] > 0 else np.max(e)
         _check(rise <= ENERGY_RTOL, f"no heated walls, yet the kinetic energy rose by {rise:.3g}")
 
@@ -930,8 +971,9 @@ def _check_sheared(scene, traj, sim):
     st = sim.stats
     if scene.restitution == 1 and len(traj.kinetic_energy):
         e0 = scene.kinetic_energy
-        gap = abs(st["kinetic_energy"] - e0 - st["shear_work"])
-        scale = max(e0, st["kinetic_energy"], abs(st["shear_work"]))
+        work = st["shear_work"] + st["drive_energy"]  # a driving's kicks add theirs
+        gap = abs(st["kinetic_energy"] - e0 - work)
+        scale = max(e0, st["kinetic_energy"], abs(st["shear_work"]), abs(st["drive_energy"]))
         _check(gap <= ENERGY_RTOL * scale, f"sheared elastic run: energy - work off by {gap:.3g}")
 
 

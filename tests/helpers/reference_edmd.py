@@ -5,9 +5,13 @@ collision rule (2.10-2.11) or wall rule (2.22).  O(N^2) per event: tests only.
 
 A restitution may be a number or a law (anything callable on a normal impact speed, as
 granular.restitution's laws are, evaluated with NumPy): eps(|dv . n|) for a pair, e_w(|v_a|)
-for a wall."""
+for a wall.
+
+A scene's random driving (granular.driving) is its kicks as events, from the engine's
+random numbers (csrc/drive.h): the same pairs, times and velocity changes."""
 
 import itertools
+import math
 
 import numpy as np
 
@@ -68,6 +72,7 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
         sample_times,
         wall_e=scene.wall_restitution,
         tensors=tensors,
+        driving=scene.driving,
     )
 
 
@@ -75,11 +80,49 @@ def _eps(restitution, speed):
     return float(restitution(speed)) if callable(restitution) else restitution
 
 
-def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0, tensors=None):
+def kick_wait(driving, n, k):
+    """The waiting time before kick k (csrc/drive.c gr_drive_wait)."""
+    from helpers.sde_reference import Stream
+
+    return -math.log(Stream(driving.seed, k, 1).uniform()) / (0.5 * driving.rate * n)
+
+
+def kick(driving, v, m, k):
+    """Kick k on velocities v (changed in place), as csrc/drive.c does it: the pair, then
+    the momenta +-dp (white noise) or the pair's relative velocity drawn anew (thermostat)."""
+    from helpers.sde_reference import Stream
+
+    n, d = v.shape
+    st = Stream(driving.seed, k, 0)
+    i = int(st.uniform() * n)
+    j = int(st.uniform() * (n - 1))
+    j += j >= i
+    mi, mj = float(m[i]), float(m[j])
+    big, mu = mi + mj, mi * mj / (mi + mj)
+    if hasattr(driving, "strength"):
+        amp = 2.0 * mu * math.sqrt(driving.strength / driving.rate)
+        for a in range(d):
+            dp = amp * st.normal()
+            v[i, a] += dp / mi
+            v[j, a] -= dp / mj
+    else:
+        sd = math.sqrt(driving.temperature / mu)
+        for a in range(d):
+            c = (mi * v[i, a] + mj * v[j, a]) / big
+            g = sd * st.normal()
+            v[i, a] = c + (mj / big) * g
+            v[j, a] = c - (mi / big) * g
+    return i, j
+
+
+def run(
+    x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0, tensors=None, driving=None
+):
     """Positions (unwrapped) and velocities at sample_times.  A dict ``tensors`` gets the
     stress tensor's parts at the sample times: "collisional" (sum over pair collisions of
     dr_a dp_b, dr = x_j - x_i, dp j's momentum change) and "kinetic_time" (the integral of
-    sum m v_a v_b over time, summed step by step)."""
+    sum m v_a v_b over time, summed step by step).  ``driving`` (a granular.WhiteNoise or
+    PairThermostat): its kicks, drawn as csrc/drive.c draws them."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
     L = hi - lo
     image = np.zeros_like(x)
@@ -89,6 +132,9 @@ def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0, tens
     d = x.shape[1]
     coll, kin_time = np.zeros((d, d)), np.zeros((d, d))
     coll_out, kin_out = [], []
+    kicks, t_kick = 0, math.inf
+    if driving is not None:
+        t_kick = kick_wait(driving, len(x), 0)
     while True:
         kin = np.einsum("i,ia,ib->ab", m, v, v)
         pt = pair_times(x, v, r, L, periodic)
@@ -102,7 +148,8 @@ def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0, tens
             w = np.minimum(up, down)
             k = np.unravel_index(np.argmin(w), w.shape)
             t_wall, wall = max(w[k], 0.0), k
-        dt = min(t_pair, t_wall)
+        is_kick = t_kick - t < min(t_pair, t_wall)
+        dt = min(t_pair, t_wall, t_kick - t)
         while samples and samples[0] <= min(t + dt, t_stop):
             ts = samples.pop(0)
             out_x.append(x + v * (ts - t) + image * L)
@@ -112,13 +159,17 @@ def run(x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0, tens
         if t + dt > t_stop:
             break
         x += v * dt
-        t += dt
         kin_time = kin_time + kin * dt
+        t = t_kick if is_kick else t + dt  # (kick times as the engine sums them)
         if periodic:
             wrap = np.floor((x - lo) / L)
             x -= wrap * L
             image += wrap
-        if t_pair <= t_wall:
+        if is_kick:
+            kick(driving, v, m, kicks)
+            kicks += 1
+            t_kick = t + kick_wait(driving, len(x), kicks)
+        elif t_pair <= t_wall:
             dr = x[j] - x[i]
             if periodic:
                 dr -= L * np.round(dr / L)
