@@ -54,6 +54,14 @@ typedef struct {
     gr_law law, wall_law;     /* kind GR_LAW_CONSTANT (zeroed): restitution and
                                * wall_restitution above; else eps(v_n) replaces them
                                * (restitution.h).  gr_edmd_new copies the tables. */
+    double tangential_restitution; /* rough particles (rule.h): beta in [-1, 1], -1 smooth;
+                                    * beta_0 of the Coulomb rule */
+    double inertia_factor;    /* rough particles: I = q m r^2, q in (0, 1] */
+    double friction;          /* rough particles: Coulomb's mu >= 0 (Walton's rule); +inf:
+                               * constant beta */
+    const double *spin;       /* NULL: smooth particles.  Else their angular velocities
+                               * (n in 2D, n x 3 in 3D), and the rough rule; gr_edmd_new
+                               * copies them */
 } gr_edmd_config;
 
 typedef struct {
@@ -80,6 +88,8 @@ typedef struct {
     int64_t *wall;        /* count: cumulative wall collisions */
     double *virial;       /* count: cumulative pair virial sum over collisions of r_ij . dp_j */
     double *wall_impulse; /* count: cumulative normal momentum given to the walls */
+    double *spin;         /* count x n x (1 in 2D, 3 in 3D): angular velocities, or NULL
+                           * (always NULL for smooth particles) */
 } gr_edmd_samples;
 
 typedef struct {
@@ -136,5 +146,9 @@ const char *gr_scan_kernel(void);
  * Does not change the system. */
 void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image);
 void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c);
+/* Rough particles: whether s carries spins, and their angular velocities now (n in 2D,
+ * n x 3 in 3D, in the caller's order; they do not change in flight). */
+int gr_edmd_has_spin(const gr_edmd *s);
+void gr_edmd_spin(const gr_edmd *s, double *spin);
 
 #endif

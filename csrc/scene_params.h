@@ -16,6 +16,9 @@
 #define GR_SCENE_DOUBLES(X) \
     X(wall_restitution)     \
     X(restitution)          \
-    X(contact_duration)
+    X(contact_duration)     \
+    X(tangential_restitution) \
+    X(inertia_factor)       \
+    X(friction)
 
 #endif

@@ -108,6 +108,21 @@ def frozen_energy(radii, masses):
     return 0.5 * len(radii) * float(np.max(masses)) * speed * speed
 
 
+def rotational_dim(dim: int) -> int:
+    """The rotational degrees of freedom of a particle: 1 in 2D, 3 in 3D."""
+    return 1 if dim == 2 else 3
+
+
+def rotational_energy(spins: Any, inertia: Any, dim: int) -> Any:
+    """Rotational kinetic energy sum I w^2 / 2 of spins (..., N) in 2D or (..., N, 3) in
+    3D with moments of inertia ``inertia`` (N,): a float, or an array over the leading
+    axes."""
+    w = np.asarray(spins, dtype=np.float64)
+    w2 = w * w if dim == 2 else np.sum(w * w, axis=-1)
+    e = 0.5 * np.sum(np.asarray(inertia, dtype=np.float64) * w2, axis=-1)
+    return float(e) if np.ndim(e) == 0 else e
+
+
 def _set(scene: Scene, name: str, value: Any) -> None:
     """Set a field while the Scene is made (``Scene.__setattr__`` refuses it after)."""
     object.__setattr__(scene, name, value)
@@ -142,6 +157,10 @@ class Scene:
     wall_restitution: float | RestitutionLaw
     restitution: float | RestitutionLaw
     contact_duration: float
+    angular_velocities: NDArray[np.float64]
+    tangential_restitution: float
+    inertia_factor: float
+    friction: float
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         try:
@@ -235,6 +254,22 @@ class Scene:
     def temperature(self) -> float:
         """Granular temperature T = 2 <E_kin> / d per particle (k_B = 1)."""
         return 2.0 * self.kinetic_energy / (self.dim * self.n)
+
+    @property
+    def moments_of_inertia(self) -> NDArray[np.float64]:
+        """Each particle's moment of inertia I = q m r^2 (q: ``inertia_factor``), shape (N,)."""
+        return self.inertia_factor * self.masses * self.radii**2
+
+    @property
+    def rotational_energy(self) -> float:
+        """Total rotational kinetic energy, sum of I w^2 / 2."""
+        return rotational_energy(self.angular_velocities, self.moments_of_inertia, self.dim)
+
+    @property
+    def rotational_temperature(self) -> float:
+        """Rotational temperature T_rot = <I w^2> / d_rot per particle, d_rot = 1 in 2D
+        (the spin along z), 3 in 3D (Huthmann & Zippelius 1997; k_B = 1)."""
+        return 2.0 * self.rotational_energy / (rotational_dim(self.dim) * self.n)
 
     def replace(self, **changes: Any) -> Scene:
         """A copy with some fields changed, e.g. ``scene.replace(restitution=0.8)``; the
