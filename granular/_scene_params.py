@@ -230,8 +230,7 @@ def _angular_velocities(value: Any, n: int, d: int) -> np.ndarray:
     a = np.array(real(value, "angular_velocities"), dtype=np.float64, order="C", copy=True)
     if a.shape != shape:
         raise ValueError(
-            f"angular_velocities must have shape {shape} ((N,) in 2D, (N, 3) in 3D), got "
-            f"{a.shape}"
+            f"angular_velocities must have shape {shape} ((N,) in 2D, (N, 3) in 3D), got {a.shape}"
         )
     if not np.all(np.isfinite(a)):
         raise ValueError("angular_velocities contains NaN or infinity")

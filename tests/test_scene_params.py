@@ -32,6 +32,10 @@ def _examples():
         "wall_restitution": Viscoelastic.from_restitution(0.9, 1.0),
         "restitution": TabulatedRestitution([0.0, 1.0, 3.0], [1.0, 0.9, 0.7]),
         "contact_duration": 1e-3,
+        "angular_velocities": np.linspace(-1.0, 1.0, 12),
+        "tangential_restitution": 0.5,
+        "inertia_factor": 0.3,
+        "friction": 0.2,
     }
 
 
@@ -113,7 +117,7 @@ def test_every_parameter_survives_a_checkpoint(tmp_path):
     loaded = Simulation.load(tmp_path / "c.npz")
     for p in PARAMETERS:
         assert _same(p.get(loaded._initial), p.get(scene)), p.name
-        if p.name not in ("positions", "velocities"):
+        if p.name not in _scene_params.SAMPLED:
             assert _same(p.get(loaded.scene), p.get(scene)), p.name
     a = sim.run(stop_when={"collisions_per_particle": 4}, store=("positions",))
     b = loaded.run(stop_when={"collisions_per_particle": 4}, store=("positions",))
