@@ -117,8 +117,8 @@ static inline void rule_wall_apply(int dim, double *v, int a, double ew)
 
 /* ---- the rough rule: tangential restitution and spins ----
  *
- * Rough disks and spheres (Huthmann & Zippelius 1997, PRE 56, R6275, eqs. 1-4; Luding,
- * Huthmann, McNamara & Zippelius 1998, PRE 58, 3416, eqs. 1-6), written for unequal
+ * Rough disks and spheres (Huthmann & Zippelius 1997, PRE 56, R6275; Luding, Huthmann,
+ * McNamara & Zippelius 1998, PRE 58, 3416, sect. II), written here for unequal
  * radii a_i, a_j and masses, moments of inertia I = q m a^2.  With n = dr / |dr| (from i
  * to j), the relative velocity of j's surface against i's at the contact point is
  *     g = v_j - v_i - (a_i w_i + a_j w_j) x n,
@@ -139,7 +139,7 @@ static inline void rule_wall_apply(int dim, double *v, int a, double ew)
  * slides at |P_t| = mu |P_n| beyond, which is the tangential restitution
  *     beta = -1 + mu (1 + xi) (m_eff / m_t) |g . n| / |g_t|
  *          = -1 + mu (1 + xi) (1 + 1/q) cot(gamma)
- * (gamma the angle between g and -n; Luding et al. 1998 eq. 6 for equal particles): beta
+ * (gamma the angle between g and -n, as Luding et al. 1998 write it for equal particles): beta
  * is the smaller of the two.  friction = mu = +inf is the constant-beta rule.
  *
  * In 2D a spin is the scalar w along z: w x n = w (-n_y, n_x), n x P = n_x P_y - n_y P_x. */

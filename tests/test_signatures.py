@@ -18,7 +18,7 @@ from granular.errors import shown
 pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 
 # what may come before the keyword-only parameters
-THEORY_INDEPENDENT = {"t", "lag", "speed", "eta", "box", "temperature"}
+THEORY_INDEPENDENT = {"t", "lag", "speed", "eta", "box", "temperature", "collisions"}
 PLOT_X = {"times", "velocities", "positions", "traj"}
 
 # names the package used, or a user might reach for, for a quantity that has another name
@@ -171,6 +171,10 @@ VALID = {
     "v0_sq": 0.5,
     "order": 1,
     "points": 50,
+    "collisions": 3.0,
+    "tangential_restitution": 0.5,
+    "inertia_factor": 0.4,
+    "rotational_temperature0": 0.1,
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],
@@ -179,6 +183,8 @@ BAD = {
     "restitution": [1.5, -0.1, math.nan],
     "packing": [1.0, -0.1],
     "dim": [1, 4],
+    "beta": [1.5, -1.5, math.nan],
+    "inertia": [0.0, 1.5, math.nan],
 }
 
 

@@ -68,6 +68,13 @@ from .msd import (
     msd_langevin,
     msd_logarithmic,
 )
+from .rough import (
+    RoughCoefficients,
+    rough_coefficients,
+    rough_cooling,
+    rough_temperature_ratio,
+    rough_temperatures,
+)
 from .tracer import (
     tracer_contact_value,
     tracer_friction,
@@ -105,6 +112,7 @@ __all__ = [
     "AKappa",
     "FloatOrArray",
     "LangevinCoefficients",
+    "RoughCoefficients",
     "collision_frequency",
     "collision_time",
     "compressibility_factor",
@@ -131,6 +139,10 @@ __all__ = [
     "packing_fraction",
     "powerlaw_udsbm_increment_msd",
     "powerlaw_udsbm_moments",
+    "rough_coefficients",
+    "rough_cooling",
+    "rough_temperature_ratio",
+    "rough_temperatures",
     "shear_mode_growth",
     "shear_mode_level",
     "shear_viscosity",
