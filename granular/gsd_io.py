@@ -42,6 +42,17 @@ The exact float64 (and int64) values granular reads back live in the log section
   its default.  Layout 1 from the start: the parameters after ``boundary`` were added
   beside the fields earlier readers read, and they read these files still.
 
+Rough particles (a trajectory that stored ``angular_velocities``): ``particles/angmom`` and
+``particles/moment_inertia`` in HOOMD's convention, without orientations (every
+``particles/orientation`` stays the identity quaternion (1, 0, 0, 0), so the body frame is
+the box's): HOOMD stores angular momentum as the quaternion P = 2 q x (0, S) conjugate to
+the orientation q (Kamberaj 2005; HOOMD's "Anisotropic particles" page), S the angular
+momentum in the body frame, so here P = (0, 2 I w).  ``moment_inertia`` holds the principal
+moments (I, I, I) of a sphere and (0, 0, I) of a disk, which rotates about z only (HOOMD
+integrates no axis of moment 0); I = q m r^2.  The exact spins are in the log,
+``log/granular/angular_velocities`` (float64, (N,) in 2D, (N, 3) in 3D), with
+``log/granular/rotational_energy`` every frame.
+
 (gsd >= 4 can write the HOOMD fields in float64, but OVITO and older gsd and HOOMD read
 float32 ones: the standard fields stay float32 and the exact values go in the log.)
 
@@ -60,7 +71,7 @@ from typing import Any
 import numpy as np
 
 from ._files import atomic_target, check_kind
-from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, split
+from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, spin_shape, split
 from .errors import GSDFileError
 from .interop import box_lengths_3d
 from .restitution import RestitutionLaw, describe, from_description
@@ -77,7 +88,16 @@ _COUNTERS = (
 _INT_COUNTERS = ("pair_collisions", "wall_collisions")
 # the log's own names beside the scene parameters' (which may not take one of them:
 # tests/test_scene_params.py checks)
-LOG_NAMES = ("format", "stop_reason", "time", "unwrapped_positions", "velocities", *_COUNTERS)
+LOG_NAMES = (
+    "format",
+    "stop_reason",
+    "time",
+    "unwrapped_positions",
+    "velocities",
+    "angular_velocities",
+    "rotational_energy",
+    *_COUNTERS,
+)
 
 
 def _gsd():
@@ -178,6 +198,10 @@ def _frame(hoomd, traj, k, lower, upper):
     if traj.velocities is not None:
         frame.particles.velocity = _pad3(traj.velocities[k])
         log["granular/velocities"] = np.ascontiguousarray(traj.velocities[k], dtype=np.float64)
+    if traj.angular_velocities is not None:
+        _spin_fields(frame, log, traj, k)
+    if traj.rotational_energy is not None:
+        log["granular/rotational_energy"] = np.array([traj.rotational_energy[k]], np.float64)
     for name in _COUNTERS:
         dtype = np.int64 if name in _INT_COUNTERS else np.float64
         log[f"granular/{name}"] = np.atleast_1d(np.asarray(getattr(traj, name)[k], dtype))
@@ -190,6 +214,27 @@ def _frame(hoomd, traj, k, lower, upper):
                 log[f"granular/{field}"] = _encode(value)
     frame.log = log
     return frame
+
+
+def _spin_fields(frame, log, traj, k):
+    """Rough particles' spins of sample ``k``: HOOMD's angmom and moment_inertia (module
+    docstring), the exact values in the log."""
+    w = np.asarray(traj.angular_velocities[k], dtype=np.float64)
+    q = float(traj.scene_parameters["inertia_factor"])
+    inertia = q * np.asarray(traj.masses) * np.asarray(traj.radii) ** 2
+    w3 = np.zeros((traj.n, 3))
+    if traj.dim == 2:
+        w3[:, 2] = w
+        moments = np.zeros((traj.n, 3))
+        moments[:, 2] = inertia
+    else:
+        w3[:] = w
+        moments = np.repeat(inertia[:, None], 3, axis=1)
+    angmom = np.zeros((traj.n, 4))
+    angmom[:, 1:] = 2.0 * inertia[:, None] * w3  # P = 2 q x (0, I w), q = 1
+    frame.particles.angmom = angmom.astype(np.float32)
+    frame.particles.moment_inertia = moments.astype(np.float32)
+    log["granular/angular_velocities"] = np.ascontiguousarray(w)
 
 
 def write(traj: Any, path: str | os.PathLike) -> None:
@@ -375,13 +420,21 @@ def _wrap_checked(f: _File, k: int, x: np.ndarray, p: dict[str, Any]) -> np.ndar
 
 
 def _scene(
-    f: _File, k: int, x: np.ndarray, v: np.ndarray, p: dict[str, Any], make_scene: Any
+    f: _File,
+    k: int,
+    x: np.ndarray,
+    v: np.ndarray,
+    p: dict[str, Any],
+    make_scene: Any,
+    w: np.ndarray | None = None,
 ) -> Any:
     """Frame ``k``'s state as a Scene (``make_scene``: the Scene class) with the run's
-    parameters ``p``, which checks it as every scene is checked (finite, the scales, inside
-    the box, no overlaps)."""
+    parameters ``p`` (and spins ``w``, if the file has them), which checks it as every scene
+    is checked (finite, the scales, inside the box, no overlaps)."""
     x = _wrap_checked(f, k, x, p)
     try:
+        if w is not None:
+            return make_scene(x, v, angular_velocities=w, **p)
         return make_scene(x, v, **p)
     except (ValueError, TypeError) as exc:
         raise GSDFileError(f"{f.where}, frame {k}: not a valid state: {exc}") from exc
@@ -398,6 +451,10 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
         p, stop_reason = _params(f)
         n, d = len(p["radii"]), len(p["box"][0])
         has_v = f.has(0, _log("velocities"))
+        has_w = f.has(0, _log("angular_velocities"))  # rough particles' spins
+        has_rot = f.has(0, _log("rotational_energy"))
+        spins: list[np.ndarray] = []
+        rotational: list[float] = []
         still = np.zeros((n, d))
         times: list[float] = []
         positions: list[np.ndarray] = []
@@ -421,7 +478,15 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
                 velocities.append(v)
             elif f.has(k, _log("velocities")):
                 raise f.error(k, _log("velocities"), "is there but frame 0 has none")
-            _scene(f, k, x, v, p, make_scene)
+            w = f.array(k, _log("angular_velocities"), spin_shape(n, d)) if has_w else None
+            if w is not None:
+                spins.append(w)
+            if has_rot:
+                e = f.array(k, _log("rotational_energy"), (1,))[0]
+                if not (np.isfinite(e) and e >= 0):
+                    raise f.error(k, _log("rotational_energy"), f"is {e}, not finite and >= 0")
+                rotational.append(float(e))
+            _scene(f, k, x, v, p, make_scene, w)
             positions.append(x)
             for name in _COUNTERS:
                 value = _counter(f, k, name, d, counters[name])
@@ -444,6 +509,10 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
         },
         stop_reason=stop_reason,
         parameters=p,
+        angular_velocities=np.array(spins).reshape(len(times), *spin_shape(n, d))
+        if has_w
+        else None,
+        rotational_energy=np.array(rotational) if has_rot else None,
     )
 
 
@@ -497,7 +566,10 @@ def scene_from_gsd(path: str | os.PathLike, frame: int, make_scene: Any, **param
             v = np.zeros((n, d))
             if f.has(k, _log("velocities")):
                 v = f.array(k, _log("velocities"), (n, d))
-            own = _scene(f, k, x, v, p, make_scene)
+            w = None
+            if f.has(k, _log("angular_velocities")):
+                w = f.array(k, _log("angular_velocities"), spin_shape(n, d))
+            own = _scene(f, k, x, v, p, make_scene, w)
         else:
             own = _foreign_scene(f, k, make_scene)
     return own.replace(**params)

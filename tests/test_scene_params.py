@@ -130,11 +130,16 @@ def _gsd_round_trip(tmp_path, writer=None):
     frame) or ``granular.read`` gives back differs from the run's, and those read keeps."""
     scene = Scene(**_examples())
     sim = Simulation(scene)
-    traj = sim.run(t_stop=0.05, sample_times=[0.0, 0.05], store=("positions", "velocities"))
+    store = ("positions", "velocities", "angular_velocities")
+    traj = sim.run(t_stop=0.05, sample_times=[0.0, 0.05], store=store)
     (writer or type(traj).write)(traj, tmp_path / "run.gsd")
     back = Scene.from_gsd(tmp_path / "run.gsd")
     read = granular.read(tmp_path / "run.gsd").scene_parameters
-    now = scene.replace(positions=traj.positions[-1], velocities=traj.velocities[-1])
+    now = scene.replace(
+        positions=traj.positions[-1],
+        velocities=traj.velocities[-1],
+        angular_velocities=traj.angular_velocities[-1],
+    )
     differ = [p.name for p in PARAMETERS if not _same(p.get(back), p.get(now))]
     differ += [f"read {n}" for n in read if not _same(read[n], BY_NAME[n].get(scene))]
     return differ, set(read)
