@@ -173,7 +173,8 @@ static inline void rule_rough_tangential(int dim, const double *dr, double *vi, 
     for (int a = 0; a < 3; a++) g[a] -= gn * n[a];
     const double gt2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
     if (!(gt2 > 0.0)) return; /* no tangential motion at the contact: nothing to do */
-    const double m_t = 1.0 / ((1.0 + 1.0 / q) * (1.0 / mi + 1.0 / mj));
+    /* 1/m_t = (1 + 1/q)(1/m_i + 1/m_j), written without 1/q (q may be tiny) */
+    const double m_t = q / ((1.0 + q) * (1.0 / mi + 1.0 / mj));
     double f = (1.0 + beta) * m_t; /* P_t = -f g_t */
     if (mu < INFINITY && f * sqrt(gt2) > mu * pn) f = mu * pn / sqrt(gt2); /* sliding */
     double P[3] = {-f * g[0], -f * g[1], -f * g[2]};
@@ -181,17 +182,18 @@ static inline void rule_rough_tangential(int dim, const double *dr, double *vi, 
         vi[a] -= P[a] / mi;
         vj[a] += P[a] / mj;
     }
-    const double ci = 1.0 / (q * mi * ai), cj = 1.0 / (q * mj * aj);
+    /* w -= n x P / (q m a): (P / m) / q is a speed of the order of g (P_t carries a factor
+     * q), so the order of the divisions keeps every step within float64 at any scale */
     if (dim == 2) {
         const double t = n[0] * P[1] - n[1] * P[0];
-        wi[0] -= ci * t;
-        wj[0] -= cj * t;
+        wi[0] -= t / mi / q / ai;
+        wj[0] -= t / mj / q / aj;
     } else {
         const double t[3] = {n[1] * P[2] - n[2] * P[1], n[2] * P[0] - n[0] * P[2],
                              n[0] * P[1] - n[1] * P[0]};
         for (int a = 0; a < 3; a++) {
-            wi[a] -= ci * t[a];
-            wj[a] -= cj * t[a];
+            wi[a] -= t[a] / mi / q / ai;
+            wj[a] -= t[a] / mj / q / aj;
         }
     }
 }

@@ -100,6 +100,21 @@ def _check_scales(radii, masses, velocities, lower, upper):
         )
 
 
+@np.errstate(over="ignore")
+def _check_spin_scales(scene):
+    """Rough particles' spins: a radius times a spin is a speed, kept within the speeds'
+    limits (the collision formulas add it to the velocities, the energy squares it)."""
+    r = scene.radii if scene.dim == 2 else scene.radii[:, None]
+    u = float(np.max(np.abs(r * scene.angular_velocities), initial=0.0))
+    _check_range("the largest radius times spin", u, 0.0, SCALE_HI)
+    _check_range(
+        "the largest mass times (radius times spin) squared",
+        float(np.max(scene.masses)) * u * u,
+        0.0,
+        SCALE_HI**2,
+    )
+
+
 def frozen_energy(radii, masses):
     """Total kinetic energy below which the speeds times the smallest diameter fall below
     SCALE_LO, where the contact-time arithmetic underflows and pairs would pass through
@@ -113,13 +128,16 @@ def rotational_dim(dim: int) -> int:
     return 1 if dim == 2 else 3
 
 
-def rotational_energy(spins: Any, inertia: Any, dim: int) -> Any:
-    """Rotational kinetic energy sum I w^2 / 2 of spins (..., N) in 2D or (..., N, 3) in
-    3D with moments of inertia ``inertia`` (N,): a float, or an array over the leading
-    axes."""
+def rotational_energy(spins: Any, scene: Any) -> Any:
+    """Rotational kinetic energy sum I w^2 / 2 = sum q m (r w)^2 / 2 of spins (..., N) in 2D
+    or (..., N, 3) in 3D of a scene's particles: a float, or an array over the leading axes.
+    (r w is a speed: written so, the product stays within float64 wherever the scene's
+    scales do.)"""
     w = np.asarray(spins, dtype=np.float64)
-    w2 = w * w if dim == 2 else np.sum(w * w, axis=-1)
-    e = 0.5 * np.sum(np.asarray(inertia, dtype=np.float64) * w2, axis=-1)
+    r = np.asarray(scene.radii)
+    rw = r * w if scene.dim == 2 else r[:, None] * w
+    u2 = rw * rw if scene.dim == 2 else np.sum(rw * rw, axis=-1)
+    e = 0.5 * scene.inertia_factor * np.sum(np.asarray(scene.masses) * u2, axis=-1)
     return float(e) if np.ndim(e) == 0 else e
 
 
@@ -187,6 +205,7 @@ class Scene:
                     raise ValueError(
                         "the kinetic energy overflows: velocities too large for float64"
                     )
+        _check_spin_scales(self)
         # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
         # the engine's own rules in O(N) through a cell grid, without building an engine.
         _core.edmd_check(**self._engine_keywords())
@@ -263,7 +282,7 @@ class Scene:
     @property
     def rotational_energy(self) -> float:
         """Total rotational kinetic energy, sum of I w^2 / 2."""
-        return rotational_energy(self.angular_velocities, self.moments_of_inertia, self.dim)
+        return rotational_energy(self.angular_velocities, self)
 
     @property
     def rotational_temperature(self) -> float:

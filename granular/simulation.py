@@ -203,7 +203,7 @@ class Simulation:
             c["pressure"] = float("nan")
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
         # rough particles (kinetic_energy is the translational part)
-        c["rotational_energy"] = rotational_energy(self._spins(), s.moments_of_inertia, s.dim)
+        c["rotational_energy"] = rotational_energy(self._spins(), s)
         c["translational_temperature"] = 2.0 * c["kinetic_energy"] / (s.dim * s.n)
         c["rotational_temperature"] = 2.0 * c["rotational_energy"] / (rotational_dim(s.dim) * s.n)
         c["temperature_ratio"] = (
@@ -554,9 +554,7 @@ class Simulation:
         }
         spins = cut["angular_velocities"]
         cut["rotational_energy"] = (
-            np.full(k, s.rotational_energy)
-            if spins is None
-            else rotational_energy(spins, s.moments_of_inertia, s.dim)
+            np.full(k, s.rotational_energy) if spins is None else rotational_energy(spins, s)
         )
         if not getattr(self, "_spins_stored", False):
             cut["angular_velocities"] = None

@@ -160,13 +160,12 @@ def _fig_rough(cfg, out, *, ensemble, save, fig, row, mean_row):
     omega0 = float(theory.collision_frequency(density=DENSITY, radius=RADIUS, temperature=1.0))
     t_end = 20.0 / omega0 * 3.0  # about 20 collisions per particle as T falls
     times = np.linspace(0.0, t_end, 31)
-    T_runs, R_runs = [], []
+    samples = []
     for i in range(runs):
         sim = Simulation(_scene(5000 + i, tangential_restitution=beta, restitution=XI))
         tr = sim.run(t_stop=t_end, sample_times=times, store=())
-        T_runs.append(tr.temperature)
-        R_runs.append(tr.rotational_temperature)
-    T_runs, R_runs = np.array(T_runs), np.array(R_runs)
+        samples.append((tr.temperature, tr.rotational_temperature))
+    T_runs, R_runs = np.array([a for a, _ in samples]), np.array([b for _, b in samples])
     eta = N * 4 / 3 * math.pi * RADIUS**3 / (N / DENSITY)
     T_th, R_th = theory.rough_cooling(
         times, density=DENSITY, radius=RADIUS, temperature0=1.0, rotational_temperature0=0.0,

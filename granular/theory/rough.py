@@ -218,9 +218,7 @@ def rough_cooling(
     if times[-1] == 0.0:
         sol = np.repeat(y0[:, None], len(times), axis=1)
     else:
-        res = solve_ivp(
-            rhs, (0.0, times[-1]), y0, t_eval=times, rtol=1e-10, atol=1e-14 * y0.sum()
-        )
+        res = solve_ivp(rhs, (0.0, times[-1]), y0, t_eval=times, rtol=1e-10, atol=1e-14 * y0.sum())
         sol = res.y
     if np.ndim(t) == 0:
         return sol[0, 0], sol[1, 0]
