@@ -31,8 +31,8 @@ follows from dt = ds / omega(T(s)) (``rough_cooling`` integrates the equations i
 ``rough_temperature_ratio`` and both decay as Haff's law with the slower rate.
 
 Self-diffusion of rough spheres: the literature gives it for constant xi and beta
-(Bodrova & Brilliantov 2012, Granular Matter 14, 85, with a Sonine correction); it is not
-implemented here.
+(Bodrova & Brilliantov 2012, Granular Matter, doi:10.1007/s10035-012-0319-2, with a Sonine
+correction); it is not implemented here.
 """
 
 from __future__ import annotations
