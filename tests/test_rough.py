@@ -434,3 +434,30 @@ def test_gsd_carries_the_spins(tmp_path, dim):
         want = np.zeros((s.n, 3))
         want[:, 2 if dim == 2 else slice(None)] = inertia[:, None] if dim == 3 else inertia
         np.testing.assert_allclose(frame.particles.moment_inertia, want, rtol=1e-6)
+
+
+def test_animate_draws_a_radius_line_per_disk():
+    """plot.animate of a rough run draws one radius line per disk, turned by the spin summed
+    over the samples (exact here: one disk spinning alone in a big box, no collision); a run
+    without stored spins draws none."""
+    pytest.importorskip("matplotlib")
+    from granular import plot
+
+    s = Scene([[0.5, 0.5]], [[0.0, 0.0]], 0.1, tangential_restitution=0.5,
+              angular_velocities=[2.0])  # fmt: skip
+    times = np.linspace(0.0, 1.0, 5)
+    tr = Simulation(s).run(
+        t_stop=1.0, sample_times=times, store=("positions", "angular_velocities")
+    )
+    anim = plot.animate(tr)
+    anim.draw(3)
+    lines = [c for c in anim.ax.collections if c.__class__.__name__ == "LineCollection"]
+    assert len(lines) == 1
+    (seg,) = lines[0].get_segments()
+    angle = math.atan2(seg[1, 1] - seg[0, 1], seg[1, 0] - seg[0, 0])
+    assert angle == pytest.approx(math.remainder(2.0 * times[3], 2 * math.pi), abs=1e-12)
+    assert np.linalg.norm(seg[1] - seg[0]) == pytest.approx(0.1)
+    plain = plot.animate(Simulation(s).run(t_stop=1.0, sample_times=times))
+    assert not [c for c in plain.ax.collections if c.__class__.__name__ == "LineCollection"]
+    with pytest.raises(ValueError, match="angular_velocities"):
+        plot.animate(Simulation(s).run(t_stop=1.0, sample_times=times), spin=True)
