@@ -29,7 +29,7 @@ from __future__ import annotations
 import functools
 import os
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -494,11 +494,11 @@ def animate(
                 c.set_facecolor(rgba)
         if radii_lines is not None and phi is not None:
             tip = xy + 0.5 * d[:, None] * np.column_stack([np.cos(phi[s]), np.sin(phi[s])])
-            radii_lines.set_segments(np.stack([xy, tip], axis=1))
+            radii_lines.set_segments(list(np.stack([xy, tip], axis=1)))
             radii_lines.set_alpha(None)
             edge = np.zeros((n, 4))
             edge[:, 3] = np.where(rgba[:, 3] > 0, 1.0, 0.0)  # hidden with its disk
-            radii_lines.set_color(edge)
+            radii_lines.set_color(cast(Any, edge))  # RGBA rows; the stubs want tuples
         first = 0 if trail_length is None else max(0, s - int(trail_length))
         for line, i in zip(lines, trail_ids, strict=True):
             path = positions[first : s + 1, i][:, [ax0, ax1]]
