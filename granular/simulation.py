@@ -191,7 +191,11 @@ class Simulation:
         collisions' virial.  In a periodic box V is the box volume.  In a walled box the
         walls' virial is -P d V_reach, so V is the volume the centres reach, the box shrunk
         by one radius at each face (see ``Trajectory.pressure``: exact for equal radii,
-        approximate for mixtures)."""
+        approximate for mixtures).  Rough particles (docs/rough.md): rotational_energy (sum
+        I w^2 / 2; kinetic_energy is the translational part), translational_temperature,
+        rotational_temperature (T_rot = <I w^2> / d_rot, d_rot = 1 in 2D, 3 in 3D) and
+        temperature_ratio T_rot / T_tr (NaN when T_tr = 0); for smooth particles their
+        spins' values, which never change."""
         c = self._engine.counters()
         s = self._initial
         if c["time"] > 0:
