@@ -19,7 +19,7 @@
  * cost every scene in every scan, where the extra array is touched only by a collision of
  * the rule that uses it.  Under constant velocity (flight.h) an angular velocity does not
  * change in flight, so neither the clock nor the predictions read it; the checkpoint
- * would save the array when it exists. */
+ * saves the array when it exists (csrc/checkpoint.c). */
 #ifndef GR_RULE_H
 #define GR_RULE_H
 

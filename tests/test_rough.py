@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from granular import Scene, Simulation, _core
+from granular import Scene, Simulation, TabulatedRestitution, _core
 
 from helpers import reference_edmd
 
@@ -224,6 +224,10 @@ def _gas(dim, n=200, seed=3, **rough):
     return s.replace(angular_velocities=w, **rough)
 
 
+# a restitution law of the normal impact speed (eps falls from 1 to 0.7)
+_LAW = TabulatedRestitution([0.0, 1.0, 3.0], [1.0, 0.9, 0.7])
+
+
 def _bits(engine):
     pos, vel, _ = engine.state()
     return pos.tobytes() + vel.tobytes(), engine.counters()["events"]
@@ -285,6 +289,9 @@ def test_perfectly_rough_keeps_the_energy():
         (3, dict(tangential_restitution=0.0, restitution=0.8)),
         (2, dict(tangential_restitution=0.6, friction=0.15, restitution=0.9)),
         (3, dict(tangential_restitution=0.5, friction=0.2, restitution=0.95, inertia_factor=0.6)),
+        # with a restitution law: the rough loop evaluates it for the normal part
+        (2, dict(tangential_restitution=0.3, restitution=_LAW)),
+        (3, dict(tangential_restitution=0.3, friction=0.3, restitution=_LAW)),
     ],
 )
 def test_a_rough_gas_agrees_with_the_slow_reference(dim, rough):
@@ -461,3 +468,35 @@ def test_animate_draws_a_radius_line_per_disk():
     assert not [c for c in plain.ax.collections if c.__class__.__name__ == "LineCollection"]
     with pytest.raises(ValueError, match="angular_velocities"):
         plot.animate(Simulation(s).run(t_stop=1.0, sample_times=times), spin=True)
+
+
+def test_the_tc_models_elastic_collisions_are_smooth():
+    """With the TC model a collision within t_c of either particle's previous one is
+    elastic; for rough particles it is smooth too (it keeps the energy): with t_c longer
+    than the run, once every particle has collided every collision is the TC model's: no
+    spin changes again and the energy (translation + rotation) stays, to rounding (1e-12)."""
+    s = _gas(2, n=100, tangential_restitution=0.0, restitution=0.8, contact_duration=1e6)
+    sim = Simulation(s)
+    sim.run(stop_when={"collisions_per_particle": 20}, store=())
+    assert sim.stats["tc_elastic_collisions"] > 0
+    before = sim.scene
+    assert np.any(before.angular_velocities != s.angular_velocities)  # rough at first
+    plain = sim.stats["pair_collisions"] - sim.stats["tc_elastic_collisions"]
+    sim.run(stop_when={"collisions_per_particle": 40}, store=())
+    after = sim.scene
+    # every particle had collided by then: every collision since was the TC model's
+    assert sim.stats["pair_collisions"] - sim.stats["tc_elastic_collisions"] == plain
+    assert np.array_equal(after.angular_velocities, before.angular_velocities)
+    assert energy(after) == pytest.approx(energy(before), rel=1e-12)
+
+
+def test_smooth_particles_keep_their_spins():
+    """A smooth scene (beta = -1) with spins: the engine carries none, and the scene, samples
+    and checkpoints keep them as given."""
+    s = _gas(3, n=50, restitution=0.9)
+    sim = Simulation(s)
+    tr = sim.run(t_stop=0.5, sample_times=[0.0, 0.5], store=("angular_velocities",))
+    assert sim._engine.angular_velocities() is None
+    assert np.array_equal(tr.angular_velocities[-1], s.angular_velocities)
+    assert np.array_equal(sim.scene.angular_velocities, s.angular_velocities)
+    assert tr.rotational_energy[-1] == s.rotational_energy
