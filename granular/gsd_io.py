@@ -51,7 +51,9 @@ momentum in the body frame, so here P = (0, 2 I w).  ``moment_inertia`` holds th
 moments (I, I, I) of a sphere and (0, 0, I) of a disk, which rotates about z only (HOOMD
 integrates no axis of moment 0); I = q m r^2.  The exact spins are in the log,
 ``log/granular/angular_velocities`` (float64, (N,) in 2D, (N, 3) in 3D), with
-``log/granular/rotational_energy`` every frame.
+``log/granular/rotational_energy`` every frame.  ``Scene.from_gsd`` of a HOOMD file takes its
+spins from ``angmom``, ``orientation`` and ``moment_inertia`` (the box frame's angular
+velocity, by the same convention) and its inertia factor when all particles share one.
 
 (gsd >= 4 can write the HOOMD fields in float64, but OVITO and older gsd and HOOMD read
 float32 ones: the standard fields stay float32 and the exact values go in the log.)
@@ -575,6 +577,39 @@ def scene_from_gsd(path: str | os.PathLike, frame: int, make_scene: Any, **param
     return own.replace(**params)
 
 
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products of quaternions (..., 4) stored (real, x, y, z)."""
+    w1, v1 = a[..., :1], a[..., 1:]
+    w2, v2 = b[..., :1], b[..., 1:]
+    w = w1 * w2 - np.sum(v1 * v2, axis=-1, keepdims=True)
+    return np.concatenate([w, w1 * v2 + w2 * v1 + np.cross(v1, v2)], axis=-1)
+
+
+def _foreign_spins(f, k, get, n, dim, radii, masses):
+    """A HOOMD frame's spins as Scene keywords (see the module docstring): the body-frame
+    angular momentum S = im(q* P) / 2 turned into the box frame by the orientation q,
+    divided by the moment of inertia about each axis (0 where it is 0: no rotation there);
+    the scene's inertia_factor I / (m r^2) when every particle has the same one (within
+    float32's rounding) in (0, 1]."""
+    P = get("particles/angmom", (n, 4), 0.0)
+    q = get("particles/orientation", (n, 4), [1.0, 0.0, 0.0, 0.0])
+    moments = get("particles/moment_inertia", (n, 3), 0.0)
+    conj = q * np.array([1.0, -1.0, -1.0, -1.0])
+    body = 0.5 * _quat_mul(conj, P)
+    body[:, 0] = 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w_body = np.where(moments > 0, body[:, 1:] / moments, 0.0)
+    w = _quat_mul(_quat_mul(q, np.concatenate([np.zeros((n, 1)), w_body], axis=1)), conj)[:, 1:]
+    out: dict[str, Any] = {"angular_velocities": w[:, 2] if dim == 2 else w}
+    axis = moments[:, 2] if dim == 2 else moments[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        factor = axis / (masses * radii**2)
+    if np.all(np.isfinite(factor)) and np.ptp(factor) <= 1e-5 * np.max(np.abs(factor)):
+        if 0.0 < float(factor[0]) <= 1.0 + 1e-6:
+            out["inertia_factor"] = min(float(factor[0]), 1.0)
+    return out
+
+
 def _foreign_scene(f: _File, k: int, make_scene: Any) -> Any:
     """Frame ``k`` of a file granular did not write, from its float32 HOOMD fields, as a
     periodic box centred at the origin.  A field missing from frame ``k`` is frame 0's, else
@@ -606,13 +641,12 @@ def _foreign_scene(f: _File, k: int, make_scene: Any) -> Any:
     lengths = box[:dim]
     lower, upper = -0.5 * lengths, 0.5 * lengths
     x = np.where(x >= upper, x - lengths, x)
+    radii = 0.5 * get("particles/diameter", (n,), 1.0)
+    masses = get("particles/mass", (n,), 1.0)
+    spin = {}
+    if f.has(k, "particles/angmom") or f.has(0, "particles/angmom"):
+        spin = _foreign_spins(f, k, get, n, dim, radii, masses)
     try:
-        return make_scene(
-            x,
-            v,
-            0.5 * get("particles/diameter", (n,), 1.0),
-            get("particles/mass", (n,), 1.0),
-            box=(lower, upper),
-        )
+        return make_scene(x, v, radii, masses, box=(lower, upper), **spin)
     except (ValueError, TypeError) as exc:
         raise GSDFileError(f"{f.where}, frame {k}: not a valid state: {exc}") from exc

@@ -500,3 +500,36 @@ def test_smooth_particles_keep_their_spins():
     assert np.array_equal(tr.angular_velocities[-1], s.angular_velocities)
     assert np.array_equal(sim.scene.angular_velocities, s.angular_velocities)
     assert tr.rotational_energy[-1] == s.rotational_energy
+
+
+def test_a_hoomd_files_spins_are_read(tmp_path):
+    """Scene.from_gsd of a file HOOMD could have written (granular's log absent): spins from
+    particles/angmom, orientation and moment_inertia (S = im(q* P) / 2 in the body frame,
+    turned into the box frame), and the inertia factor they share."""
+    gsd = pytest.importorskip("gsd.hoomd")
+    rng = np.random.default_rng(5)
+    n = 8
+    x = (np.arange(n)[:, None] * np.array([0.6, 0.35, 0.2]) % 2.0) - 1.0
+    w = rng.normal(size=(n, 3))
+    q = rng.normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1)[:, None]
+    inertia = 0.4 * 1.0 * 0.05**2
+    # P = 2 q (0, S) with S the body-frame angular momentum I R(q)^T w
+    from granular.gsd_io import _quat_mul
+
+    conj = q * np.array([1.0, -1.0, -1.0, -1.0])
+    s_body = _quat_mul(_quat_mul(conj, np.column_stack([np.zeros(n), inertia * w])), q)
+    P = 2.0 * _quat_mul(q, s_body)
+    frame = gsd.Frame()
+    frame.configuration.box = [2.0, 2.0, 2.0, 0, 0, 0]
+    frame.particles.N = n
+    frame.particles.position = x.astype(np.float32)
+    frame.particles.diameter = np.full(n, 0.1, np.float32)
+    frame.particles.orientation = q.astype(np.float32)
+    frame.particles.angmom = P.astype(np.float32)
+    frame.particles.moment_inertia = np.full((n, 3), inertia, np.float32)
+    with gsd.open(tmp_path / "h.gsd", "w") as f:
+        f.append(frame)
+    scene = Scene.from_gsd(tmp_path / "h.gsd")
+    np.testing.assert_allclose(scene.angular_velocities, w, rtol=1e-5, atol=1e-5)
+    assert scene.inertia_factor == pytest.approx(0.4, rel=1e-5)
