@@ -706,8 +706,8 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
     "rough": (
         "rough spheres: T_rot / T_tr against beta, coupled cooling, Walton's rule",
-        60.0,
-        20.0,
+        31.0,
+        9.2,
     ),
 }
 
