@@ -301,10 +301,14 @@ class Scene:
     def __repr__(self):
         # the gas' summary, then each parameter that is not an array (the wall restitution
         # only where there are walls)
+        # (the rough particles' parameters only for rough particles)
+        rough = ("tangential_restitution", "inertia_factor", "friction")
         shown = [
             f"{p.name}={p.get(self)!r}"
             for p in PARAMETERS
-            if not p.is_array and (p.name != "wall_restitution" or self.boundary == "walls")
+            if not p.is_array
+            and (p.name != "wall_restitution" or self.boundary == "walls")
+            and (p.name not in rough or self.tangential_restitution != -1.0)
         ]
         return (
             f"Scene(n={self.n}, dim={self.dim}, packing_fraction={self.packing_fraction:.4g}, "
