@@ -228,9 +228,10 @@ static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject
 #define COUNT_OF(field) +1
 static char *edmd_names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                              "periodic", GR_SCENE_DOUBLES(NAME_OF) "cell_factor", "big_ratio",
-                             "shell", "law", "wall_law", "stress", NULL};
+                             "shell", "law", "wall_law", "stress", "angular_velocities",
+                             NULL};
 #define EDMD_REQUIRED (7 GR_SCENE_DOUBLES(COUNT_OF))
-#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOOp"
+#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOOpO"
 
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
@@ -239,6 +240,7 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
                           npy_intp *n_out)
 {
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None;
+    PyObject *ospin = Py_None; /* rough particles' angular velocities, or None: smooth */
     gr_edmd_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.cell_factor = 1.0;
@@ -249,7 +251,8 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
                                      sim ? EDMD_FORMAT ":EDMD" : EDMD_FORMAT ":edmd_check",
                                      edmd_names, &opos, &ovel, &orad, &omass, &olo, &ohi,
                                      &cfg.periodic, GR_SCENE_DOUBLES(ADDRESS_OF) &cfg.cell_factor,
-                                     &cfg.big_ratio, &cfg.shell, &olaw, &owall, &cfg.stress) ||
+                                     &cfg.big_ratio, &cfg.shell, &olaw, &owall, &cfg.stress,
+                                     &ospin) ||
         require_keywords(args, kw, edmd_names, EDMD_REQUIRED, sim ? "EDMD" : "edmd_check") < 0)
         return -1;
 #undef ADDRESS_OF
@@ -265,7 +268,8 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
     PyArrayObject *pos = as_f64(opos, "positions", 2, any2);
     npy_intp n = pos ? PyArray_DIM(pos, 0) : 0, d = pos ? PyArray_DIM(pos, 1) : 0;
     npy_intp shp[2] = {n, d}, shn[1] = {n}, shd[1] = {d};
-    PyArrayObject *vel = NULL, *rad = NULL, *mass = NULL, *lo = NULL, *hi = NULL;
+    PyArrayObject *vel = NULL, *rad = NULL, *mass = NULL, *lo = NULL, *hi = NULL, *spin = NULL;
+    npy_intp shw[2] = {n, 3};
     int ok = 0;
     if (!pos) goto done;
     if (d != 2 && d != 3) {
@@ -277,6 +281,10 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
         !(mass = as_f64(omass, "masses", 1, shn)) || !(lo = as_f64(olo, "lower", 1, shd)) ||
         !(hi = as_f64(ohi, "upper", 1, shd)))
         goto done;
+    /* spins: (N,) in 2D (along z), (N, 3) in 3D */
+    if (ospin != Py_None && !(spin = as_f64(ospin, "angular_velocities", d == 2 ? 1 : 2, shw)))
+        goto done;
+    cfg.spin = spin ? PyArray_DATA(spin) : NULL;
     cfg.dim = (int)d;
     cfg.n = n;
     for (int a = 0; a < d; a++) {
@@ -309,6 +317,7 @@ done:
     Py_XDECREF(mass);
     Py_XDECREF(lo);
     Py_XDECREF(hi);
+    Py_XDECREF(spin);
     Py_XDECREF(law_x);
     Py_XDECREF(law_y);
     Py_XDECREF(wall_x);
@@ -434,17 +443,17 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
                             "max_events", "sample_times", "next", "positions", "velocities",
                             "kinetic_energy", "momentum", "pair_collisions", "wall_collisions",
                             "virial", "wall_impulse",
-                            "stress_collisional", "kinetic_time_tensor", "kinetic_tensor",
+                            "stress_collisional", "kinetic_time_tensor", "kinetic_tensor", "angular_velocities",
                             NULL};
     gr_edmd_stop stop;
     long long max_events, next;
     PyObject *otimes, *opos = Py_None, *ovel = Py_None, *okin = Py_None, *omom = Py_None,
              *opair = Py_None, *owall = Py_None, *ovir = Py_None, *oimp = Py_None,
-             *ostc = Py_None, *ostk = Py_None, *okt = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$dddLOLOOOOOOOOOOO:advance", names, &stop.t_stop,
+             *ostc = Py_None, *ostk = Py_None, *okt = Py_None, *ospin = Py_None;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$dddLOLOOOOOOOOOOOO:advance", names, &stop.t_stop,
                                      &stop.collisions_per_particle, &stop.kinetic_energy,
                                      &max_events, &otimes, &next, &opos, &ovel, &okin, &omom,
-                                     &opair, &owall, &ovir, &oimp, &ostc, &ostk, &okt) ||
+                                     &opair, &owall, &ovir, &oimp, &ostc, &ostk, &okt, &ospin) ||
         require_keywords(args, kw, names, 6, "advance") < 0)
         return NULL;
     if (!check_ready(self)) return NULL;
@@ -472,10 +481,12 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         Py_DECREF(times);
         return NULL;
     }
-    npy_intp nd, td, tdd;
+    npy_intp nd, td, tdd, nw;
     if (!mul_size(T, self->n, &nd, "positions") || !mul_size(nd, self->dim, &nd, "positions") ||
         !mul_size(T, self->dim, &td, "momentum") ||
-        !mul_size(td, self->dim, &tdd, "stress_collisional")) {
+        !mul_size(td, self->dim, &tdd, "stress_collisional") ||
+        !mul_size(T, self->n, &nw, "angular_velocities") ||
+        !mul_size(nw, self->dim == 2 ? 1 : 3, &nw, "angular_velocities")) {
         Py_DECREF(times);
         return NULL;
     }
@@ -489,7 +500,8 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         !out_buffer(oimp, "wall_impulse", NPY_FLOAT64, T, (void **)&smp.wall_impulse) ||
         !out_buffer(ostc, "stress_collisional", NPY_FLOAT64, tdd, (void **)&smp.stress_collisional) ||
         !out_buffer(ostk, "kinetic_time_tensor", NPY_FLOAT64, tdd, (void **)&smp.kinetic_time_tensor) ||
-        !out_buffer(okt, "kinetic_tensor", NPY_FLOAT64, tdd, (void **)&smp.kinetic_tensor)) {
+        !out_buffer(okt, "kinetic_tensor", NPY_FLOAT64, tdd, (void **)&smp.kinetic_tensor) ||
+        !out_buffer(ospin, "angular_velocities", NPY_FLOAT64, nw, (void **)&smp.spin)) {
         Py_DECREF(times);
         return NULL;
     }
@@ -521,6 +533,19 @@ static PyObject *EDMD_state(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     gr_edmd_state(self->sim, PyArray_DATA((PyArrayObject *)pos),
                   PyArray_DATA((PyArrayObject *)vel), PyArray_DATA((PyArrayObject *)img));
     return Py_BuildValue("(NNN)", pos, vel, img);
+}
+
+/* The rough particles' angular velocities now: (N,) in 2D, (N, 3) in 3D; None for smooth
+ * particles. */
+static PyObject *EDMD_angular_velocities(EDMDObject *self, PyObject *Py_UNUSED(ignored))
+{
+    if (!check_ready(self)) return NULL;
+    if (!gr_edmd_has_spin(self->sim)) Py_RETURN_NONE;
+    npy_intp shp[2] = {self->n, 3};
+    PyObject *out = PyArray_SimpleNew(self->dim == 2 ? 1 : 2, shp, NPY_FLOAT64);
+    if (!out) return NULL;
+    gr_edmd_spin(self->sim, PyArray_DATA((PyArrayObject *)out));
+    return out;
 }
 
 static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
@@ -603,8 +628,12 @@ static PyMethodDef EDMD_methods[] = {
      " sample_times, next, positions=None, velocities=None, kinetic_energy=None,"
      " momentum=None, pair_collisions=None, wall_collisions=None, virial=None,"
      " wall_impulse=None, stress_collisional=None, kinetic_time_tensor=None,"
-     " kinetic_tensor=None) -> (reason, next).  Process events, writing samples into the"
-     " arrays given (stop_kinetic_energy: the mean to stop at, negative for none)."},
+     " kinetic_tensor=None, angular_velocities=None) -> (reason, next).  Process events,"
+     " writing samples into the arrays given (stop_kinetic_energy: the mean translational"
+     " kinetic energy to stop at, negative for none)."},
+    {"angular_velocities", (PyCFunction)EDMD_angular_velocities, METH_NOARGS,
+     "angular_velocities() -> the rough particles' spins now ((N,) in 2D, (N, 3) in 3D), or"
+     " None for smooth particles"},
     {"state", (PyCFunction)EDMD_state, METH_NOARGS,
      "state() -> (positions wrapped in the box, velocities, image counters) at the current time"},
     {"counters", (PyCFunction)EDMD_counters, METH_NOARGS, "counters() -> dict"},

@@ -15,6 +15,7 @@ void gr_edmd_free(gr_edmd *s)
     if (!s) return;
     free(s->P);
     free(s->mass);
+    free(s->spin);
     free(s->image);
     free(s->sched);
     free(s->order.id_of);
@@ -100,6 +101,13 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     if (status == GR_OK) status = wall_status;
     s->dim = d;
     s->n = n;
+    s->cfg.spin = NULL; /* the caller's array: copied into s->spin below */
+    if (cfg->spin) {
+        const size_t bytes = (size_t)n * GR_SPIN_DIM(d) * sizeof *s->spin;
+        s->spin = malloc(bytes);
+        if (s->spin) memcpy(s->spin, cfg->spin, bytes);
+        else status = GR_ERR_NOMEM;
+    }
     for (int a = 0; a < 3; a++) s->L[a] = a < d ? cfg->hi[a] - cfg->lo[a] : 1.0;
     /* Lees-Edwards (boundary.h): cells only, every particle in them (the neighbour lists'
      * and the big particles' image tables are fixed, the sliding images are not) */

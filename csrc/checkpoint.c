@@ -115,6 +115,7 @@ typedef struct {
     uint64_t total;      /* bytes of the whole checkpoint */
     int64_t n;
     int32_t dim, stride, lists, nb, ncells, nc[3], cap, big_n;
+    int32_t spin;        /* 1: rough particles' spins follow the masses */
 } header;
 
 static header header_of(const gr_edmd *s, size_t total)
@@ -135,6 +136,7 @@ static header header_of(const gr_edmd *s, size_t total)
     for (int a = 0; a < 3; a++) h.nc[a] = s->cells.nc[a];
     h.cap = s->nl.cap;
     h.big_n = s->big.n;
+    h.spin = s->spin != NULL;
     return h;
 }
 
@@ -154,6 +156,7 @@ static void io_header(cursor *c, header *h)
     io(c, h->nc, sizeof h->nc);
     IO(c, h->cap);
     IO(c, h->big_n);
+    IO(c, h->spin);
 }
 
 /* Everything after the header, in order.  The arrays of s must be allocated for the
@@ -209,6 +212,7 @@ static void transfer(cursor *c, gr_edmd *s)
 
     io(c, s->P, (size_t)n * GR_STRIDE(s->dim) * sizeof *s->P);
     io(c, s->mass, (size_t)n * sizeof *s->mass);
+    if (s->spin) io(c, s->spin, (size_t)n * GR_SPIN_DIM(d) * sizeof *s->spin);
     io(c, s->image, (size_t)n * d * sizeof *s->image);
     io(c, s->sched, (size_t)n * sizeof *s->sched);
     io(c, s->order.id_of, (size_t)n * sizeof *s->order.id_of);
@@ -302,6 +306,7 @@ static void free_state(gr_edmd *t)
 {
     free(t->P);
     free(t->mass);
+    free(t->spin);
     free(t->image);
     free(t->sched);
     free(t->order.id_of);
@@ -326,6 +331,7 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     *t = *s;
     t->P = gr_big_alloc((n * GR_STRIDE(s->dim) * sizeof(double) + 63) / 64 * 64);
     t->mass = gr_big_alloc(n * sizeof(double));
+    t->spin = s->spin ? malloc(n * GR_SPIN_DIM(d) * sizeof(double)) : NULL;
     t->image = calloc(n * d, sizeof(int64_t));
     t->sched = gr_big_alloc(n * sizeof(gr_sched));
     t->order.id_of = malloc(n * sizeof(int32_t));
@@ -341,8 +347,8 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     t->nl.centre = lists ? gr_big_alloc(n * (d + 1) * sizeof(double)) : NULL;
     t->nl.rows = lists ? gr_big_alloc(n * (size_t)cap * sizeof(int32_t)) : NULL;
     t->nl.cap = cap;
-    if (!t->P || !t->mass || !t->image || !t->sched || !t->order.id_of || !t->big.is_big ||
-        !t->queue.item || !t->queue.head || !t->queue.near || !t->cells.head ||
+    if (!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
+        !t->order.id_of || !t->big.is_big || !t->queue.item || !t->queue.head || !t->queue.near || !t->cells.head ||
         !t->cells.next || !t->cells.prev || !t->cells.occ ||
         (lists && (!t->nl.centre || !t->nl.rows))) {
         free_state(t);
@@ -467,6 +473,10 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         }
         if (s->nl.shell > 0.0 && !same_double(t->nl.centre[(size_t)i * (d + 1) + d], RAD(p, d)))
             return "a neighbour list's centre is corrupt";
+        if (t->spin)
+            for (int k = 0; k < GR_SPIN_DIM(d); k++)
+                if (!(fabs(t->spin[(size_t)i * GR_SPIN_DIM(d) + k]) <= 1e140))
+                    return "a particle's angular velocity is out of range";
     }
 
     /* scheduling states: every index an event follows is in range; a particle with no
@@ -588,7 +598,7 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
     else if (h.total != size) what = "truncated, or with bytes appended";
     else if (h.n != want.n || h.dim != want.dim || h.stride != want.stride || h.lists != want.lists ||
              h.nb != want.nb || h.ncells != want.ncells || memcmp(h.nc, want.nc, sizeof h.nc) != 0 ||
-             h.big_n != want.big_n)
+             h.big_n != want.big_n || h.spin != want.spin)
         what = "made for another scene or other engine knobs (sizes differ)";
     else if (h.lists && !(h.cap >= want.cap && cap_reachable(h.cap, h.dim, h.n)))
         what = "its neighbour-list capacity (header field cap) is out of range: not a "

@@ -100,7 +100,8 @@ static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, i
                             int32_t old);
 
 /* The loop, for dynamics dyn (flight.h: how particles move between events), dimension
- * dim and laws = 0 (constant restitution) or 1 (a restitution law, restitution.h),
+ * dim and laws = 0 (constant restitution), 1 (a restitution law, restitution.h) or
+ * GR_RULE_ROUGH (rough particles, rule.h),
  * constants in each of the four advance_* below: a constant-xi run executes the loop
  * compiled without any law code, not a test per collision, and each dynamics gets its
  * own loop the same way (constant velocity, GR_FLIGHT_LINEAR, is the only one so far: a
@@ -235,6 +236,19 @@ static int advance_3d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
     return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err);
 }
 
+/* Rough particles (rule.h): the law rule's code with the tangential impulse and spins. */
+static int advance_2d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                            gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 2, GR_RULE_ROUGH, stop, smp, err);
+}
+
+static int advance_3d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                            gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err);
+}
+
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
     /* a driven gas runs the plain loop between kicks (drive.c): nothing per event here */
@@ -250,6 +264,9 @@ int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
                      "a neighbour list could not grow earlier; the system cannot go on");
         return GR_ERR_NOMEM;
     }
+    if (s->spin) /* a scene with spins: the rough rule, with or without laws */
+        return s->dim == 2 ? advance_2d_rough(s, stop, smp, err)
+                           : advance_3d_rough(s, stop, smp, err);
     if (s->cfg.law.kind != GR_LAW_CONSTANT || s->cfg.wall_law.kind != GR_LAW_CONSTANT)
         return s->dim == 2 ? advance_2d_law(s, stop, smp, err) : advance_3d_law(s, stop, smp, err);
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
@@ -304,13 +321,25 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
         if (s->cfg.periodic) dr[a] = bd_nearest(dr[a], s->L[a]);
     }
     int64_t clamped; /* 1 if xi is the law's at its range's end */
+    const int64_t elastic_before = s->elastic_tc;
     const double xi = rule_pair_eps(&s->cfg, laws, dim, dr, VEL(p, dim), VEL(q, dim), t,
                                     &s->sched[i], &s->sched[j], &clamped, &s->elastic_tc);
     double before = kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j);
     double vb[6]; /* the velocities before, for the stress tensor */
     if (s->cfg.stress)
         for (int a = 0; a < dim; a++) vb[a] = VEL(p, dim)[a], vb[3 + a] = VEL(q, dim)[a];
-    double vir = rule_pair_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
+    double vir;
+    if (GR_RULE_IS_ROUGH(laws)) { /* compiled into the rough loops only */
+        const int w = dim == 2 ? 1 : 3; /* spin components */
+        /* the TC model's elastic collision is smooth too: it keeps the energy */
+        const double beta =
+            s->elastic_tc != elastic_before ? -1.0 : s->cfg.tangential_restitution;
+        vir = rule_rough_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->spin + (size_t)i * w,
+                               s->spin + (size_t)j * w, s->mass[i], s->mass[j], RAD(p, dim),
+                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction);
+    } else {
+        vir = rule_pair_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
+    }
     if (vir < 0.0) { /* grazing: no longer approaching at contact after rounding */
         s->invalid++;
         predict(s, dyn, dim, i);

@@ -64,6 +64,14 @@ typedef struct {
      * the white noise's xi0^2 (GR_DRIVE_WHITE_NOISE) or the thermostat's temperature
      * (GR_DRIVE_THERMOSTAT); drive_seed: the random numbers' key, an integer in [0, 2^53). */
     double drive_kind, drive_rate, drive_strength, drive_seed;
+    double tangential_restitution; /* rough particles (rule.h): beta in [-1, 1], -1 smooth;
+                                    * beta_0 of the Coulomb rule */
+    double inertia_factor;    /* rough particles: I = q m r^2, q in (0, 1] */
+    double friction;          /* rough particles: Coulomb's mu >= 0 (Walton's rule); +inf:
+                               * constant beta */
+    const double *spin;       /* NULL: smooth particles.  Else their angular velocities
+                               * (n in 2D, n x 3 in 3D), and the rough rule; gr_edmd_new
+                               * copies them */
 } gr_edmd_config;
 
 typedef struct {
@@ -94,6 +102,8 @@ typedef struct {
     double *stress_collisional; /* cumulative sum over pair collisions of r_a dp_b */
     double *kinetic_time_tensor;/* cumulative integral of sum m v_a v_b over time */
     double *kinetic_tensor;     /* sum m v_a v_b at the sample */
+    double *spin;         /* count x n x (1 in 2D, 3 in 3D): angular velocities, or NULL
+                           * (always NULL for smooth particles) */
 } gr_edmd_samples;
 
 typedef struct {
@@ -158,5 +168,9 @@ const char *gr_scan_kernel(void);
  * Does not change the system. */
 void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image);
 void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c);
+/* Rough particles: whether s carries spins, and their angular velocities now (n in 2D,
+ * n x 3 in 3D, in the caller's order; they do not change in flight). */
+int gr_edmd_has_spin(const gr_edmd *s);
+void gr_edmd_spin(const gr_edmd *s, double *spin);
 
 #endif

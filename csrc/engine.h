@@ -35,6 +35,8 @@ struct gr_edmd {
     double L[3];
     double *P;            /* n records (rec), 64-byte aligned */
     double *mass;
+    double *spin;         /* rough particles' angular velocities (rule.h): n (2D) or n * 3
+                           * (3D) doubles, in the particles' internal order; NULL: smooth */
     int64_t *image;       /* n * dim periodic image counters */
     gr_sched *sched;      /* n: each particle's scheduling state */
     gr_cq queue;
@@ -93,6 +95,9 @@ struct gr_edmd {
 #else
 #define GR_PREFETCH(p) ((void)(p))
 #endif
+
+/* spin components per particle: 1 in 2D (along z), 3 in 3D */
+#define GR_SPIN_DIM(dim) ((dim) == 2 ? 1 : 3)
 
 /* the parts of record p, for dimension dim */
 #define VEL(p, dim) ((p) + (dim))

@@ -51,6 +51,7 @@ int gr_renumber(gr_edmd *s)
     } while (0)
     PERMUTE(s->P, double, (size_t)GR_STRIDE(s->dim));
     PERMUTE(s->mass, double, 1);
+    if (s->spin) PERMUTE(s->spin, double, (size_t)GR_SPIN_DIM(d));
     PERMUTE(s->image, int64_t, (size_t)d);
     PERMUTE(s->order.id_of, int32_t, 1);
     PERMUTE(s->big.is_big, uint8_t, 1);

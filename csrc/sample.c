@@ -49,6 +49,10 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
             mom[a] += m * v;
             kin += 0.5 * m * v * v;
         }
+        if (smp->spin && s->spin) /* spins do not change in flight */
+            for (int a = 0; a < GR_SPIN_DIM(dim); a++)
+                smp->spin[((size_t)k * s->n + (size_t)s->order.id_of[i]) * GR_SPIN_DIM(dim) + a] =
+                    s->spin[(size_t)i * GR_SPIN_DIM(dim) + a];
     }
     if (smp->kinetic) smp->kinetic[k] = kin;
     if (smp->momentum)
@@ -114,6 +118,17 @@ void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image)
             if (image) image[out] = img;
         }
     }
+}
+
+int gr_edmd_has_spin(const gr_edmd *s) { return s->spin != NULL; }
+
+void gr_edmd_spin(const gr_edmd *s, double *spin)
+{
+    const int w = GR_SPIN_DIM(s->dim);
+    if (!s->spin) return;
+    for (int32_t i = 0; i < s->n; i++)
+        for (int a = 0; a < w; a++)
+            spin[(size_t)s->order.id_of[i] * w + a] = s->spin[(size_t)i * w + a];
 }
 
 void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)

@@ -22,6 +22,9 @@
     X(drive_kind)           \
     X(drive_rate)           \
     X(drive_strength)       \
-    X(drive_seed)
+    X(drive_seed)           \
+    X(tangential_restitution) \
+    X(inertia_factor)       \
+    X(friction)
 
 #endif

@@ -16,7 +16,12 @@ What a frame shows, and why it is drawn that way:
   frames shown), wrapped into the box and broken where they cross a periodic edge;
 - the time in a strip above the box, never over a particle;
 - with ``color_by_speed`` each frame's speeds over its own rms speed unless a ``norm`` is
-  given: a cooling gas keeps its colours.
+  given: a cooling gas keeps its colours;
+- rough particles' spins (a trajectory that stored ``angular_velocities``) as a radius line
+  per disk, turned by the spin about the axis drawn face-on (z in 2D, the depth axis in
+  3D): the angle is summed sample by sample, phi_k = phi_(k-1) + w_(k-1) (t_k - t_(k-1)),
+  exact between collisions and an approximation across them (the samples do not record
+  when a spin changed).
 """
 
 from __future__ import annotations
@@ -24,7 +29,7 @@ from __future__ import annotations
 import functools
 import os
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -134,6 +139,24 @@ def _trail_particles(trails, n):
 
 
 @functools.cache
+def _spin_angles(traj: Any, depth: int | None, sign: float = 1.0) -> NDArray[np.float64]:
+    """(T, N) angles of each disk's radius line: the spin about the axis seen face-on (z in
+    2D, the depth axis in 3D; ``sign`` -1 when the drawn axes and it are left-handed, as x,
+    z and y are) summed over the samples, starting at 0."""
+    w = traj.angular_velocities
+    if w is None:
+        raise ValueError(
+            "spin=True draws rough particles' rotation: run with store including "
+            "'angular_velocities'"
+        )
+    w = np.asarray(w, dtype=np.float64)
+    face_on = w if depth is None else sign * w[:, :, depth]
+    dt = np.diff(np.asarray(traj.times, dtype=np.float64))
+    phi = np.zeros_like(face_on)
+    phi[1:] = np.cumsum(face_on[:-1] * dt[:, None], axis=0)
+    return phi
+
+
 def _animation_class():
     """The FuncAnimation subclass, defined on first use so that importing granular.plot does
     not import matplotlib."""
@@ -279,6 +302,7 @@ def animate(
     blit: bool | None = None,
     title: str | None = None,
     ax: Axes | None = None,
+    spin: bool | None = None,
 ) -> Any:
     """An animation of a trajectory: particles as disks at their true radii in the box.
 
@@ -320,6 +344,10 @@ def animate(
     ax : matplotlib Axes, optional
         Draw into these (e.g. from ``plt.subplots()`` for a live window); by default a new
         Figure outside pyplot, so a notebook shows the animation once, not also a still.
+    spin : bool, optional
+        Draw each disk's rotation as a radius line (rough particles: the trajectory must
+        have stored ``angular_velocities``).  Default: when it did.  The angle is the spin
+        about the axis seen face-on summed over the samples (module docstring).
 
     Returns
     -------
@@ -355,9 +383,16 @@ def animate(
     elif norm is not None:
         raise ValueError("norm sets the colours of speeds: pass color_by_speed=True with it")
 
+    phi = None
+    if spin is None:
+        spin = traj.angular_velocities is not None
+    if spin:
+        right_handed = depth is None or (ax0, ax1, depth) in ((0, 1, 2), (1, 2, 0), (2, 0, 1))
+        phi = _spin_angles(traj, depth, 1.0 if right_handed else -1.0)
+
     _matplotlib("matplotlib")  # a bare install: say which extra brings it
     from matplotlib import colors as mcolors
-    from matplotlib.collections import EllipseCollection
+    from matplotlib.collections import EllipseCollection, LineCollection
     from matplotlib.patches import Rectangle
 
     own_figure = None
@@ -404,11 +439,17 @@ def animate(
     # box (below), so only the parts that reach into it are seen
     images = [collection() for _ in range(3)] if periodic else []
     lines = [ax.plot([], [], "-", lw=1.2, color=trail_color, zorder=3)[0] for _ in trail_ids]
+    radii_lines = None
+    if phi is not None:
+        radii_lines = LineCollection([], colors="k", linewidths=0.8, zorder=2)
+        ax.add_collection(radii_lines)
     outline = ax.add_patch(
         Rectangle((lo[ax0], lo[ax1]), length[ax0], length[ax1], fill=False, lw=1.5, clip_on=False)
     )
     for c in (disks, *images):  # periodic images and wrapped disks end at the box' edges
         c.set_clip_path(outline)
+    if radii_lines is not None:
+        radii_lines.set_clip_path(outline)
     # the clock sits in a strip above the box, where it never covers a particle; the box'
     # outline is the frame, the axes' own spines only carry the ticks along it
     strip = 0.09 * length[ax1]
@@ -472,13 +513,21 @@ def animate(
                 else:
                     c.set_offsets(xy + shift * mask)
                 c.set_facecolor(rgba)
+        if radii_lines is not None and phi is not None:
+            tip = xy + 0.5 * d[:, None] * np.column_stack([np.cos(phi[s]), np.sin(phi[s])])
+            radii_lines.set_segments(list(np.stack([xy, tip], axis=1)))
+            radii_lines.set_alpha(None)
+            edge = np.zeros((n, 4))
+            edge[:, 3] = np.where(rgba[:, 3] > 0, 1.0, 0.0)  # hidden with its disk
+            radii_lines.set_color(cast(Any, edge))  # RGBA rows; the stubs want tuples
         first = 0 if trail_length is None else max(0, s - int(trail_length))
         for line, i in zip(lines, trail_ids, strict=True):
             path = positions[first : s + 1, i][:, [ax0, ax1]]
             path = trail_segments(path, lo[[ax0, ax1]], hi[[ax0, ax1]], periodic)
             line.set_data(path[:, 0], path[:, 1])
         clock.set_text(f"t = {traj.times[s]:.4g}")
-        return [disks, *images, outline, *lines, clock]  # in the order a full drawing has
+        extra = [radii_lines] if radii_lines is not None else []
+        return [disks, *images, *extra, outline, *lines, clock]  # a full drawing's order
 
     if own_figure is not None:
         # lay the figure out once: constrained layout would otherwise run on every frame

@@ -129,6 +129,18 @@ QUANTITIES: dict[str, Quantity] = {
     "bins": Quantity("histogram bins", "dimensionless count"),
     "shells": Quantity("number of wave-number shells drawn, smallest first", "dimensionless count"),
     "color": Quantity("matplotlib colour", "-"),
+    # rough particles (granular.theory.rough)
+    "tangential_restitution": Quantity(
+        "tangential restitution beta (-1 smooth, 1 perfectly rough)", "dimensionless", "beta"
+    ),
+    "inertia_factor": Quantity(
+        "q in the moment of inertia I = q m r^2 (None: 1/2 in 2D, 2/5 in 3D)",
+        "dimensionless",
+        "inertia",
+    ),
+    "rotational_temperature0": Quantity(
+        "rotational temperature T_rot = <I w^2> / d_rot at t = 0", "eps", "nonnegative"
+    ),
 }
 
 
@@ -139,6 +151,8 @@ _RULES = {
     "nonnegative": (lambda x: (x >= 0) & np.isfinite(x), "must be >= 0 and finite"),
     "restitution": (lambda x: (x >= 0) & (x <= 1), "must lie in [0, 1]"),
     "packing": (lambda x: (x >= 0) & (x < 1), "must lie in [0, 1)"),
+    "beta": (lambda x: (x >= -1) & (x <= 1), "must lie in [-1, 1]"),
+    "inertia": (lambda x: (x > 0) & (x <= 1), "must lie in (0, 1]"),
 }
 
 

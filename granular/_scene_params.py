@@ -209,6 +209,72 @@ def _contact_duration(value: Any, n: int, d: int) -> float:
     return kept
 
 
+# -- rough particles (csrc/rule.h, docs/rough.md) ----------------------------------------
+
+# A spin array's shape symbol: (N,) in 2D (the spin along z), (N, 3) in 3D.
+SPIN = "w"
+# The default inertia factor q (I = q m r^2): a uniform disk in 2D, a solid sphere in 3D.
+INERTIA_FACTOR = {2: 0.5, 3: 0.4}
+
+
+def spin_shape(n: int, d: int) -> tuple[int, ...]:
+    """The shape of N particles' angular velocities in d dimensions."""
+    return (n,) if d == 2 else (n, 3)
+
+
+def _angular_velocities(value: Any, n: int, d: int) -> np.ndarray:
+    shape = spin_shape(n, d)
+    if value is None:
+        a = np.zeros(shape)
+        a.setflags(write=False)
+        return a
+    a = np.array(real(value, "angular_velocities"), dtype=np.float64, order="C", copy=True)
+    if a.shape != shape:
+        raise ValueError(
+            f"angular_velocities must have shape {shape} ((N,) in 2D, (N, 3) in 3D), got {a.shape}"
+        )
+    if not np.all(np.isfinite(a)):
+        raise ValueError("angular_velocities contains NaN or infinity")
+    if np.any(np.abs(a) > SCALE_HI):
+        raise ValueError(f"angular_velocities must lie within +-{SCALE_HI:g}")
+    a.setflags(write=False)
+    return a
+
+
+def _tangential_restitution(value: Any, n: int, d: int) -> float:
+    kept = float(value)
+    if not -1.0 <= kept <= 1.0:
+        raise ValueError(
+            f"tangential_restitution must lie in [-1, 1] (-1 smooth, 1 perfectly rough), "
+            f"got {value}"
+        )
+    return kept
+
+
+def _inertia_factor(value: Any, n: int, d: int) -> float:
+    if value is None:
+        return INERTIA_FACTOR[d]
+    kept = float(value)
+    if not 0.0 < kept <= 1.0:
+        raise ValueError(
+            f"inertia_factor q (I = q m r^2) must lie in (0, 1] (2/5 a solid sphere, 1/2 a "
+            f"disk, 2/3 a hollow sphere), got {value}"
+        )
+    return kept
+
+
+def _friction(value: Any, n: int, d: int) -> float:
+    kept = float(value)
+    if not kept >= 0.0:  # NaN too
+        raise ValueError(f"friction must be >= 0 (inf: no Coulomb limit), got {value}")
+    return kept
+
+
+def _spin_keywords(kept: Any) -> dict[str, Any]:
+    # engine_keywords gives None instead for a smooth scene (tangential_restitution -1)
+    return {"angular_velocities": kept}
+
+
 def _law_keywords(number: str, law: str) -> Callable[[Any], dict[str, Any]]:
     """A restitution's keywords: the number (1, unused, for a law) and the law (None for a
     number: the engine's constant loop)."""
@@ -381,12 +447,63 @@ PARAMETERS += (
         _finite("shear_offset"),
         _same("shear_offset"),
     ),
+    # rough particles (csrc/rule.h; docs/rough.md)
+    SceneParameter(
+        "angular_velocities",
+        "array_like or None",
+        ("N", SPIN),
+        None,
+        "sqrt(eps/m) / L",
+        "Rough particles' angular velocities: shape (N,) in 2D (the spin along z), (N, 3) "
+        "in 3D; None: all at rest.  They change only in collisions of rough particles "
+        "(``tangential_restitution`` > -1).",
+        _angular_velocities,
+        _spin_keywords,
+    ),
+    SceneParameter(
+        "tangential_restitution",
+        "float in [-1, 1]",
+        None,
+        -1.0,
+        "dimensionless",
+        "Tangential restitution beta of pair collisions (Huthmann & Zippelius 1997): the "
+        "contact point's tangential relative velocity becomes -beta times itself.  -1 "
+        "smooth (the default: the smooth rule, no spins change), 0 the tangential motion "
+        "stopped, 1 perfectly rough (energy kept).  With a finite ``friction`` it is "
+        "Walton's beta_0, the sticking value.  Walls stay smooth.",
+        _tangential_restitution,
+        _same("tangential_restitution"),
+    ),
+    SceneParameter(
+        "inertia_factor",
+        "float in (0, 1] or None",
+        None,
+        None,
+        "dimensionless",
+        "q in the moment of inertia I = q m r^2 of rough particles; None: 1/2 (a uniform "
+        "disk) in 2D, 2/5 (a solid sphere) in 3D.",
+        _inertia_factor,
+        _same("inertia_factor"),
+    ),
+    SceneParameter(
+        "friction",
+        "float >= 0",
+        None,
+        math.inf,
+        "dimensionless",
+        "Coulomb friction coefficient mu of Walton's rule (Walton & Braun 1986): a "
+        "collision whose tangential impulse would exceed mu times the normal one slides, "
+        "with the tangential impulse mu times the normal one; inf: always "
+        "``tangential_restitution`` (no Coulomb limit).",
+        _friction,
+        _same("friction"),
+    ),
 )
 
 BY_NAME: dict[str, SceneParameter] = {p.name: p for p in PARAMETERS}
 # what a trajectory samples; the other parameters are the run's, the same at every sample
 # (a Trajectory and a GSD file keep them once)
-SAMPLED: tuple[str, ...] = ("positions", "velocities")
+SAMPLED: tuple[str, ...] = ("positions", "velocities", "angular_velocities")
 RUN_PARAMETERS: tuple[SceneParameter, ...] = tuple(p for p in PARAMETERS if p.name not in SAMPLED)
 NAMES: tuple[str, ...] = tuple(BY_NAME)
 # the Scene's attributes that hold parameters (the box's corners for the box)
@@ -410,6 +527,8 @@ SIGNATURE = inspect.Signature(
 def shape_of(parameter: SceneParameter, n: int, d: int) -> tuple[int, ...]:
     """An array parameter's shape for N particles in d dimensions."""
     assert parameter.shape is not None
+    if parameter.shape == ("N", SPIN):
+        return spin_shape(n, d)
     return tuple(n if s == "N" else d for s in parameter.shape)
 
 
@@ -425,12 +544,18 @@ def engine_keywords(scene: Any) -> dict[str, Any]:
     keywords: dict[str, Any] = {}
     for p in PARAMETERS:
         keywords.update(p.engine(p.get(scene)))
+    if keywords["tangential_restitution"] == -1.0:
+        # smooth particles: no spins, so the engine runs the smooth rule (csrc/rule.h), bit
+        # for bit the loop of scenes without rough particles; the spins stay as given
+        keywords["angular_velocities"] = None
     return keywords
 
 
 def shape_text(parameter: SceneParameter) -> str:
     """An array parameter's shape as the docs write it: (N, d), (N,)."""
     assert parameter.shape is not None
+    if parameter.shape == ("N", SPIN):
+        return "(N,) in 2D, (N, 3) in 3D"
     return f"({', '.join(parameter.shape)}{',' if len(parameter.shape) == 1 else ''})"
 
 

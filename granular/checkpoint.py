@@ -41,6 +41,7 @@ import numpy as np
 from . import _core
 from ._files import check_kind, write_atomic
 from ._npz import check_members, open_regular, read_header, read_member
+from ._rough import rough_keeps_energy
 from ._scene_params import PARAMETERS, shape_of
 from .errors import CheckpointError, GranularError
 from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
@@ -97,7 +98,9 @@ def _fault(sim: _Run) -> str | None:
     except (GranularError, ValueError) as exc:
         return f"its particles now are not a valid scene ({exc})"
     start = sim._initial
-    e0, e = start.kinetic_energy, now.kinetic_energy
+    # rough particles trade energy between translation and rotation: the total counts
+    e0 = start.kinetic_energy + start.rotational_energy
+    e = now.kinetic_energy + now.rotational_energy
     periodic = start.boundary == "periodic"
     if start.shear_rate != 0.0:
         return _sheared_fault(sim, start, now)
@@ -108,8 +111,10 @@ def _fault(sim: _Run) -> str | None:
                 f"its kinetic energy {e:.6g} exceeds the initial scene's {e0:.6g}, which "
                 "collisions without heated walls cannot do"
             )
-        elastic = not loses_energy(start.restitution) and (
-            periodic or not loses_energy(start.wall_restitution)
+        elastic = (
+            not loses_energy(start.restitution)
+            and (periodic or not loses_energy(start.wall_restitution))
+            and rough_keeps_energy(start)
         )
         if elastic and e < e0 * (1.0 - _CONSERVED_RTOL):
             return (

@@ -54,6 +54,19 @@ The exact float64 (and int64) values granular reads back live in the log section
   its default.  Layout 1 from the start: the parameters after ``boundary`` were added
   beside the fields earlier readers read, and they read these files still.
 
+Rough particles (a trajectory that stored ``angular_velocities``): ``particles/angmom`` and
+``particles/moment_inertia`` in HOOMD's convention, without orientations (every
+``particles/orientation`` stays the identity quaternion (1, 0, 0, 0), so the body frame is
+the box's): HOOMD stores angular momentum as the quaternion P = 2 q x (0, S) conjugate to
+the orientation q (Kamberaj 2005; HOOMD's "Anisotropic particles" page), S the angular
+momentum in the body frame, so here P = (0, 2 I w).  ``moment_inertia`` holds the principal
+moments (I, I, I) of a sphere and (0, 0, I) of a disk, which rotates about z only (HOOMD
+integrates no axis of moment 0); I = q m r^2.  The exact spins are in the log,
+``log/granular/angular_velocities`` (float64, (N,) in 2D, (N, 3) in 3D), with
+``log/granular/rotational_energy`` every frame.  ``Scene.from_gsd`` of a HOOMD file takes its
+spins from ``angmom``, ``orientation`` and ``moment_inertia`` (the box frame's angular
+velocity, by the same convention) and its inertia factor when all particles share one.
+
 (gsd >= 4 can write the HOOMD fields in float64, but OVITO and older gsd and HOOMD read
 float32 ones: the standard fields stay float32 and the exact values go in the log.)
 
@@ -73,7 +86,7 @@ import numpy as np
 
 from . import _shear
 from ._files import atomic_target, check_kind
-from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, split
+from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, spin_shape, split
 from .driving import PairThermostat, WhiteNoise
 from .errors import GSDFileError
 from .interop import box_lengths_3d
@@ -95,7 +108,8 @@ _INT_COUNTERS = ("pair_collisions", "wall_collisions")
 _TENSORS = ("stress_collisional", "kinetic_time_tensor", "kinetic_tensor")
 _HOOMD_PRESSURE_TENSOR = "md/compute/ThermodynamicQuantities/pressure_tensor"
 LOG_NAMES = (
-    "format", "stop_reason", "time", "unwrapped_positions", "velocities", *_COUNTERS, *_TENSORS
+    "format", "stop_reason", "time", "unwrapped_positions", "velocities",
+    "angular_velocities", "rotational_energy", *_COUNTERS, *_TENSORS
 )  # fmt: skip
 
 
@@ -201,6 +215,10 @@ def _frame(hoomd, traj, k, lower, upper):
     if traj.velocities is not None:
         frame.particles.velocity = _pad3(traj.velocities[k])
         log["granular/velocities"] = np.ascontiguousarray(traj.velocities[k], dtype=np.float64)
+    if traj.angular_velocities is not None:
+        _spin_fields(frame, log, traj, k)
+    if traj.rotational_energy is not None:
+        log["granular/rotational_energy"] = np.array([traj.rotational_energy[k]], np.float64)
     for name in _COUNTERS:
         dtype = np.int64 if name in _INT_COUNTERS else np.float64
         log[f"granular/{name}"] = np.atleast_1d(np.asarray(getattr(traj, name)[k], dtype))
@@ -255,6 +273,27 @@ def _hoomd_pressure_tensor(traj, k):
     else:
         p[:d, :d] = traj.pressure_tensor(per_window=True)[k - 1]
     return np.array([p[0, 0], p[0, 1], p[0, 2], p[1, 1], p[1, 2], p[2, 2]])
+
+
+def _spin_fields(frame, log, traj, k):
+    """Rough particles' spins of sample ``k``: HOOMD's angmom and moment_inertia (module
+    docstring), the exact values in the log."""
+    w = np.asarray(traj.angular_velocities[k], dtype=np.float64)
+    q = float(traj.scene_parameters["inertia_factor"])
+    inertia = q * np.asarray(traj.masses) * np.asarray(traj.radii) ** 2
+    w3 = np.zeros((traj.n, 3))
+    if traj.dim == 2:
+        w3[:, 2] = w
+        moments = np.zeros((traj.n, 3))
+        moments[:, 2] = inertia
+    else:
+        w3[:] = w
+        moments = np.repeat(inertia[:, None], 3, axis=1)
+    angmom = np.zeros((traj.n, 4))
+    angmom[:, 1:] = 2.0 * inertia[:, None] * w3  # P = 2 q x (0, I w), q = 1
+    frame.particles.angmom = angmom.astype(np.float32)
+    frame.particles.moment_inertia = moments.astype(np.float32)
+    log["granular/angular_velocities"] = np.ascontiguousarray(w)
 
 
 def write(traj: Any, path: str | os.PathLike) -> None:
@@ -447,10 +486,11 @@ def _scene(
     p: dict[str, Any],
     make_scene: Any,
     t: float = 0.0,
+    w: np.ndarray | None = None,
 ) -> Any:
     """Frame ``k``'s state (at time ``t``) as a Scene (``make_scene``: the Scene class) with
-    the run's parameters ``p``, which checks it as every scene is checked (finite, the
-    scales, inside the box, no overlaps).  A sheared box's (csrc/boundary.h) positions are
+    the run's parameters ``p`` (and spins ``w``, if the file has them), which checks it as
+    every scene is checked (finite, the scales, inside the box, no overlaps).  A sheared box's (csrc/boundary.h) positions are
     brought into the box through its images at t, and the Scene gets the offset then."""
     if p.get("shear_rate", 0.0) != 0.0 and np.all(np.isfinite(x)):
         lower, upper = p["box"]
@@ -462,6 +502,8 @@ def _scene(
         p = {**p, "shear_offset": _shear.offset(rate, d0, lx, ly, t)}
     x = _wrap_checked(f, k, x, p)
     try:
+        if w is not None:
+            return make_scene(x, v, angular_velocities=w, **p)
         return make_scene(x, v, **p)
     except (ValueError, TypeError) as exc:
         raise GSDFileError(f"{f.where}, frame {k}: not a valid state: {exc}") from exc
@@ -478,6 +520,10 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
         p, stop_reason = _params(f)
         n, d = len(p["radii"]), len(p["box"][0])
         has_v = f.has(0, _log("velocities"))
+        has_w = f.has(0, _log("angular_velocities"))  # rough particles' spins
+        has_rot = f.has(0, _log("rotational_energy"))
+        spins: list[np.ndarray] = []
+        rotational: list[float] = []
         still = np.zeros((n, d))
         times: list[float] = []
         positions: list[np.ndarray] = []
@@ -503,7 +549,15 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
                 velocities.append(v)
             elif f.has(k, _log("velocities")):
                 raise f.error(k, _log("velocities"), "is there but frame 0 has none")
-            _scene(f, k, x, v, p, make_scene, t)
+            w = f.array(k, _log("angular_velocities"), spin_shape(n, d)) if has_w else None
+            if w is not None:
+                spins.append(w)
+            if has_rot:
+                e = f.array(k, _log("rotational_energy"), (1,))[0]
+                if not (np.isfinite(e) and e >= 0):
+                    raise f.error(k, _log("rotational_energy"), f"is {e}, not finite and >= 0")
+                rotational.append(float(e))
+            _scene(f, k, x, v, p, make_scene, t, w)
             positions.append(x)
             for name in _COUNTERS:
                 value = _counter(f, k, name, d, counters[name])
@@ -532,6 +586,10 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
         },
         stop_reason=stop_reason,
         parameters=p,
+        angular_velocities=np.array(spins).reshape(len(times), *spin_shape(n, d))
+        if has_w
+        else None,
+        rotational_energy=np.array(rotational) if has_rot else None,
     )
 
 
@@ -586,10 +644,46 @@ def scene_from_gsd(path: str | os.PathLike, frame: int, make_scene: Any, **param
             if f.has(k, _log("velocities")):
                 v = f.array(k, _log("velocities"), (n, d))
             t = float(f.array(k, _log("time"), (1,))[0])
-            own = _scene(f, k, x, v, p, make_scene, t)
+            w = None
+            if f.has(k, _log("angular_velocities")):
+                w = f.array(k, _log("angular_velocities"), spin_shape(n, d))
+            own = _scene(f, k, x, v, p, make_scene, t, w)
         else:
             own = _foreign_scene(f, k, make_scene)
     return own.replace(**params)
+
+
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products of quaternions (..., 4) stored (real, x, y, z)."""
+    w1, v1 = a[..., :1], a[..., 1:]
+    w2, v2 = b[..., :1], b[..., 1:]
+    w = w1 * w2 - np.sum(v1 * v2, axis=-1, keepdims=True)
+    return np.concatenate([w, w1 * v2 + w2 * v1 + np.cross(v1, v2)], axis=-1)
+
+
+def _foreign_spins(f, k, get, n, dim, radii, masses):
+    """A HOOMD frame's spins as Scene keywords (see the module docstring): the body-frame
+    angular momentum S = im(q* P) / 2 turned into the box frame by the orientation q,
+    divided by the moment of inertia about each axis (0 where it is 0: no rotation there);
+    the scene's inertia_factor I / (m r^2) when every particle has the same one (within
+    float32's rounding) in (0, 1]."""
+    P = get("particles/angmom", (n, 4), 0.0)
+    q = get("particles/orientation", (n, 4), [1.0, 0.0, 0.0, 0.0])
+    moments = get("particles/moment_inertia", (n, 3), 0.0)
+    conj = q * np.array([1.0, -1.0, -1.0, -1.0])
+    body = 0.5 * _quat_mul(conj, P)
+    body[:, 0] = 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w_body = np.where(moments > 0, body[:, 1:] / moments, 0.0)
+    w = _quat_mul(_quat_mul(q, np.concatenate([np.zeros((n, 1)), w_body], axis=1)), conj)[:, 1:]
+    out: dict[str, Any] = {"angular_velocities": w[:, 2] if dim == 2 else w}
+    axis = moments[:, 2] if dim == 2 else moments[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        factor = axis / (masses * radii**2)
+    if np.all(np.isfinite(factor)) and np.ptp(factor) <= 1e-5 * np.max(np.abs(factor)):
+        if 0.0 < float(factor[0]) <= 1.0 + 1e-6:
+            out["inertia_factor"] = min(float(factor[0]), 1.0)
+    return out
 
 
 def _foreign_scene(f: _File, k: int, make_scene: Any) -> Any:
@@ -625,13 +719,12 @@ def _foreign_scene(f: _File, k: int, make_scene: Any) -> Any:
     lengths = box[:dim]
     lower, upper = -0.5 * lengths, 0.5 * lengths
     x = np.where(x >= upper, x - lengths, x)
+    radii = 0.5 * get("particles/diameter", (n,), 1.0)
+    masses = get("particles/mass", (n,), 1.0)
+    spin = {}
+    if f.has(k, "particles/angmom") or f.has(0, "particles/angmom"):
+        spin = _foreign_spins(f, k, get, n, dim, radii, masses)
     try:
-        return make_scene(
-            x,
-            v,
-            0.5 * get("particles/diameter", (n,), 1.0),
-            get("particles/mass", (n,), 1.0),
-            box=(lower, upper),
-        )
+        return make_scene(x, v, radii, masses, box=(lower, upper), **spin)
     except (ValueError, TypeError) as exc:
         raise GSDFileError(f"{f.where}, frame {k}: not a valid state: {exc}") from exc

@@ -101,12 +101,45 @@ def _check_scales(radii, masses, velocities, lower, upper):
         )
 
 
+@np.errstate(over="ignore")
+def _check_spin_scales(scene):
+    """Rough particles' spins: a radius times a spin is a speed, kept within the speeds'
+    limits (the collision formulas add it to the velocities, the energy squares it)."""
+    r = scene.radii if scene.dim == 2 else scene.radii[:, None]
+    u = float(np.max(np.abs(r * scene.angular_velocities), initial=0.0))
+    _check_range("the largest radius times spin", u, 0.0, SCALE_HI)
+    _check_range(
+        "the largest mass times (radius times spin) squared",
+        float(np.max(scene.masses)) * u * u,
+        0.0,
+        SCALE_HI**2,
+    )
+
+
 def frozen_energy(radii, masses):
     """Total kinetic energy below which the speeds times the smallest diameter fall below
     SCALE_LO, where the contact-time arithmetic underflows and pairs would pass through
     each other (speeds estimated with the largest mass, to be safe)."""
     speed = SCALE_LO / (2.0 * float(np.min(radii)))
     return 0.5 * len(radii) * float(np.max(masses)) * speed * speed
+
+
+def rotational_dim(dim: int) -> int:
+    """The rotational degrees of freedom of a particle: 1 in 2D, 3 in 3D."""
+    return 1 if dim == 2 else 3
+
+
+def rotational_energy(spins: Any, scene: Any) -> Any:
+    """Rotational kinetic energy sum I w^2 / 2 = sum q m (r w)^2 / 2 of spins (..., N) in 2D
+    or (..., N, 3) in 3D of a scene's particles: a float, or an array over the leading axes.
+    (r w is a speed: written so, the product stays within float64 wherever the scene's
+    scales do.)"""
+    w = np.asarray(spins, dtype=np.float64)
+    r = np.asarray(scene.radii)
+    rw = r * w if scene.dim == 2 else r[:, None] * w
+    u2 = rw * rw if scene.dim == 2 else np.sum(rw * rw, axis=-1)
+    e = 0.5 * scene.inertia_factor * np.sum(np.asarray(scene.masses) * u2, axis=-1)
+    return float(e) if np.ndim(e) == 0 else e
 
 
 def _set(scene: Scene, name: str, value: Any) -> None:
@@ -146,6 +179,10 @@ class Scene:
     shear_rate: float
     shear_offset: float
     driving: WhiteNoise | PairThermostat | None
+    angular_velocities: NDArray[np.float64]
+    tangential_restitution: float
+    inertia_factor: float
+    friction: float
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         try:
@@ -172,6 +209,7 @@ class Scene:
                     raise ValueError(
                         "the kinetic energy overflows: velocities too large for float64"
                     )
+        _check_spin_scales(self)
         # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
         # the engine's own rules in O(N) through a cell grid, without building an engine.
         _core.edmd_check(**self._engine_keywords())
@@ -240,6 +278,22 @@ class Scene:
         """Granular temperature T = 2 <E_kin> / d per particle (k_B = 1)."""
         return 2.0 * self.kinetic_energy / (self.dim * self.n)
 
+    @property
+    def moments_of_inertia(self) -> NDArray[np.float64]:
+        """Each particle's moment of inertia I = q m r^2 (q: ``inertia_factor``), shape (N,)."""
+        return self.inertia_factor * self.masses * self.radii**2
+
+    @property
+    def rotational_energy(self) -> float:
+        """Total rotational kinetic energy, sum of I w^2 / 2."""
+        return rotational_energy(self.angular_velocities, self)
+
+    @property
+    def rotational_temperature(self) -> float:
+        """Rotational temperature T_rot = <I w^2> / d_rot per particle, d_rot = 1 in 2D
+        (the spin along z), 3 in 3D (Huthmann & Zippelius 1997; k_B = 1)."""
+        return 2.0 * self.rotational_energy / (rotational_dim(self.dim) * self.n)
+
     def replace(self, **changes: Any) -> Scene:
         """A copy with some fields changed, e.g. ``scene.replace(restitution=0.8)``; the
         box is changed as ``box=`` (a length, or the corners (lower, upper))."""
@@ -251,10 +305,14 @@ class Scene:
     def __repr__(self):
         # the gas' summary, then each parameter that is not an array (the wall restitution
         # only where there are walls)
+        # (the rough particles' parameters only for rough particles)
+        rough = ("tangential_restitution", "inertia_factor", "friction")
         shown = [
             f"{p.name}={p.get(self)!r}"
             for p in PARAMETERS
-            if not p.is_array and (p.name != "wall_restitution" or self.boundary == "walls")
+            if not p.is_array
+            and (p.name != "wall_restitution" or self.boundary == "walls")
+            and (p.name not in rough or self.tangential_restitution != -1.0)
         ]
         return (
             f"Scene(n={self.n}, dim={self.dim}, packing_fraction={self.packing_fraction:.4g}, "

@@ -15,7 +15,8 @@ from numpy.typing import ArrayLike, NDArray
 from . import _core, _edmd, _shear, checkpoint
 from . import restitution as _restitution
 from ._edmd import check_memory as _check_memory
-from ._scene_params import RUN_PARAMETERS
+from ._rough import rough_keeps_energy
+from ._scene_params import RUN_PARAMETERS, spin_shape
 from .errors import (
     ClusteringWarning,
     FrozenGasError,
@@ -24,12 +25,13 @@ from .errors import (
     InelasticCollapseError,
     NoProgressError,
 )
-from .scene import BIG_RATIO, Scene, frozen_energy
+from .scene import BIG_RATIO, Scene, frozen_energy, rotational_dim, rotational_energy
 from .trajectory import Trajectory, _pressure_volume
 
 _STOP_KEYS = ("collisions_per_particle", "kinetic_energy", "events")
 _CHUNK = _edmd.CHUNK
-_STORE = ("positions", "velocities")
+_STORE = ("positions", "velocities", "angular_velocities")
+_STORE_DEFAULT = ("positions", "velocities")
 # What a sample records besides positions, velocities and momentum: the engine's counters
 # at that instant.  One name each, shared by the engine's counters, the binding's sample
 # buffers and Trajectory's attributes.
@@ -213,6 +215,12 @@ class Simulation:
         by one radius at each face (see ``Trajectory.pressure``: exact for equal radii,
         approximate for mixtures).
 
+        Rough particles (docs/rough.md): rotational_energy (sum I w^2 / 2; kinetic_energy
+        is the translational part), translational_temperature, rotational_temperature
+        (T_rot = <I w^2> / d_rot, d_rot = 1 in 2D, 3 in 3D) and temperature_ratio
+        T_rot / T_tr (NaN when T_tr = 0); for smooth particles their spins' values, which
+        never change.
+
         With ``Simulation(stress=True)`` also: stress_collisional, kinetic_time_tensor,
         kinetic_tensor (each d rows of d numbers, a tuple of tuples: ``np.array`` makes
         the matrix; see ``Trajectory``) and pressure_tensor, their average since the start
@@ -250,7 +258,22 @@ class Simulation:
             c["temperature"] = 2.0 * c["kinetic_energy"] / (s.dim * s.n)
         # the random driving's energy input per unit time (0 before any time has passed)
         c["drive_power"] = c["drive_energy"] / c["time"] if c["time"] > 0 else 0.0
+        # rough particles (kinetic_energy is the translational part)
+        c["rotational_energy"] = rotational_energy(self._spins(), s)
+        c["translational_temperature"] = 2.0 * c["kinetic_energy"] / (s.dim * s.n)
+        c["rotational_temperature"] = 2.0 * c["rotational_energy"] / (rotational_dim(s.dim) * s.n)
+        c["temperature_ratio"] = (
+            c["rotational_temperature"] / c["translational_temperature"]
+            if c["translational_temperature"] > 0
+            else float("nan")
+        )
         return c
+
+    def _spins(self) -> NDArray[np.float64]:
+        """The angular velocities now: the engine's for rough particles, else the scene's
+        (smooth particles' spins never change)."""
+        w = self._engine.angular_velocities()
+        return self._initial.angular_velocities if w is None else w
 
     @property
     def scene(self) -> Scene:
@@ -260,8 +283,10 @@ class Simulation:
         s = self._initial
         if s.shear_rate != 0.0:
             offset = shear_offset_at(s, self.time)
-            return s.replace(positions=pos, velocities=vel, shear_offset=offset)
-        return s.replace(positions=pos, velocities=vel)
+            return s.replace(
+                positions=pos, velocities=vel, angular_velocities=self._spins(), shear_offset=offset
+            )
+        return s.replace(positions=pos, velocities=vel, angular_velocities=self._spins())
 
     @property
     def unwrapped_positions(self) -> NDArray[np.float64]:
@@ -284,7 +309,7 @@ class Simulation:
         *,
         sample_times: ArrayLike | None = None,
         stop_when: Mapping[str, float] | None = None,
-        store: tuple[str, ...] | list[str] = _STORE,
+        store: tuple[str, ...] | list[str] = _STORE_DEFAULT,
         progress: bool = False,
     ) -> Trajectory:
         """Advance until ``t_stop`` (absolute time) or a ``stop_when`` criterion, whichever
@@ -303,7 +328,7 @@ class Simulation:
             pair collisions counting for both partners), ``kinetic_energy`` (stop when
             the mean kinetic energy per particle falls to this), ``events`` (events this
             run may process, cell crossings included).
-        store : tuple of {"positions", "velocities"}
+        store : tuple of {"positions", "velocities", "angular_velocities"}
             Which per-particle arrays to keep (statistics are always kept).  Storing
             nothing keeps memory O(T) for long runs.
         progress : bool
@@ -405,12 +430,15 @@ class Simulation:
                 # sample so that every sample is taken at the time asked for
                 t_end = float(times[-1])
         count = len(times) + final_sample
+        # rough particles' spins are sampled for the rotational energy even when not stored
+        self._spins_stored = "angular_velocities" in store
+        rough = self._engine.angular_velocities() is not None
         _check_memory(
-            8.0 * count * self._initial.n * self._initial.dim * len(store),
+            8.0 * count * self._initial.n * self._initial.dim * (len(store) + rough),
             f"storing {count} samples of {' and '.join(store)} (sample less often, "
             f"or run with store=() and keep only the statistics)",
         )
-        buf = self._buffers(count, store)
+        buf = self._buffers(count, store, rough)
 
         # the C loop fills the first len(times) samples; a final one may follow
         views = {k: (None if v is None else v[: len(times)]) for k, v in buf.items()}
@@ -547,7 +575,9 @@ class Simulation:
         energy never falls without a dissipative channel (inelastic pairs, of which there
         must be two, or absorbing walls)."""
         s = self._initial
-        pairs_lose = _restitution.loses_energy(s.restitution) and s.n >= 2
+        pairs_lose = (
+            _restitution.loses_energy(s.restitution) or not rough_keeps_energy(s)
+        ) and s.n >= 2
         walls_lose = s.boundary == "walls" and _restitution.loses_energy(s.wall_restitution)
         mean = self._engine.counters()["kinetic_energy"] / s.n
         if not (pairs_lose or walls_lose) and target < mean:
@@ -570,6 +600,8 @@ class Simulation:
             buf["positions"][k] = self.unwrapped_positions
         if buf["velocities"] is not None:
             buf["velocities"][k] = vel
+        if buf["angular_velocities"] is not None:
+            buf["angular_velocities"][k] = self._spins()
         buf["momentum"][k] = (m * vel).sum(axis=0)
         for name, _ in _COUNTED:
             buf[name][k] = c[name]
@@ -577,11 +609,16 @@ class Simulation:
             if buf.get(name) is not None:
                 buf[name][k] = np.array(c[name][: vel.shape[1] ** 2]).reshape(vel.shape[1], -1)
 
-    def _buffers(self, count, store):
+    def _buffers(self, count, store, rough=False):
         n, d = self._initial.n, self._initial.dim
+        spins = None
+        if rough or "angular_velocities" in store:  # smooth ones keep the scene's spins
+            spins = np.zeros((count, *spin_shape(n, d)))
+            spins[:] = self._initial.angular_velocities
         return dict(
             positions=np.zeros((count, n, d)) if "positions" in store else None,
             velocities=np.zeros((count, n, d)) if "velocities" in store else None,
+            angular_velocities=spins,
             momentum=np.zeros((count, d)),
             **{name: np.zeros(count, dtype=dtype) for name, dtype in _COUNTED},
             **{
@@ -595,6 +632,12 @@ class Simulation:
         cut: dict[str, Any] = {
             name: (None if a is None else a[:k].copy()) for name, a in buf.items()
         }
+        spins = cut["angular_velocities"]
+        cut["rotational_energy"] = (
+            np.full(k, s.rotational_energy) if spins is None else rotational_energy(spins, s)
+        )
+        if not getattr(self, "_spins_stored", False):
+            cut["angular_velocities"] = None
         return Trajectory(
             times.copy(),
             **cut,
@@ -632,7 +675,11 @@ class _StallGuard:
     def __init__(self, sim, dissipative_only):
         s = sim._initial
         self.limit = max(self.MIN_LIMIT, 1000 * s.n)
-        self.pairs = not dissipative_only or _restitution.loses_energy(s.restitution)
+        self.pairs = (
+            not dissipative_only
+            or _restitution.loses_energy(s.restitution)
+            or not rough_keeps_energy(s)
+        )
         self.walls = not dissipative_only or (
             s.boundary == "walls" and _restitution.loses_energy(s.wall_restitution)
         )

@@ -50,11 +50,16 @@ class Trajectory:
     stop_reason : why the run ended: "time", "collisions", "kinetic_energy", "events",
         "idle" (no event will ever happen); a run cut short carries the samples so far in
         its exception's ``.trajectory``, with "error" or, after Ctrl-C, "interrupted"
+    angular_velocities : (T, N) in 2D, (T, N, 3) in 3D, or None if not stored
+    rotational_energy : (T,) total rotational energy sum I w^2 / 2, or None (a
+        trajectory made without it)
     masses, radii, lower, upper, boundary : copied from the scene
     scene_parameters : dict, the run's scene's parameters other than the positions and
         velocities (radii, masses, box, boundary, restitutions, contact_duration, ...), as
         the Scene keeps them (the box as its corners (lower, upper))
-    temperature : (T,) granular temperature, an energy
+    temperature : (T,) granular temperature, an energy (translational)
+    rotational_temperature : (T,) T_rot = 2 E_rot / (d_rot N), d_rot = 1 in 2D, 3 in 3D
+    temperature_ratio : (T,) T_rot / T
     tamsd_lags : (T - 1,) the lags of ``tamsd()`` by default
     """
 
@@ -71,6 +76,8 @@ class Trajectory:
     stress_collisional: NDArray[np.float64] | None
     kinetic_time_tensor: NDArray[np.float64] | None
     kinetic_tensor: NDArray[np.float64] | None
+    angular_velocities: NDArray[np.float64] | None
+    rotational_energy: NDArray[np.float64] | None
     masses: NDArray[np.float64]
     radii: NDArray[np.float64]
     lower: NDArray[np.float64]
@@ -101,6 +108,8 @@ class Trajectory:
         stress_collisional: NDArray[np.float64] | None = None,
         kinetic_time_tensor: NDArray[np.float64] | None = None,
         kinetic_tensor: NDArray[np.float64] | None = None,
+        angular_velocities: NDArray[np.float64] | None = None,
+        rotational_energy: NDArray[np.float64] | None = None,
     ) -> None:
         # read-only views: a caller writing into an array the trajectory hands out gets a
         # ValueError instead of changing the trajectory unseen
@@ -117,6 +126,8 @@ class Trajectory:
             stress_collisional=stress_collisional,
             kinetic_time_tensor=kinetic_time_tensor,
             kinetic_tensor=kinetic_tensor,
+            angular_velocities=angular_velocities,
+            rotational_energy=rotational_energy,
             masses=masses,
             radii=radii,
             lower=lower,
@@ -202,6 +213,19 @@ class Trajectory:
 
     def _parameters_dict(self) -> dict[str, Any]:
         return dict(self._parameters)
+
+    @property
+    def rotational_temperature(self) -> NDArray[np.float64]:
+        """(T,) rotational temperature T_rot = 2 E_rot / (d_rot N) = <I w^2> / d_rot, d_rot =
+        1 in 2D (the spin along z), 3 in 3D (Huthmann & Zippelius 1997), k_B = 1."""
+        rot = self._need("rotational_energy")
+        return 2.0 * rot / ((1 if self.dim == 2 else 3) * self.n)
+
+    @property
+    def temperature_ratio(self) -> NDArray[np.float64]:
+        """(T,) T_rot / T_tr, the rotational over the translational temperature."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return self.rotational_temperature / self.temperature
 
     @property
     def collisions_per_particle(self) -> NDArray[np.float64]:

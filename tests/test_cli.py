@@ -142,6 +142,14 @@ REPRODUCE_MARGINS = {
     # step error and the runs start in the stationary state, whose MSD reaches the plateau
     # up to exp(-k t / (m gamma0)) terms far below the error at the plateau times used
     "langevin.trap.": 0.0,
+    # rough particles (reproduce_rough) against the Maxwellian theory, which neglects the
+    # velocity-spin correlations and non-Gaussian tails of the cooling state: the full
+    # reproduction's 3D ratios lie 1.7-2.8% below it (40 runs), the disks' 0.5%, Walton's
+    # 0.2% below its mean field (whose Monte Carlo is good to ~0.2%): margin 4%.  The cooling
+    # rows are the largest deviation from theory (theory 0): their error bars alone
+    "rough.temperature_ratio.": 0.04,
+    "rough.walton": 0.04,
+    "rough.cooling.": 0.0,
 }
 # <v^2> is not a comparison: the theory row is the runs' own temperature, so they agree to
 # rounding (checked as such)

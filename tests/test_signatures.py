@@ -18,7 +18,9 @@ from granular.errors import shown
 pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 
 # what may come before the keyword-only parameters
-THEORY_INDEPENDENT = {"t", "lag", "speed", "eta", "box", "temperature", "height", "stiffness"}
+THEORY_INDEPENDENT = {
+    "t", "lag", "speed", "eta", "box", "temperature", "height", "stiffness", "collisions"
+}  # fmt: skip
 PLOT_X = {"times", "velocities", "positions", "traj"}
 
 # names the package used, or a user might reach for, for a quantity that has another name
@@ -179,6 +181,10 @@ VALID = {
     "strength": 0.5,
     "approximation": "linear",
     "kick": 0.05,
+    "collisions": 3.0,
+    "tangential_restitution": 0.5,
+    "inertia_factor": 0.4,
+    "rotational_temperature0": 0.1,
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],
@@ -187,6 +193,8 @@ BAD = {
     "restitution": [1.5, -0.1, math.nan],
     "packing": [1.0, -0.1],
     "dim": [1, 4],
+    "beta": [1.5, -1.5, math.nan],
+    "inertia": [0.0, 1.5, math.nan],
 }
 
 

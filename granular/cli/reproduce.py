@@ -10,7 +10,8 @@ Public entry points
     then the experiments beyond the thesis, each in its own module ``reproduce_<name>``:
     ``"transport"`` (elastic viscosity and self-diffusion), ``"langevin-forces"`` (the
     Langevin model in a harmonic trap), ``"driven"`` (a2 of the cooling and the white-noise
-    driven state, the driven temperature).
+    driven state, the driven temperature), ``"rough"`` (rough spheres and disks: T_rot/T_tr,
+    the coupled cooling, Walton's rule).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -694,6 +695,13 @@ def _fig_driven(cfg, out):
     return reproduce_driven._fig_driven(cfg, out, **_tools())
 
 
+def _fig_rough(cfg, out):
+    """Rough spheres: see ``reproduce_rough``."""
+    from . import reproduce_rough
+
+    return reproduce_rough._fig_rough(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -707,6 +715,7 @@ FIGURES = {
     "transport": _fig_transport,
     "langevin-forces": _fig_langevin_forces,
     "driven": _fig_driven,
+    "rough": _fig_rough,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -727,6 +736,11 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "transport": ("elastic hard spheres: Green-Kubo viscosity and self-diffusion", 30.0, 8.0),
     "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),
     "driven": ("a2 of cooling and white-noise driven gases, driven temperature", 101.6, 18.7),
+    "rough": (
+        "rough spheres: T_rot / T_tr against beta, coupled cooling, Walton's rule",
+        31.0,
+        9.2,
+    ),
 }
 
 

@@ -68,6 +68,13 @@ from .msd import (
     msd_langevin,
     msd_logarithmic,
 )
+from .rough import (
+    RoughCoefficients,
+    rough_coefficients,
+    rough_cooling,
+    rough_temperature_ratio,
+    rough_temperatures,
+)
 from .sonine import (
     driven_temperature,
     sonine_a2_cooling,
@@ -125,6 +132,7 @@ __all__ = [
     "AKappa",
     "FloatOrArray",
     "LangevinCoefficients",
+    "RoughCoefficients",
     "barometric_density",
     "collision_frequency",
     "collision_time",
@@ -159,6 +167,10 @@ __all__ = [
     "packing_fraction",
     "powerlaw_udsbm_increment_msd",
     "powerlaw_udsbm_moments",
+    "rough_coefficients",
+    "rough_cooling",
+    "rough_temperature_ratio",
+    "rough_temperatures",
     "shear_mode_growth",
     "shear_mode_level",
     "shear_viscosity",

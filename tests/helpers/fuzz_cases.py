@@ -807,6 +807,34 @@ LATER_KINDS = {
     "threads": (_langevin_params, THREADS_MUTATIONS),
 }
 LATER_SHARE = 0.2  # of the cases
+
+
+def _rough_params(rng):
+    """A scene of rough particles: spins, a tangential restitution, maybe Walton's rule."""
+    p = _scene_params(rng)
+    n, dim = p["velocities"].shape
+    p["angular_velocities"] = rng.normal(size=(n,) if dim == 2 else (n, 3)) * 5.0
+    p["tangential_restitution"] = float(rng.choice([-1.0, 0.0, 0.5, 1.0]))
+    p["inertia_factor"] = [None, 0.4, 1.0][int(rng.integers(3))]
+    p["friction"] = float(rng.choice([INF, INF, 0.2]))
+    return p
+
+
+ROUGH_MUTATIONS = [
+    _set("tangential_restitution", [*EXTREME, -1.1, 1.1, 1 + 1e-16, "0.5", None, 1j]),
+    _set("inertia_factor", [*EXTREME, 1.5, 1 + 1e-16, "x", 1j]),
+    _set("friction", [*EXTREME, "x", None]),
+    _entry("angular_velocities", EXTREME),
+    _shape("angular_velocities"),
+    _set("angular_velocities", [*EXTREME, *WRONG_TYPES]),
+    _set("restitution", [0.0, 0.5]),
+    _scale(1e-150),
+    _scale(1e150),
+    _overlap("touching"),
+]
+# Rough particles, from a stream of their own (the others' cases stay as they were).
+ROUGH_KINDS = {"rough": (_rough_params, ROUGH_MUTATIONS)}
+ROUGH_SHARE = 0.06
 # Langevin runs whose scales are near the ends of float64, from a third stream of their own
 # (the first stream's cases stay as they were, fewer by this share).
 SCALE_KINDS = {"langevin": (_langevin_params, LANGEVIN_SCALE_MUTATIONS)}
@@ -841,12 +869,14 @@ def make_cases(seed, count):
     """``count`` cases as dicts {kind, params, labels}, the same for the same seed."""
     later, scales = int(LATER_SHARE * count), int(SCALE_SHARE * count)
     stress = int(STRESS_SHARE * count)
-    first = _draw(np.random.default_rng(seed), KINDS, count - later - scales - stress)
+    rough = int(ROUGH_SHARE * count)
+    first = _draw(np.random.default_rng(seed), KINDS, count - later - scales - stress - rough)
     return (
         first
         + _draw(np.random.default_rng([seed, 1]), LATER_KINDS, later, ("threads",))
         + _draw(np.random.default_rng([seed, 2]), SCALE_KINDS, scales, ("langevin",))
         + _draw(np.random.default_rng([seed, 3]), STRESS_KINDS, stress)
+        + _draw(np.random.default_rng([seed, 4]), ROUGH_KINDS, rough)
     )
 
 
@@ -912,8 +942,8 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
             _check(np.all(np.isfinite(sim.stats[name])), f"non-finite stats {name}")
     stats = {
         k: v
-        for k, v in sim.stats.items()  # pressure: NaN is a documented answer
-        if k != "pressure" and isinstance(v, (int, float, np.number))
+        for k, v in sim.stats.items()  # pressure, temperature_ratio: NaN is a documented answer
+        if k not in ("pressure", "temperature_ratio") and isinstance(v, (int, float, np.number))
     }
     _check(all(math.isfinite(v) for v in stats.values()), f"non-finite stats: {stats}")
     if scene.shear_rate != 0.0:
@@ -936,10 +966,18 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
                 boundary=scene.boundary,
             )
     _ = sim.scene  # the final state, checked the same way (the property builds a Scene)
-    elastic = scene.driving is None and (
-        scene.restitution == 1 and (scene.boundary == "periodic" or scene.wall_restitution == 1)
+    from granular._rough import rough_keeps_energy
+
+    elastic = (
+        scene.driving is None
+        and scene.restitution == 1
+        and (scene.boundary == "periodic" or scene.wall_restitution == 1)
+        and rough_keeps_energy(scene)
     )
     e = np.asarray(traj.kinetic_energy, dtype=float)
+    if traj.rotational_energy is not None:  # rough particles trade the two
+        _check(np.all(np.isfinite(traj.rotational_energy)), "non-finite rotational energy")
+        e = e + np.asarray(traj.rotational_energy, dtype=float)
     if elastic and len(e):
         drift = np.max(np.abs(e - e[0])) / e[0] if e[0] > 0 else np.max(np.abs(e))
         _check(drift <= ENERGY_RTOL, f"elastic run: kinetic energy drifted by {drift:.3g}")
@@ -1088,6 +1126,8 @@ def run_case(case):
             if "again" in p:
                 traj = sim.run(**p["again"], stop_when={"events": EVENTS})
                 _check_trajectory(scene, traj, sim)
+        elif kind == "rough":
+            _run_scene(Scene(**p))
         elif kind == "table":
             law = granular.TabulatedRestitution(p["speeds"], p["values"])
             _run_scene(Scene(**dict(p["scene"], **{p["side"]: law})))

@@ -8,7 +8,14 @@ granular.restitution's laws are, evaluated with NumPy): eps(|dv . n|) for a pair
 for a wall.
 
 A scene's random driving (granular.driving) is its kicks as events, from the engine's
-random numbers (csrc/drive.h): the same pairs, times and velocity changes."""
+random numbers (csrc/drive.h): the same pairs, times and velocity changes.
+
+Rough particles (``spin`` given: (N,) in 2D, (N, 3) in 3D): the impulse P at the contact
+point is found the obvious way, from rigid-body mechanics alone -- the contact point's
+relative velocity g(P) after an impulse P (dv = +-P / m, dw = (contact - centre) x (+-P) /
+I) is affine in P; P solves g(P) = -xi g_n - beta g_t (Huthmann & Zippelius 1997), and
+under Walton's Coulomb rule its tangential part is cut to mu |P_n| where it exceeds that.
+Walls are smooth."""
 
 import itertools
 import math
@@ -40,9 +47,58 @@ def pair_times(x, v, r, L, periodic):
     return best
 
 
+def rough_impulse(dr, vi, vj, wi, wj, ri, rj, mi, mj, q, xi, beta, mu):
+    """The impulse on j (-P on i) of a rough collision, 3-vectors (a 2D pair embedded with
+    its spins along z), dr = x_j - x_i at contact."""
+    n = dr / np.sqrt(np.dot(dr, dr))
+    inertia_i, inertia_j = q * mi * ri**2, q * mj * rj**2
+
+    def g(P):  # j's surface velocity at the contact point less i's, after an impulse P
+        vi2, vj2 = vi - P / mi, vj + P / mj
+        wi2 = wi + np.cross(ri * n, -P) / inertia_i
+        wj2 = wj + np.cross(-rj * n, P) / inertia_j
+        return (vj2 + np.cross(wj2, -rj * n)) - (vi2 + np.cross(wi2, ri * n))
+
+    g0 = g(np.zeros(3))
+    a = np.column_stack([g(e) - g0 for e in np.eye(3)])
+    gn = np.dot(g0, n) * n
+    want = -xi * gn - beta * (g0 - gn)
+    P = np.linalg.solve(a, want - g0)
+    pn = np.dot(P, n) * n
+    pt = P - pn
+    limit = mu * np.sqrt(np.dot(pn, pn))
+    size = np.sqrt(np.dot(pt, pt))
+    if size > limit:  # Coulomb: sliding
+        P = pn + pt * (limit / size)
+    return P
+
+
+def rough_collide(dr, vi, vj, wi, wj, ri, rj, mi, mj, q, xi, beta, mu, dim):
+    """Velocities and spins after a rough collision (``rough_impulse``): (vi, vj, wi, wj),
+    spins as the engine keeps them (2D: scalars, 3D: 3-vectors)."""
+
+    def vec(u):
+        return np.append(np.asarray(u, float), 0.0) if dim == 2 else np.asarray(u, float)
+
+    def spin(w):
+        return np.array([0.0, 0.0, float(w)]) if dim == 2 else np.asarray(w, float)
+
+    dr3, vi3, vj3, wi3, wj3 = vec(dr), vec(vi), vec(vj), spin(wi), spin(wj)
+    P = rough_impulse(dr3, vi3, vj3, wi3, wj3, ri, rj, mi, mj, q, xi, beta, mu)
+    n = dr3 / np.sqrt(np.dot(dr3, dr3))
+    wi3 = wi3 + np.cross(ri * n, -P) / (q * mi * ri**2)
+    wj3 = wj3 + np.cross(-rj * n, P) / (q * mj * rj**2)
+    vi3, vj3 = vi3 - P / mi, vj3 + P / mj
+    if dim == 2:
+        return vi3[:2], vj3[:2], wi3[2], wj3[2]
+    return vi3, vj3, wi3, wj3
+
+
 def run_scene(scene, t_stop, sample_times, tensors=None):
     """``run`` for a granular.Scene: its state, box, restitution and wall restitution
-    (``run_sheared`` for a sheared one, which sums no tensors)."""
+    (``run_sheared`` for a sheared one, which sums no tensors); for rough particles
+    (tangential_restitution > -1) positions, velocities and spins."""
+    rough = getattr(scene, "tangential_restitution", -1.0) != -1.0
     if getattr(scene, "shear_rate", 0.0) != 0.0:
         if tensors is not None:
             raise NotImplementedError("the sheared reference sums no stress tensors")
@@ -73,6 +129,10 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
         wall_e=scene.wall_restitution,
         tensors=tensors,
         driving=scene.driving,
+        spin=np.array(scene.angular_velocities) if rough else None,
+        beta=scene.tangential_restitution,
+        q=scene.inertia_factor,
+        mu=scene.friction,
     )
 
 
@@ -116,18 +176,36 @@ def kick(driving, v, m, k):
 
 
 def run(
-    x, v, r, m, lo, hi, periodic, xi, t_stop, sample_times, wall_e=1.0, tensors=None, driving=None
+    x,
+    v,
+    r,
+    m,
+    lo,
+    hi,
+    periodic,
+    xi,
+    t_stop,
+    sample_times,
+    wall_e=1.0,
+    tensors=None,
+    driving=None,
+    spin=None,
+    beta=-1.0,
+    q=0.4,
+    mu=np.inf,
 ):
     """Positions (unwrapped) and velocities at sample_times.  A dict ``tensors`` gets the
     stress tensor's parts at the sample times: "collisional" (sum over pair collisions of
     dr_a dp_b, dr = x_j - x_i, dp j's momentum change) and "kinetic_time" (the integral of
     sum m v_a v_b over time, summed step by step).  ``driving`` (a granular.WhiteNoise or
-    PairThermostat): its kicks, drawn as csrc/drive.c draws them."""
+    PairThermostat): its kicks, drawn as csrc/drive.c draws them.  With ``spin``, the spins
+    too (a third array returned)."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
+    w = None if spin is None else spin.astype(float).copy()
     L = hi - lo
     image = np.zeros_like(x)
     t = 0.0
-    out_x, out_v = [], []
+    out_x, out_v, out_w = [], [], []
     samples = list(sample_times)
     d = x.shape[1]
     coll, kin_time = np.zeros((d, d)), np.zeros((d, d))
@@ -145,15 +223,17 @@ def run(
             with np.errstate(divide="ignore", invalid="ignore"):
                 up = np.where(v > 0, (hi - r[:, None] - x) / v, np.inf)
                 down = np.where(v < 0, (lo + r[:, None] - x) / v, np.inf)
-            w = np.minimum(up, down)
-            k = np.unravel_index(np.argmin(w), w.shape)
-            t_wall, wall = max(w[k], 0.0), k
+            wt = np.minimum(up, down)
+            k = np.unravel_index(np.argmin(wt), wt.shape)
+            t_wall, wall = max(wt[k], 0.0), k
         is_kick = t_kick - t < min(t_pair, t_wall)
         dt = min(t_pair, t_wall, t_kick - t)
         while samples and samples[0] <= min(t + dt, t_stop):
             ts = samples.pop(0)
             out_x.append(x + v * (ts - t) + image * L)
             out_v.append(v.copy())
+            if w is not None:
+                out_w.append(w.copy())
             coll_out.append(coll.copy())
             kin_out.append(kin_time + kin * (ts - t))
         if t + dt > t_stop:
@@ -175,6 +255,13 @@ def run(
                 dr -= L * np.round(dr / L)
             dv = v[j] - v[i]
             eps = _eps(xi, -np.dot(dv, dr) / np.sqrt(np.dot(dr, dr)))
+            if w is not None:
+                vj_before = v[j].copy()
+                v[i], v[j], w[i], w[j] = rough_collide(
+                    dr, v[i], v[j], w[i], w[j], r[i], r[j], m[i], m[j], q, eps, beta, mu, d
+                )
+                coll += np.outer(dr, m[j] * (v[j] - vj_before))
+                continue
             f = (1 + eps) * np.dot(dv, dr) / (np.dot(dr, dr) * (m[i] + m[j]))
             v[i] += f * m[j] * dr
             v[j] -= f * m[i] * dr
@@ -187,6 +274,8 @@ def run(
     if tensors is not None:
         tensors["collisional"] = np.array(coll_out)
         tensors["kinetic_time"] = np.array(kin_out)
+    if w is not None:
+        return np.array(out_x), np.array(out_v), np.array(out_w)
     return np.array(out_x), np.array(out_v)
 
 
