@@ -490,8 +490,9 @@ def _scene(
 ) -> Any:
     """Frame ``k``'s state (at time ``t``) as a Scene (``make_scene``: the Scene class) with
     the run's parameters ``p`` (and spins ``w``, if the file has them), which checks it as
-    every scene is checked (finite, the scales, inside the box, no overlaps).  A sheared box's (csrc/boundary.h) positions are
-    brought into the box through its images at t, and the Scene gets the offset then."""
+    every scene is checked (finite, the scales, inside the box, no overlaps).  A sheared
+    box's (csrc/boundary.h) positions are brought into the box through its images at t, and
+    the Scene gets the offset then."""
     if p.get("shear_rate", 0.0) != 0.0 and np.all(np.isfinite(x)):
         lower, upper = p["box"]
         rate, d0 = p["shear_rate"], p["shear_offset"]
