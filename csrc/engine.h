@@ -57,6 +57,8 @@ struct gr_edmd {
     double kinetic;       /* total kinetic energy, updated by differences at each collision */
     double kinetic_time;  /* integral of the total kinetic energy over time, for the pressure */
     int64_t law_clamped;  /* collisions past a viscoelastic law's range (restitution.h) */
+    double wall_work;      /* vibrating wall (vibwall.h): the work it did on the particles */
+    double collision_loss; /* vibrating wall: the energy collisions dissipated */
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "engine.h"
+#include "vibwall.h"
 
 /* A restitution law (restitution.h) the engine can evaluate: kind known, parameters
  * finite and in range, a table increasing in speed with values in [0, 1]. */
@@ -48,6 +49,60 @@ static int validate_law(const gr_law *law, gr_error *err)
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, law->kind, "unknown kind of restitution law");
         return GR_ERR_VALUE;
     }
+}
+
+/* A vibrating wall (vibwall.h) the engine can run: on a walled box's axis, its numbers
+ * finite and positive, a particle's width of room between the wall at its innermost and the
+ * opposite face, and every particle on the box's side of the wall at t = 0 (with slack for
+ * the rounding of a phase carried over from a running engine: Simulation.scene). */
+static int validate_vibwall(const gr_edmd_config *cfg, const double *pos, const double *radius,
+                            double sigma_max, gr_error *err)
+{
+    const gr_vibwall *w = &cfg->vib;
+    const char *why = NULL;
+    double value = NAN;
+    if (cfg->periodic) why = "a vibrating wall needs walls (boundary='walls')";
+    else if (w->axis < 0 || w->axis >= cfg->dim) {
+        why = "a vibrating wall's axis must be 0 .. dim - 1";
+        value = w->axis;
+    } else if (w->side != 0 && w->side != 1) {
+        why = "a vibrating wall's side must be 0 (lower) or 1 (upper)";
+        value = w->side;
+    } else if (w->waveform != GR_WAVE_SINE && w->waveform != GR_WAVE_TRIANGLE) {
+        why = "a vibrating wall's waveform must be sine or triangle";
+        value = w->waveform;
+    } else if (!(w->amplitude > 0.0 && isfinite(w->amplitude))) {
+        why = "a vibrating wall's amplitude must be positive and finite";
+        value = w->amplitude;
+    } else if (!(w->omega > 0.0 && isfinite(w->omega) && isfinite(w->amplitude * w->omega) &&
+                 isfinite(w->amplitude * w->omega * w->omega))) {
+        why = "a vibrating wall's angular frequency must be positive and finite (and A omega^2 too)";
+        value = w->omega;
+    } else if (!isfinite(w->phase)) {
+        why = "a vibrating wall's phase must be finite";
+        value = w->phase;
+    } else if (!(2.0 * w->amplitude + sigma_max < cfg->hi[w->axis] - cfg->lo[w->axis])) {
+        why = "a vibrating wall's sweep (2 A) plus the largest diameter must be less than the "
+              "box's length along its axis: the wall at its innermost must leave room for a "
+              "particle";
+        value = w->amplitude;
+    }
+    if (why) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, value, why);
+        return GR_ERR_VALUE;
+    }
+    const int a = w->axis, d = cfg->dim;
+    const double X = vw_position(w, cfg->lo[a], cfg->hi[a], 0.0);
+    const double slack = 1e-12 * (cfg->hi[a] - cfg->lo[a]) + 0x1p-24 * w->amplitude;
+    for (int32_t i = 0; i < (int32_t)cfg->n; i++) {
+        const double x = pos[(size_t)i * d + a], r = radius[i];
+        if (w->side ? x + r > X + slack : x - r < X - slack) {
+            gr_error_set(err, GR_ERR_OUTSIDE, i, -1, NAN, x,
+                         "it crosses the vibrating wall (at its position at t = 0)");
+            return GR_ERR_OUTSIDE;
+        }
+    }
+    return GR_OK;
 }
 
 int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const double *vel,
@@ -149,6 +204,7 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
             }
         }
     }
+    if (cfg->vib.on) return validate_vibwall(cfg, pos, radius, sigma_max, err);
     return GR_OK;
 }
 

@@ -29,6 +29,7 @@ from .restitution import ConstantRestitution, TabulatedRestitution, Viscoelastic
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory, read
+from .walls import VibratingWall
 
 __version__ = "0.1.0"
 
@@ -79,6 +80,7 @@ __all__ = [
     "TabulatedRestitution",
     "Trajectory",
     "UnstableStepError",
+    "VibratingWall",
     "Viscoelastic",
     "analysis",
     "clustering",

@@ -29,6 +29,7 @@ import numpy as np
 from ._params import check_positive
 from ._scales import SCALE_HI, SCALE_LO
 from .restitution import ConstantRestitution, RestitutionLaw, engine_law
+from .walls import check_scene_wall, engine_wall
 
 BOUNDARIES = ("periodic", "walls")
 
@@ -328,6 +329,19 @@ PARAMETERS: tuple[SceneParameter, ...] = (
         "elastic, which prevents inelastic collapse.  0 turns it off.",
         _contact_duration,
         _same("contact_duration"),
+    ),
+    SceneParameter(
+        "vibrating_wall",
+        "VibratingWall or None",
+        None,
+        None,
+        "",
+        "A wall of a walled box moving along its axis (``granular.VibratingWall``: axis, "
+        "side, amplitude, angular frequency, phase, sine or triangle wave), reflecting in "
+        "its own frame with ``wall_restitution``; the wall sweeps 2A inwards from its face.  "
+        "None: every wall fixed.",
+        check_scene_wall,
+        engine_wall,
     ),
 )
 

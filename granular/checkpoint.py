@@ -43,7 +43,8 @@ from ._files import check_kind, write_atomic
 from ._npz import check_members, open_regular, read_header, read_member
 from ._scene_params import PARAMETERS, shape_of
 from .errors import CheckpointError, GranularError
-from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
+from .restitution import TABLE_MAX, heats, loses_energy
+from .walls import describe, from_description
 from .scene import Scene
 
 

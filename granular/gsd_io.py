@@ -35,8 +35,8 @@ The exact float64 (and int64) values granular reads back live in the log section
   ``RUN_PARAMETERS``), each attribute the Scene keeps it in under its own name: ``lower``,
   ``upper``, ``radii``, ``masses``, ``boundary``, ``wall_restitution``, ``restitution``,
   ``contact_duration``, ... .  Arrays and numbers are float64 (a number of shape (1,)), a
-  string UTF-8 bytes, a restitution law the UTF-8 bytes of its JSON description
-  (``restitution.describe``, as checkpoints store it).  They are written and read by
+  string UTF-8 bytes, a restitution law or a vibrating wall the UTF-8 bytes of its JSON
+  description (``walls.describe``, as checkpoints store it; no vibrating wall: no field).  They are written and read by
   iterating the declaration, each read back through its declared check: a parameter
   declared later needs no change here, and a file without it (written before) reads with
   its default.  Layout 1 from the start: the parameters after ``boundary`` were added
@@ -63,7 +63,7 @@ from ._files import atomic_target, check_kind
 from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, split
 from .errors import GSDFileError
 from .interop import box_lengths_3d
-from .restitution import RestitutionLaw, describe, from_description
+from .walls import describe, from_description, is_described
 
 FORMAT = 1  # the version of the log layout above
 _COUNTERS = (
@@ -114,7 +114,7 @@ def _encode(value: Any) -> np.ndarray:
     its JSON description (``restitution.describe``, as checkpoints store it)."""
     if isinstance(value, str):
         return _text(value)
-    if isinstance(value, RestitutionLaw):
+    if is_described(value):  # a restitution law or a vibrating wall
         return _text(json.dumps(describe(value)))
     return np.atleast_1d(np.asarray(value, dtype=np.float64))
 
@@ -187,6 +187,8 @@ def _frame(hoomd, traj, k, lower, upper):
         params = traj.scene_parameters
         for p in RUN_PARAMETERS:
             for field, value in split(p, params[p.name]).items():
+                if value is None:  # an absent option (no vibrating wall): its default
+                    continue
                 log[f"granular/{field}"] = _encode(value)
     frame.log = log
     return frame
@@ -353,7 +355,8 @@ def _decode(f: _File, name: str, default: Any) -> Any:
     try:
         return from_description(json.loads(text))
     except (ValueError, TypeError, RecursionError) as exc:
-        raise f.error(0, name, f"is not a restitution law's description ({exc})") from exc
+        kind = "vibrating wall's" if name.endswith("vibrating_wall") else "restitution law's"
+        raise f.error(0, name, f"is not a {kind} description ({exc})") from exc
 
 
 def _wrap_checked(f: _File, k: int, x: np.ndarray, p: dict[str, Any]) -> np.ndarray:
@@ -379,8 +382,11 @@ def _scene(
 ) -> Any:
     """Frame ``k``'s state as a Scene (``make_scene``: the Scene class) with the run's
     parameters ``p``, which checks it as every scene is checked (finite, the scales, inside
-    the box, no overlaps)."""
+    the box, no overlaps).  A vibrating wall's phase is moved on to the frame's time
+    (``VibratingWall.at_time``: where the wall was then)."""
     x = _wrap_checked(f, k, x, p)
+    if p.get("vibrating_wall") is not None:
+        p = {**p, "vibrating_wall": p["vibrating_wall"].at_time(f.array(k, _log("time"), (1,))[0])}
     try:
         return make_scene(x, v, **p)
     except (ValueError, TypeError) as exc:

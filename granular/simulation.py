@@ -189,7 +189,12 @@ class Simulation:
         collisions' virial.  In a periodic box V is the box volume.  In a walled box the
         walls' virial is -P d V_reach, so V is the volume the centres reach, the box shrunk
         by one radius at each face (see ``Trajectory.pressure``: exact for equal radii,
-        approximate for mixtures)."""
+        approximate for mixtures).  With a vibrating wall (``granular.VibratingWall``) also
+        wall_work, the work it did on the particles (the sum over its hits of J U, J the
+        normal impulse it gave and U its velocity then), and collision_loss, the kinetic
+        energy dissipated by pair and wall collisions (a heated wall's gain counts as a
+        negative loss): the kinetic energy changed by wall_work - collision_loss since the
+        start, up to rounding."""
         c = self._engine.counters()
         s = self._initial
         if c["time"] > 0:
@@ -200,13 +205,19 @@ class Simulation:
         else:
             c["pressure"] = float("nan")
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
+        if s.vibrating_wall is None:  # kept by the engine only where a wall vibrates
+            del c["wall_work"], c["collision_loss"]
         return c
 
     @property
     def scene(self) -> Scene:
-        """The current state as a new Scene (positions wrapped into a periodic box)."""
+        """The current state as a new Scene (positions wrapped into a periodic box; a
+        vibrating wall's phase moved on to the current time, ``VibratingWall.at_time``)."""
         pos, vel, _ = self._engine.state()
-        return self._initial.replace(positions=pos, velocities=vel)
+        wall = self._initial.vibrating_wall
+        if wall is not None:
+            wall = wall.at_time(self.time)
+        return self._initial.replace(positions=pos, velocities=vel, vibrating_wall=wall)
 
     @property
     def unwrapped_positions(self) -> NDArray[np.float64]:
