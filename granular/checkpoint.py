@@ -44,8 +44,8 @@ from ._npz import check_members, open_regular, read_header, read_member
 from ._scene_params import PARAMETERS, shape_of
 from .errors import CheckpointError, GranularError
 from .restitution import TABLE_MAX, heats, loses_energy
-from .walls import describe, from_description
 from .scene import Scene
+from .walls import describe, from_description
 
 
 class _Run(Protocol):

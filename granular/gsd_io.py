@@ -36,11 +36,12 @@ The exact float64 (and int64) values granular reads back live in the log section
   ``upper``, ``radii``, ``masses``, ``boundary``, ``wall_restitution``, ``restitution``,
   ``contact_duration``, ... .  Arrays and numbers are float64 (a number of shape (1,)), a
   string UTF-8 bytes, a restitution law or a vibrating wall the UTF-8 bytes of its JSON
-  description (``walls.describe``, as checkpoints store it; no vibrating wall: no field).  They are written and read by
-  iterating the declaration, each read back through its declared check: a parameter
-  declared later needs no change here, and a file without it (written before) reads with
-  its default.  Layout 1 from the start: the parameters after ``boundary`` were added
-  beside the fields earlier readers read, and they read these files still.
+  description (``walls.describe``, as checkpoints store it; no vibrating wall: no field).
+  They are written and read by iterating the declaration, each read back through its
+  declared check: a parameter declared later needs no change here, and a file without it
+  (written before) reads with its default.  Layout 1 from the start: the parameters after
+  ``boundary`` were added beside the fields earlier readers read, and they read these files
+  still.
 
 (gsd >= 4 can write the HOOMD fields in float64, but OVITO and older gsd and HOOMD read
 float32 ones: the standard fields stay float32 and the exact values go in the log.)
