@@ -69,11 +69,23 @@ static inline double vw_wave(const gr_vibwall *w, double theta)
     return u < 0.25 ? 4.0 * u : u < 0.75 ? 2.0 - 4.0 * u : 4.0 * u - 4.0;
 }
 
-/* f'(theta). */
+/* The triangle wave's cycle position for its slope and kinks: within GR_VW_KINK (of a
+ * cycle) before a kink counts as past it.  The search steps to a kink and must then see
+ * the next piece, where rounding may leave it a hair short. */
+#define GR_VW_KINK 1e-12
+static inline double vw_piece(double theta)
+{
+    const double u = vw_cycle(theta);
+    return (0.25 - u >= 0.0 && 0.25 - u < GR_VW_KINK) || (0.75 - u >= 0.0 && 0.75 - u < GR_VW_KINK)
+               ? u + GR_VW_KINK
+               : u;
+}
+
+/* f'(theta) (the triangle's slope of the piece ahead at a kink). */
 static inline double vw_wave_slope(const gr_vibwall *w, double theta)
 {
     if (w->waveform == GR_WAVE_SINE) return cos(theta);
-    const double u = vw_cycle(theta);
+    const double u = vw_piece(theta);
     return (u < 0.25 || u >= 0.75) ? 2.0 / GR_VW_PI : -2.0 / GR_VW_PI;
 }
 
@@ -94,15 +106,13 @@ static inline double vw_velocity(const gr_vibwall *w, double t)
     return w->amplitude * w->omega * vw_wave_slope(w, vw_theta(w, t));
 }
 
-/* The time from t to the triangle wave's next kink (where its velocity flips), at least a
- * thousandth of a quarter period (a kink closer than rounding is taken as passed); +inf
- * for the sine. */
+/* The time from t to the triangle wave's next kink (where its velocity flips; one within
+ * GR_VW_KINK counts as passed, as for vw_wave_slope); +inf for the sine. */
 static inline double vw_to_kink(const gr_vibwall *w, double t)
 {
     if (w->waveform == GR_WAVE_SINE) return INFINITY;
-    const double u = vw_cycle(vw_theta(w, t));
-    double next = u < 0.25 ? 0.25 : u < 0.75 ? 0.75 : 1.25;
-    if (next - u < 1e-12) next += 0.5;
+    const double u = vw_piece(vw_theta(w, t));
+    const double next = u < 0.25 ? 0.25 : u < 0.75 ? 0.75 : 1.25;
     return (next - u) * (2.0 * GR_VW_PI) / w->omega;
 }
 
