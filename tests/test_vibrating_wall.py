@@ -10,6 +10,7 @@ import pytest
 
 import granular
 from granular import Scene, Simulation, VibratingWall
+
 from helpers import reference_edmd, vibwall_reference
 
 R = 0.01
