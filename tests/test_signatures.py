@@ -18,7 +18,7 @@ from granular.errors import shown
 pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 
 # what may come before the keyword-only parameters
-THEORY_INDEPENDENT = {"t", "lag", "speed", "eta", "box", "temperature"}
+THEORY_INDEPENDENT = {"t", "lag", "speed", "eta", "box", "temperature", "peak_velocity"}
 PLOT_X = {"times", "velocities", "positions", "traj"}
 
 # names the package used, or a user might reach for, for a quantity that has another name
@@ -171,6 +171,10 @@ VALID = {
     "v0_sq": 0.5,
     "order": 1,
     "points": 50,
+    "peak_velocity": 0.5,
+    "wall_restitution": 0.9,
+    "waveform": "sine",
+    "height": 0.9,
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],

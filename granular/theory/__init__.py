@@ -82,6 +82,13 @@ from .udsbm import (
     udsbm_increment_msd,
     udsbm_v0_sq,
 )
+from .vibrated import (
+    DILUTE_EXPONENT,
+    WARR_HUNTLEY_JACQUES_EXPONENT,
+    vibrated_temperature,
+    wall_power,
+    wall_power_leading,
+)
 from .viscoelastic import (
     VISCOELASTIC_C1,
     VISCOELASTIC_C2,
@@ -100,8 +107,10 @@ from .viscoelastic import (
 )
 
 __all__ = [
+    "DILUTE_EXPONENT",
     "VISCOELASTIC_C1",
     "VISCOELASTIC_C2",
+    "WARR_HUNTLEY_JACQUES_EXPONENT",
     "AKappa",
     "FloatOrArray",
     "LangevinCoefficients",
@@ -140,6 +149,7 @@ __all__ = [
     "udsbm_ergodicity_breaking",
     "udsbm_increment_msd",
     "udsbm_v0_sq",
+    "vibrated_temperature",
     "viscoelastic_cooling_rate",
     "viscoelastic_cooling_time",
     "viscoelastic_delta",
@@ -149,6 +159,8 @@ __all__ = [
     "viscoelastic_temperature",
     "viscoelastic_temperature_second_order",
     "wall_adsorption",
+    "wall_power",
+    "wall_power_leading",
 ]
 
 # the public names say they are granular.theory's (where the API reference lists them and
