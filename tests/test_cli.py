@@ -127,6 +127,14 @@ REPRODUCE_MARGINS = {
     # dt: 2.2e-5 relative in <x^2> at dt = 0.05 for a = 5/6 (docs/powerlaw_udsbm.md), ours is
     # dt = 0.04 tau0' = 0.048; bound 1e-3
     "visco.udsbm.": 0.001,
+    # the vibrated gas's T against the uniform-gas energy balance (reproduce_vibrated): an
+    # estimate that ignores the gas being hotter and thinner at the vibrating wall and the
+    # wall's finite excursion; measured 5-9% above it: margin 12%.  Its exponent against the
+    # dilute 2: the excursion A / (s / omega) ~ V / s ~ 0.4 at every V (T ~ V^2), so it
+    # shifts T alike and the exponent little; margin 2%.  The power balance is exact.
+    "vibrated.temperature.": 0.12,
+    "vibrated.temperature_exponent": 0.02,
+    "vibrated.power_balance": 0.0,
 }
 # <v^2> is not a comparison: the theory row is the runs' own temperature, so they agree to
 # rounding (checked as such)

@@ -6,7 +6,8 @@ Public entry points
     The experiments in the thesis' order, by name: ``"4.1"``, ``"4.2-4.4"``, ``"4.5-4.7"``,
     ``"4.8+4.10"``, ``"4.9"``, ``"4.11-4.16+F"``, ``"4.17-4.23"``, then ``"clustering"``
     (where the homogeneous cooling of Fig. 4.10 ends; ``reproduce_clustering``) and
-    ``"viscoelastic"`` (the viscoelastic gas and its power-law UDSBM; ``reproduce_visco``).
+    ``"viscoelastic"`` (the viscoelastic gas and its power-law UDSBM; ``reproduce_visco``),
+    ``"vibrated"`` (a gas kept hot by a vibrating wall; ``reproduce_vibrated``).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -669,6 +670,13 @@ def _fig_visco(cfg, out):
     return reproduce_visco._fig_visco(cfg, out, **_tools())
 
 
+def _fig_vibrated(cfg, out):
+    """A gas kept hot by a vibrating wall: see ``reproduce_vibrated``."""
+    from . import reproduce_vibrated
+
+    return reproduce_vibrated._fig_vibrated(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -679,6 +687,7 @@ FIGURES = {
     "4.17-4.23": _fig_4_17_to_4_23,
     "clustering": _fig_clustering,
     "viscoelastic": _fig_visco,
+    "vibrated": _fig_vibrated,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -696,6 +705,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
+    "vibrated": ("a gas between a vibrating and a fixed wall: T against V, energy balance", 0, 0),
 }
 
 
