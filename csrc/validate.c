@@ -78,8 +78,10 @@ static int validate_vibwall(const gr_edmd_config *cfg, const double *pos, const 
                  isfinite(w->amplitude * w->omega * w->omega))) {
         why = "a vibrating wall's angular frequency must be positive and finite (and A omega^2 too)";
         value = w->omega;
-    } else if (!isfinite(w->phase)) {
-        why = "a vibrating wall's phase must be finite";
+    } else if (!(fabs(w->phase) <= 2.0 * GR_VW_PI)) {
+        /* the wall is timed by omega t + phase: a large phase's rounding would swamp it
+         * (granular.VibratingWall keeps its phase modulo 2 pi) */
+        why = "a vibrating wall's phase must lie in [-2 pi, 2 pi]";
         value = w->phase;
     } else if (!(2.0 * w->amplitude + sigma_max < cfg->hi[w->axis] - cfg->lo[w->axis])) {
         why = "a vibrating wall's sweep (2 A) plus the largest diameter must be less than the "

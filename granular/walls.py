@@ -52,7 +52,7 @@ class VibratingWall:
     angular_frequency : float
         omega > 0 [1 / (L sqrt(m/eps))]: the period is 2 pi / omega.
     phase : float, default 0.0
-        phi [rad] at t = 0.
+        phi [rad] at t = 0, kept modulo 2 pi (``math.fmod``: the sign stays).
     waveform : {"sine", "triangle"}, default "sine"
         f = sin, or the symmetric triangle wave with the same period, peaks and phase.
     """
@@ -82,6 +82,9 @@ class VibratingWall:
         phase = float(self.phase)
         if not math.isfinite(phase):
             raise ValueError(f"VibratingWall's phase must be finite, got {self.phase!r}")
+        # kept modulo 2 pi: the engine times the wall by omega t + phase, whose rounding a
+        # phase of 1e16 (ulp 2 rad) would swamp
+        phase = math.fmod(phase, 2.0 * math.pi)
         if not (math.isfinite(amplitude * omega) and math.isfinite(amplitude * omega * omega)):
             raise ValueError(
                 f"VibratingWall's peak speed A omega = {amplitude:g} * {omega:g} and "

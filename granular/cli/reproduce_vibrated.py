@@ -84,13 +84,15 @@ def _fig_vibrated(cfg, out, *, ensemble, save, fig, row, mean_row):
     names, rows)."""
     runs = RUNS
     velocities = np.array([a * OMEGA for a in AMPLITUDES])
-    temps, errs, balance = [], [], []
+    t_list: list[float] = []
+    e_list: list[float] = []
+    balance: list[float] = []
     rows = []
     for k, a in enumerate(AMPLITUDES):
         results = [_steady(a, 100 * k + s, cfg.quick) for s in range(runs)]
         T = np.array([r[0] for r in results])
-        temps.append(T.mean())
-        errs.append(T.std(ddof=1) / math.sqrt(runs))
+        t_list.append(float(T.mean()))
+        e_list.append(float(T.std(ddof=1) / math.sqrt(runs)))
         balance.extend(r[1] for r in results)
         V = a * OMEGA
         predicted = _balance(V)
@@ -104,7 +106,7 @@ def _fig_vibrated(cfg, out, *, ensemble, save, fig, row, mean_row):
                 theory_value=predicted,
             )
         )
-    temps, errs = np.array(temps), np.array(errs)
+    temps, errs = np.array(t_list), np.array(e_list)
     # weighted least squares of ln T on ln V (sigma of ln T = err / T)
     x, y, w = np.log(velocities), np.log(temps), (temps / errs) ** 2
     xm = np.sum(w * x) / np.sum(w)

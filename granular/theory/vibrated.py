@@ -46,7 +46,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import optimize, special
 
 from .._params import keyword_only
 from ._numerics import FloatOrArray, _check_dim
@@ -71,6 +70,8 @@ def _wall_velocities(peak_velocity, waveform):
 
 def _incoming_moment(U, s):
     """I(U) = int_{v < U} (U - v)^2 f(v) dv for f the Maxwellian of standard deviation s."""
+    from scipy import special  # at call time: `import granular` does not load SciPy
+
     z = U / s
     return (
         s
@@ -199,6 +200,8 @@ def vibrated_temperature(
             dim=dim,
         )
         return math.log(gain) - math.log(height * dim * density * t / tau0)
+
+    from scipy import optimize
 
     # the loss grows as T^(3/2), the gain as T^(1/2) (then slower): one crossing
     t_guess = mass * peak_velocity**2
