@@ -274,3 +274,15 @@ def test_a_frequency_float64_cannot_time_is_refused():
     assert sim.stats["events"] == 0
     assert wall.max_time == pytest.approx(2**26 / 1e12)
     sim.run(t_stop=0.5 * wall.max_time, store=())  # within reach: runs
+
+
+def test_a_large_phase_is_kept_modulo_two_pi_and_the_engine_refuses_one():
+    """The wall is timed by omega t + phase: a phase of 1e16 (ulp 2 rad) would swamp it.
+    VibratingWall keeps it modulo 2 pi; the binding, given one directly, refuses it."""
+    wall = VibratingWall(1, "lower", 0.1, 1.0, phase=1e16)
+    assert abs(wall.phase) <= 2 * math.pi
+    assert wall.phase == math.fmod(1e16, 2 * math.pi)
+    keywords = _walled(vibrating_wall=wall)._engine_keywords()
+    keywords["vibrating_wall"] = dict(keywords["vibrating_wall"], phase=1e16)
+    with pytest.raises(ValueError, match=r"phase must lie in \[-2 pi, 2 pi\]"):
+        granular._core.edmd_check(**keywords)
