@@ -100,7 +100,16 @@ def _fault(sim: _Run) -> str | None:
     start = sim._initial
     e0, e = start.kinetic_energy, now.kinetic_energy
     periodic = start.boundary == "periodic"
-    if periodic or not heats(start.wall_restitution):
+    if start.vibrating_wall is not None:  # it heats: the energy must be its bookkeeping's
+        c = sim._engine.counters()
+        work, loss = c["wall_work"], c["collision_loss"]
+        scale = max(e0, e, abs(work), abs(loss))
+        if not abs(e - e0 - (work - loss)) <= _CONSERVED_RTOL * scale:
+            return (
+                f"its kinetic energy {e:.6g} is not the initial {e0:.6g} plus the vibrating "
+                f"wall's work {work:.6g} less the collisions' loss {loss:.6g}"
+            )
+    elif periodic or not heats(start.wall_restitution):
         if e > e0 * (1.0 + _CONSERVED_RTOL):
             return (
                 f"its kinetic energy {e:.6g} exceeds the initial scene's {e0:.6g}, which "

@@ -286,3 +286,25 @@ def test_a_large_phase_is_kept_modulo_two_pi_and_the_engine_refuses_one():
     keywords["vibrating_wall"] = dict(keywords["vibrating_wall"], phase=1e16)
     with pytest.raises(ValueError, match=r"phase must lie in \[-2 pi, 2 pi\]"):
         granular._core.edmd_check(**keywords)
+
+
+def test_a_gas_the_wall_heated_saves_and_loads(tmp_path):
+    """The wall adds energy: a checkpoint's energy check is its bookkeeping (the initial
+    energy plus the work less the loss), not the bound that holds without heating; a state
+    whose energy does not match it is refused."""
+    s = _gas("lower", "sine", 1.0, 1.0, n=20, seed=6, radius=0.03)
+    s = s.replace(velocities=0.3 * s.velocities)  # slower than the wall: it heats the gas
+    sim = Simulation(s)
+    sim.run(t_stop=5.0, store=())
+    assert sim.scene.kinetic_energy > 1.5 * s.kinetic_energy
+    sim.save(tmp_path / "hot.npz")
+    loaded = Simulation.load(tmp_path / "hot.npz")
+    a = sim.run(t_stop=6.0, sample_times=[6.0])
+    b = loaded.run(t_stop=6.0, sample_times=[6.0])
+    assert np.array_equal(a.positions, b.positions)
+    from granular import checkpoint
+
+    assert checkpoint._fault(loaded) is None
+    sneaky = Simulation(s.replace(velocities=2.0 * s.velocities))  # same scene, other energy
+    sneaky._initial = s
+    assert "wall's work" in checkpoint._fault(sneaky)
