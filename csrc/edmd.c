@@ -399,7 +399,9 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
  * normal impulse it gives) and the energy lost, m (1 - e_w^2) |v - U|^2 / 2, are counted
  * (wall_work, collision_loss: the kinetic energy changes by exactly their difference).  A
  * particle found not approaching the wall (a graze at the scale of rounding) is left as it
- * is and predicted again from t: the search then starts beyond the touch. */
+ * is and predicted again from t: the search then starts beyond the touch; so is one that
+ * only enters the wall's band (vibwall.h: the search for the contact starts there).  Both
+ * count as stale events. */
 static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, int32_t i,
                                        double t, gr_error *err)
 {
@@ -408,7 +410,9 @@ static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, i
     const int a = w->axis;
     move(dyn, dim, p, t);
     const double U = vw_velocity(w, t), vn = v[a], rel = vn - U;
-    if (!((w->side ? -rel : rel) < 0.0)) {
+    /* entering the wall's band (the search starts now), or a graze at rounding's scale */
+    if (!vw_touching(w, s->cfg.lo[a], s->cfg.hi[a], t, p[a], vn, RAD(p, dim)) ||
+        !((w->side ? -rel : rel) < 0.0)) {
         s->invalid++;
         predict(s, dyn, dim, i);
         return GR_OK;

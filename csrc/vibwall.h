@@ -20,8 +20,10 @@
  * (h stays above that parabola), so stepping by it never passes a hit; near a transversal
  * root the steps converge quadratically (they are Newton steps with a safety margin), and
  * the search ends when a step no longer moves the absolute time (full precision) or the
- * gap is no longer positive while approaching.  Outside the wall's band of reach the
- * particle flies to the band's edge in one step (fl_wall_time).  Grazing: where the gap is
+ * gap is no longer positive while approaching.  A particle outside the wall's band of reach
+ * is predicted to reach the band's face (fl_wall_time: one division), where an event that
+ * is no contact (vw_touching) starts the search: most particles are far from the wall, and
+ * their predictions then cost what a fixed wall's do.  Grazing: where the gap is
  * within the rounding of positions (tol) and not closing, the search steps on by at least
  * sqrt(2 tol / K), in which the gap cannot fall below -tol: a touch shallower than the
  * rounding of the coordinates is not a hit; any deeper one is found.
@@ -124,6 +126,27 @@ static inline double vw_phase_resolution(const gr_vibwall *w, double t)
     return w->omega * (nextafter(fabs(t), INFINITY) - fabs(t));
 }
 
+/* The rounding of a gap to the wall near time t: of the coordinates and of the wall's
+ * position (A times the rounding of its phase). */
+static inline double vw_tol(const gr_vibwall *w, double lo, double hi, double t)
+{
+    return 16.0 * DBL_EPSILON * (fabs(lo) + fabs(hi) + w->amplitude * (1.0 + fabs(vw_theta(w, t))));
+}
+
+/* Whether a particle (coordinate x, velocity v along the wall's axis, radius r, at time t)
+ * whose predicted wall event is now touches the wall: the search (vw_hit_time) predicts
+ * contacts and, for a particle outside the wall's band, the time it enters the band, where
+ * the gap is wider than a contact's rounding (the coordinates', and the closing speed times
+ * the time's). */
+static inline int vw_touching(const gr_vibwall *w, double lo, double hi, double t, double x,
+                              double v, double r)
+{
+    const double sigma = w->side ? -1.0 : 1.0, U = vw_velocity(w, t);
+    const double h = sigma * (x - vw_position(w, lo, hi, t)) - r;
+    const double ulp = nextafter(fabs(t), INFINITY) - fabs(t);
+    return h <= vw_tol(w, lo, hi, t) + 4.0 * (fabs(v) + fabs(U)) * ulp;
+}
+
 /* Iterations of the search before it gives up and returns where it stands (an event there
  * finds the particle not approaching and searches again from that later time: progress,
  * never a missed hit).  Reached only in pathological cases: a prediction takes a few
@@ -133,7 +156,8 @@ static inline double vw_phase_resolution(const gr_vibwall *w, double t)
 
 /* The time from the particle's clock t0 (normal coordinate x0, velocity v0 along the
  * wall's axis a, radius r) to its first contact with the vibrating wall w of the box
- * [lo, hi] along a, approaching it; +inf if there is none. */
+ * [lo, hi] along a, approaching it, or the time it enters the wall's band if it is outside
+ * (vw_touching tells the two apart); +inf if there is neither. */
 static inline double vw_hit_time(const gr_vibwall *w, int dyn, int a, double lo, double hi,
                                  double t0, double x0, double v0, double r)
 {
@@ -144,8 +168,7 @@ static inline double vw_hit_time(const gr_vibwall *w, int dyn, int a, double lo,
     const double band = w->side ? hi - 2.0 * A - r : lo + 2.0 * A + r;
     const double K = vw_normal_accel(dyn, a) +
                      (w->waveform == GR_WAVE_SINE ? A * w->omega * w->omega : 0.0);
-    const double tol = 16.0 * DBL_EPSILON *
-                       (fabs(lo) + fabs(hi) + A * (1.0 + fabs(vw_theta(w, t0))));
+    const double tol = vw_tol(w, lo, hi, t0);
     const double min_step = K > 0.0 ? sqrt(2.0 * tol / K) : 0.0;
     double tau = 0.0;
     for (int it = 0; it < GR_VIB_MAX_STEPS; it++) {
@@ -157,10 +180,10 @@ static inline double vw_hit_time(const gr_vibwall *w, int dyn, int a, double lo,
             const int which = w->side ? fl_wall_time(dyn, x, v, -INFINITY, band, &dt)
                                       : fl_wall_time(dyn, x, v, band, INFINITY, &dt);
             if (which != w->side || !(dt < INFINITY)) return INFINITY;
-            if (dt > 0.0 && t0 + (tau + dt) > t0 + tau) {
-                tau += dt;
-                continue;
-            }
+            /* the time it enters the band: an event there (vw_touching says it is no
+             * contact) starts the exact search, so that a particle far from the wall costs
+             * one division per prediction, not a search */
+            if (dt > 0.0 && t0 + (tau + dt) > t0 + tau) return tau + dt;
         }
         const double t = t0 + tau;
         const double h = sigma * (x - vw_position(w, lo, hi, t)) - r;
