@@ -705,7 +705,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
-    "vibrated": ("gas between a vibrating and a fixed wall: T against V, balance", 40.0, 12.0),
+    "vibrated": ("gas between a vibrating and a fixed wall: T against V, balance", 25.4, 12.0),
 }
 
 

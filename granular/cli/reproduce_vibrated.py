@@ -7,7 +7,7 @@ Registered (``"vibrated"`` in ``reproduce.FIGURES``), no gravity:
   0.01 in the unit box (area fraction 0.063), xi = 0.99, elastic walls, the lower wall a
   sine of angular frequency ``OMEGA`` = 250 and amplitude A = 0.001, 0.002, 0.004 (peak
   speeds V = 0.25, 0.5, 1; A far below the mean free path, ~0.09).  Each of ``RUNS`` runs
-  settles for 300 collisions per particle (quick: 100), then the time-averaged kinetic
+  settles for 300 collisions per particle (quick: 150), then the time-averaged kinetic
   energy over 1500 (quick: 250) gives its temperature T = <E> / N (2D); the rows
   give T at each V (mean and standard error over runs) against ``theory.vibrated_temperature``
   (the balance of the wall's input with Haff's loss for a uniform gas: an estimate, the gas
@@ -41,7 +41,7 @@ RUNS = 10  # per amplitude (the reproduction's rows want >= 10 for Student-t err
 
 def _lengths(quick):
     """Collisions per particle to settle, then to measure over."""
-    return (100, 250) if quick else (300, 1500)
+    return (150, 250) if quick else (300, 1500)
 
 
 def _balance(peak_velocity):
@@ -58,7 +58,7 @@ def _steady(amplitude, seed, quick, gravity=None):
     a = amplitude
     wall = VibratingWall(1, "lower", a, OMEGA)
     # started near the balance's temperature: the gas relaxes in ~1 / (1 - xi^2) = 50
-    # collisions per particle, well within the settling (quick: 100)
+    # collisions per particle, well within the settling (quick: 150)
     start = Scene.random(
         N, RADIUS, dim=2, box=((0.0, 2 * a), (1.0, 1.0)), boundary="walls",
         temperature=_balance(a * OMEGA), seed=seed,
