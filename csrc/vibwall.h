@@ -30,7 +30,9 @@
  *
  * The contract with the dynamics (flight.h).  The search uses only fl_at, fl_vel_at (the
  * normal coordinate and velocity after tau), fl_wall_time (reaching a plane: the band's
- * edge) and vw_normal_accel below (a bound on |dv/dtau| along the axis).  Constant velocity:
+ * edge; it is given +-inf as the stop on the side it does not ask about, which must come
+ * out as never reached, and it must answer the first crossing of the plane asked about,
+ * from either side) and vw_normal_accel below (a bound on |dv/dtau| along the axis).  Constant velocity:
  * 0.  A uniform field g adds |g[axis]| there and needs nothing else: the same search then
  * times a vibrating floor under gravity (the parabola bound holds for any |h''| <= K). */
 #ifndef GR_VIBWALL_H
