@@ -194,7 +194,8 @@ class Simulation:
         normal impulse it gave and U its velocity then), and collision_loss, the kinetic
         energy dissipated by pair and wall collisions (a heated wall's gain counts as a
         negative loss): the kinetic energy changed by wall_work - collision_loss since the
-        start, up to rounding."""
+        start, up to rounding; its stale_events also count a particle's arrival at the band
+        the wall sweeps, where the exact search for its hit starts (docs/vibrated.md)."""
         c = self._engine.counters()
         s = self._initial
         if c["time"] > 0:
