@@ -151,6 +151,24 @@ def _fig_vibrated(cfg, out, *, ensemble, save, fig, row, mean_row):
     return [save(f, out, "vibrated_temperature.png")], rows
 
 
+def notes(by_id):
+    """Sentences for report.md's vibrated section, conditional on the rows."""
+    text = [
+        "The temperatures are compared with the energy balance of a uniform gas "
+        "(theory.vibrated_temperature), an estimate: the gas is hotter and thinner at the "
+        "vibrating wall, and the wall's excursion is ~0.4 of a thermal flight per period; "
+        "docs/vibrated.md."
+    ]
+    alpha = by_id.get("vibrated.temperature_exponent")
+    if alpha is not None:
+        text.append(
+            f"T ~ V^{alpha['ours']:.3f}: the dilute theory's 2 (Kumaran 1998); the dense bed of "
+            "Warr, Huntley & Jacques (1995), under gravity, gave 1.41 +- 0.11, an experiment this "
+            "gas without gravity does not repeat."
+        )
+    return text
+
+
 def temperature_scaling_under_gravity(gravity=-1.0, amplitudes=(0.002, 0.004, 0.008), quick=False):
     """The vibrated bed under gravity (NOT registered: needs the engine's ``gravity`` scene
     parameter): T against V = A omega at fixed omega, returning (velocities, temperatures,
