@@ -217,6 +217,31 @@ static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject
     return 0;
 }
 
+/* A vibrating wall from None (none: *w zeroed) or a dict {axis, side, waveform, amplitude,
+ * omega, phase} as granular/walls.py builds it (VibratingWall._engine).  Returns 0, or -1
+ * with an exception set.  The engine checks the values (validate.c). */
+static int parse_vibwall(PyObject *obj, gr_vibwall *w)
+{
+    static char *names[] = {"axis", "side", "waveform", "amplitude", "omega", "phase", NULL};
+    memset(w, 0, sizeof *w);
+    if (obj == Py_None) return 0;
+    if (!PyDict_Check(obj)) {
+        PyErr_SetString(PyExc_TypeError, "vibrating_wall must be None or a dict of axis, side, "
+                                         "waveform, amplitude, omega and phase");
+        return -1;
+    }
+    PyObject *none = PyTuple_New(0);
+    if (!none) return -1;
+    int ok = PyArg_ParseTupleAndKeywords(none, obj, "|$iiiddd:vibrating_wall", names, &w->axis,
+                                         &w->side, &w->waveform, &w->amplitude, &w->omega,
+                                         &w->phase) &&
+             require_keywords(NULL, obj, names, 6, "vibrating_wall") == 0;
+    Py_DECREF(none);
+    if (!ok) return -1;
+    w->on = 1;
+    return 0;
+}
+
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
  * exception set. */
@@ -229,9 +254,9 @@ static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject
 static char *edmd_names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                              "periodic", GR_SCENE_DOUBLES(NAME_OF) "cell_factor", "big_ratio",
                              "shell", "law", "wall_law", "stress", "angular_velocities",
-                             NULL};
+                             "vibrating_wall", NULL};
 #define EDMD_REQUIRED (7 GR_SCENE_DOUBLES(COUNT_OF))
-#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOOpO"
+#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOOpOO"
 
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
@@ -241,6 +266,7 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
 {
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None;
     PyObject *ospin = Py_None; /* rough particles' angular velocities, or None: smooth */
+    PyObject *ovib = Py_None;
     gr_edmd_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.cell_factor = 1.0;
@@ -252,10 +278,11 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
                                      edmd_names, &opos, &ovel, &orad, &omass, &olo, &ohi,
                                      &cfg.periodic, GR_SCENE_DOUBLES(ADDRESS_OF) &cfg.cell_factor,
                                      &cfg.big_ratio, &cfg.shell, &olaw, &owall, &cfg.stress,
-                                     &ospin) ||
+                                     &ospin, &ovib) ||
         require_keywords(args, kw, edmd_names, EDMD_REQUIRED, sim ? "EDMD" : "edmd_check") < 0)
         return -1;
 #undef ADDRESS_OF
+    if (parse_vibwall(ovib, &cfg.vib) < 0) return -1;
     gr_law law, wall_law;
     PyArrayObject *law_x = NULL, *law_y = NULL, *wall_x = NULL, *wall_y = NULL;
     if (parse_law(olaw, "law", &law, &law_x, &law_y) < 0) return -1;
@@ -554,7 +581,7 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
     gr_edmd_counters c;
     gr_edmd_get_counters(self->sim, &c);
 #define NINE(x) x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7], x[8]
-    PyObject *out = Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d,s:d,s:L,s:d}", "time", c.t,
+    PyObject *out = Py_BuildValue("{s:d,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:L,s:d,s:d,s:d,s:d,s:(iii),s:d,s:d,s:L,s:d,s:d,s:d}", "time", c.t,
                          "events", (long long)c.events, "pair_collisions", (long long)c.pair,
                          "wall_collisions", (long long)c.wall, "cell_crossings",
                          (long long)c.crossings, "shell_exits", (long long)c.shell_exits,
@@ -565,7 +592,8 @@ static PyObject *EDMD_counters(EDMDObject *self, PyObject *Py_UNUSED(ignored))
                          "kinetic_time_integral", c.kinetic_time, "cells",
                          c.ncell[0], c.ncell[1], c.ncell[2], "shell", c.shell,
                          "shear_work", c.shear_work, "kicks", (long long)c.kicks,
-                         "drive_energy", c.drive_energy);
+                         "drive_energy", c.drive_energy, "wall_work", c.wall_work,
+                         "collision_loss", c.collision_loss);
     /* the stress tensor's parts: nine numbers each, of which the first dim * dim are the
      * dim x dim tensor row-major (zeros unless built with stress) */
     PyObject *st = out ? Py_BuildValue("{s:(ddddddddd),s:(ddddddddd),s:(ddddddddd)}",

@@ -182,6 +182,15 @@ static void transfer(cursor *c, gr_edmd *s)
     io_law(c, &cfg->law);
     io_law(c, &cfg->wall_law);
     if (c->law_differs) return; /* read: the rest is not this scene's */
+    IO(c, cfg->vib.on); /* the vibrating wall: compared with the scene's in check_state */
+    IO(c, cfg->vib.axis);
+    IO(c, cfg->vib.side);
+    IO(c, cfg->vib.waveform);
+    IO(c, cfg->vib.amplitude);
+    IO(c, cfg->vib.omega);
+    IO(c, cfg->vib.phase);
+    IO(c, s->wall_work);
+    IO(c, s->collision_loss);
 
     IO(c, s->t);
     IO(c, s->eps_t);
@@ -376,6 +385,10 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         !same_double(a->cell_factor, b->cell_factor) || !same_double(a->big_ratio, b->big_ratio) ||
         !same_double(a->shell, b->shell) || a->stress != b->stress)
         return "its box, restitution, contact duration or engine knobs differ from the scene's";
+    if (a->vib.on != b->vib.on || a->vib.axis != b->vib.axis || a->vib.side != b->vib.side ||
+        a->vib.waveform != b->vib.waveform || !same_double(a->vib.amplitude, b->vib.amplitude) ||
+        !same_double(a->vib.omega, b->vib.omega) || !same_double(a->vib.phase, b->vib.phase))
+        return "its vibrating wall differs from the scene's";
     if (t->nl.broken != 0 && t->nl.broken != 1) return "its neighbour-list flag is corrupt";
 
     /* counters: each starts at 0 and grows by one at a time (order.next: events plus a
@@ -447,6 +460,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
     if (!(t->t >= 0.0 && t->t < INFINITY) || !isfinite(t->eps_t) || !isfinite(t->kinetic) ||
         !isfinite(t->kinetic_time) || !isfinite(t->virial) || !isfinite(t->wall_impulse) ||
         !isfinite(t->shear_work) ||
+        !isfinite(t->wall_work) || !isfinite(t->collision_loss) ||
         t->t_prev_event != t->t_prev_event)
         return "its time or energy counters are not finite";
     if (!(t->stress_t >= 0.0 && t->stress_t <= t->t)) return "its stress tensor's clock is out of range";

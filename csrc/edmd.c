@@ -32,6 +32,7 @@
 #include "rule.h"
 #include "search.h"
 #include "stress.h"
+#include "vibwall.h"
 
 /* Everything an event of particle i is about to read or write, requested at once.  A
  * macro, not a function: GCC takes a function that only prefetches for one without
@@ -98,6 +99,8 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
                            double t, gr_error *err);
 static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up,
                             int32_t old);
+static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, int32_t i,
+                                       double t, gr_error *err);
 
 /* The loop, for dynamics dyn (flight.h: how particles move between events), dimension
  * dim and laws = 0 (constant restitution), 1 (a restitution law, restitution.h) or
@@ -108,7 +111,7 @@ static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, i
  * new one adds its advance_* and its choice in gr_edmd_advance, and no line here). */
 static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, const int laws,
                                     const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                                    gr_error *err)
+                                    gr_error *err, const int vib)
 {
     const double t_stop = stop->t_stop;
     const int64_t n = s->n;
@@ -190,10 +193,17 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
                 predict(s, dyn, dim, i);
                 continue;
             }
+            const double k0 = vib ? s->kinetic : 0.0;
             status = do_pair(s, dyn, dim, laws, i, e->partner, te, err);
+            if (vib) s->collision_loss += k0 - s->kinetic; /* vibwall.h's bookkeeping */
+            check = 1;
+        } else if (vib && -2 - e->partner == 2 * s->cfg.vib.axis + s->cfg.vib.side) {
+            status = do_vibwall(s, dyn, dim, laws, i, te, err);
             check = 1;
         } else {
+            const double k0 = vib ? s->kinetic : 0.0;
             status = do_wall(s, dyn, dim, laws, i, -2 - e->partner, te, err);
+            if (vib) s->collision_loss += k0 - s->kinetic;
             check = 1;
         }
         if (status != GR_OK) return status;
@@ -216,37 +226,67 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
 
 static int advance_2d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 2, 0, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 2, 0, stop, smp, err, 0);
 }
 
 static int advance_3d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 3, 0, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 3, 0, stop, smp, err, 0);
 }
 
 static int advance_2d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 2, 1, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 2, 1, stop, smp, err, 0);
 }
 
 static int advance_3d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err, 0);
+}
+
+/* A vibrating wall's loops (vibwall.h): compiled with the law rule (which takes a
+ * constant restitution from the config as well), so two loops, not four. */
+static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 2, 1, stop, smp, err, 1);
+}
+
+static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err, 1);
+}
+
+/* A vibrating wall's run: refused where float64 cannot time the wall's phase at the end of
+ * the run (or, without a time limit, now): there omega t's rounding, omega ulp(t), passes
+ * GR_VIB_PHASE_RESOLUTION and the wall's position is known to less than A 2^-26. */
+static int advance_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
+{
+    const double t_end = stop->t_stop < INFINITY ? stop->t_stop : s->t;
+    if (!(vw_phase_resolution(&s->cfg.vib, t_end) <= GR_VIB_PHASE_RESOLUTION)) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, t_end, s->cfg.vib.omega,
+                     "float64 cannot time the vibrating wall at this time: its phase omega t "
+                     "would be resolved to worse than 2^-26 radians (omega ulp(t)); a run may "
+                     "last up to about t = 2^26 / omega");
+        return GR_ERR_VALUE;
+    }
+    return s->dim == 2 ? advance_2d_vib(s, stop, smp, err) : advance_3d_vib(s, stop, smp, err);
 }
 
 /* Rough particles (rule.h): the law rule's code with the tangential impulse and spins. */
 static int advance_2d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                             gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 2, GR_RULE_ROUGH, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 2, GR_RULE_ROUGH, stop, smp, err, 0);
 }
 
 static int advance_3d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                             gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err);
+    return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err, 0);
 }
 
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
@@ -267,6 +307,7 @@ int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
     if (s->spin) /* a scene with spins: the rough rule, with or without laws */
         return s->dim == 2 ? advance_2d_rough(s, stop, smp, err)
                            : advance_3d_rough(s, stop, smp, err);
+    if (s->cfg.vib.on) return advance_vib(s, stop, smp, err);
     if (s->cfg.law.kind != GR_LAW_CONSTANT || s->cfg.wall_law.kind != GR_LAW_CONSTANT)
         return s->dim == 2 ? advance_2d_law(s, stop, smp, err) : advance_3d_law(s, stop, smp, err);
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
@@ -402,6 +443,70 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
     s->wall++;
     s->sched[i].count++;
     s->sched[i].last = -2 - wall;
+    if (streak(s, i, t)) {
+        gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), -1, t, (double)GR_COLLAPSE_STREAK,
+                     GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
+                     "each within 1e-9 of a free-flight time of the previous");
+        predict(s, dyn, dim, i);
+        return GR_ERR_COLLAPSE;
+    }
+    predict(s, dyn, dim, i);
+    return GR_OK;
+}
+
+/* A hit on the vibrating wall (vibwall.h) at t: the particle is reflected in the wall's
+ * frame -- its velocity relative to the wall, U along the axis, mirrored and scaled by e_w
+ * as at a fixed wall (thesis 2.22) -- and placed on the wall.  The wall's work J U (J the
+ * normal impulse it gives) and the energy lost, m (1 - e_w^2) |v - U|^2 / 2, are counted
+ * (wall_work, collision_loss: the kinetic energy changes by exactly their difference).  A
+ * particle found not approaching the wall (a graze at the scale of rounding) is left as it
+ * is and predicted again from t: the search then starts beyond the touch; so is one that
+ * only enters the wall's band (vibwall.h: the search for the contact starts there).  Both
+ * count as stale events. */
+static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, int32_t i,
+                                       double t, gr_error *err)
+{
+    const gr_vibwall *w = &s->cfg.vib;
+    double *p = rec(s, dim, i), *v = VEL(p, dim);
+    const int a = w->axis;
+    move(dyn, dim, p, t);
+    const double U = vw_velocity(w, t), vn = v[a], rel = vn - U;
+    /* entering the wall's band (the search starts now), or a graze at rounding's scale */
+    if (!vw_touching(w, s->cfg.lo[a], s->cfg.hi[a], t, p[a], vn, RAD(p, dim)) ||
+        !((w->side ? -rel : rel) < 0.0)) {
+        s->invalid++;
+        predict(s, dyn, dim, i);
+        return GR_OK;
+    }
+    const double m = s->mass[i], before = kinetic_of(s, dyn, dim, i);
+    double w2 = 0.0; /* |v - U|^2 */
+    for (int k = 0; k < dim; k++) w2 += k == a ? rel * rel : v[k] * v[k];
+    double vb[3]; /* the velocity before, for the stress tensor */
+    if (s->cfg.stress)
+        for (int k = 0; k < dim; k++) vb[k] = v[k];
+    int64_t clamped;
+    const double ew = rule_wall_eps(&s->cfg, laws, rel, t, &s->sched[i], &clamped);
+    s->law_clamped += clamped;
+    v[a] = rel;
+    rule_wall_apply(dim, v, a, ew);
+    v[a] += U;
+    p[a] = vw_position(w, s->cfg.lo[a], s->cfg.hi[a], t) + (w->side ? -RAD(p, dim) : RAD(p, dim));
+    for (int k = 0; k < dim; k++) {
+        if (!isfinite(v[k])) {
+            gr_error_set(err, GR_ERR_NONFINITE, uid(s, i), -1, t, v[k],
+                         "a velocity after the vibrating wall");
+            return GR_ERR_NONFINITE;
+        }
+    }
+    if (s->cfg.stress) stress_wall(s, dim, t, m, vb, v);
+    const double J = m * (v[a] - vn);
+    s->wall_impulse += fabs(J);
+    s->wall_work += J * U;
+    s->collision_loss += 0.5 * m * (1.0 - ew * ew) * w2;
+    s->kinetic += kinetic_of(s, dyn, dim, i) - before;
+    s->wall++;
+    s->sched[i].count++;
+    s->sched[i].last = -2 - (2 * a + w->side);
     if (streak(s, i, t)) {
         gr_error_set(err, GR_ERR_COLLAPSE, uid(s, i), -1, t, (double)GR_COLLAPSE_STREAK,
                      GR_XSTR(GR_COLLAPSE_STREAK) " successive collisions of one particle, "
@@ -643,6 +748,39 @@ static inline void schedule(gr_edmd *s, int32_t i)
     gr_cq_update(&s->queue, i, e->t_coll < e->t_cross ? e->t_coll : e->t_cross);
 }
 
+/* predict_wall with a vibrating wall: its hit time (vibwall.h), and the fixed walls, its
+ * own face not among them.  A scene without one never comes here (one test of a flag the
+ * walled box's prediction reads anyway). */
+static void predict_wall_vib(gr_edmd *s, int dyn, int dim, int32_t i)
+{
+    const double *p = rec(s, dim, i), *v = VEL(p, dim);
+    const gr_vibwall *w = &s->cfg.vib;
+    gr_sched *e = &s->sched[i];
+    double best = vw_hit_time(w, dyn, w->axis, s->cfg.lo[w->axis], s->cfg.hi[w->axis],
+                              TIME(p, dim), p[w->axis], v[w->axis], RAD(p, dim));
+    int32_t wall = best < INFINITY ? 2 * w->axis + w->side : -1;
+    for (int a = 0; a < dim; a++) {
+        double dt;
+        double lo_stop = bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim));
+        double hi_stop = bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim));
+        if (a == w->axis) { /* the vibrating face is out of reach of this test */
+            if (w->side) hi_stop = INFINITY;
+            else lo_stop = -INFINITY;
+        }
+        const int up = fl_wall_time(dyn, p[a], v[a], lo_stop, hi_stop, &dt);
+        if (up < 0 || !(dt < INFINITY)) continue;
+        if (dt < 0.0) dt = 0.0;
+        if (dt < best) {
+            best = dt;
+            wall = 2 * a + up;
+        }
+    }
+    if (wall >= 0) {
+        e->t_coll = TIME(p, dim) + best;
+        e->partner = -2 - wall;
+    }
+}
+
 /* i's next wall collision (none in a periodic box), replacing its prediction. */
 static inline void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i)
 {
@@ -651,6 +789,10 @@ static inline void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i)
     e->t_coll = INFINITY;
     e->partner = -1;
     if (s->cfg.periodic) return;
+    if (s->cfg.vib.on) {
+        predict_wall_vib(s, dyn, dim, i);
+        return;
+    }
     double best = INFINITY;
     int32_t wall = -1;
     for (int a = 0; a < dim; a++) {

@@ -36,6 +36,19 @@ enum {
     GR_STOP_IDLE = 5        /* no event will ever happen again and t_stop is infinite */
 };
 
+/* A vibrating wall (vibwall.h): the face of `axis` on `side` (0 at lo, 1 at hi) moves as
+ * c + amplitude * f(omega t + phase), f = sin or the triangle wave.  Zeroed: none. */
+enum { GR_WAVE_SINE = 0, GR_WAVE_TRIANGLE = 1 };
+typedef struct {
+    int on;                   /* 1: a vibrating wall; 0: none (the rest unused) */
+    int axis;                 /* 0 .. dim-1 */
+    int side;                 /* 0: the face at lo, 1: at hi */
+    int waveform;             /* GR_WAVE_SINE or GR_WAVE_TRIANGLE */
+    double amplitude;         /* A > 0 (length) */
+    double omega;             /* angular frequency > 0 (1 / time) */
+    double phase;             /* radians, finite */
+} gr_vibwall;
+
 typedef struct {
     int dim;                  /* 2 or 3 */
     int64_t n;                /* number of particles, >= 1 */
@@ -72,6 +85,7 @@ typedef struct {
     const double *spin;       /* NULL: smooth particles.  Else their angular velocities
                                * (n in 2D, n x 3 in 3D), and the rough rule; gr_edmd_new
                                * copies them */
+    gr_vibwall vib;           /* a vibrating wall (walls only); vib.on 0: none */
 } gr_edmd_config;
 
 typedef struct {
@@ -122,6 +136,11 @@ typedef struct {
     double kinetic_time;    /* integral over time of the total kinetic energy */
     double shear_work;      /* Lees-Edwards: work of the sliding images, the x momentum
                              * carried across the y faces times the velocity jump u */
+    double wall_work;       /* vibrating wall: sum over its hits of J U (J the normal impulse
+                             * it gives, U its velocity then): the work it did */
+    double collision_loss;  /* vibrating wall: the kinetic energy lost in pair and wall
+                             * collisions (pairs: the energy before less after; walls:
+                             * m (1 - e^2) w^2 / 2, w the speed relative to the wall) */
     int ncell[3];           /* cells per axis */
     double shell;           /* the neighbour lists' shell in largest diameters, 0: none
                              * (a box too small for the shell asked for has none) */

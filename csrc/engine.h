@@ -74,6 +74,8 @@ struct gr_edmd {
     double drive_next;
     int64_t kicks;
     double drive_energy;
+    double wall_work;      /* vibrating wall (vibwall.h): the work it did on the particles */
+    double collision_loss; /* vibrating wall: the energy collisions dissipated */
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are

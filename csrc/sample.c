@@ -144,6 +144,8 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->law_clamped = s->law_clamped;
     c->virial = s->virial;
     c->wall_impulse = s->wall_impulse;
+    c->wall_work = s->wall_work;
+    c->collision_loss = s->collision_loss;
     c->kinetic_time = s->kinetic_time;
     c->shear_work = s->shear_work;
     c->kinetic = kinetic_total(s, dynamics_of(s), s->dim);

@@ -40,6 +40,7 @@ from .restitution import ConstantRestitution, TabulatedRestitution, Viscoelastic
 from .scene import Scene
 from .simulation import Simulation
 from .trajectory import Trajectory, read
+from .walls import VibratingWall
 
 __version__ = "0.1.0"
 
@@ -91,6 +92,7 @@ __all__ = [
     "TabulatedRestitution",
     "Trajectory",
     "UnstableStepError",
+    "VibratingWall",
     "Viscoelastic",
     "WhiteNoise",
     "analysis",

@@ -70,6 +70,16 @@ QUANTITIES: dict[str, Quantity] = {
         "(time/L)^(1/5)",
     ),
     "tracer_radius": Quantity("radius R of a heavy tracer", "L", "positive"),
+    "peak_velocity": Quantity(
+        "a vibrating wall's peak speed V (A omega for a sine)", "sqrt(eps/m)", "nonnegative"
+    ),
+    "wall_restitution": Quantity(
+        "a wall's coefficient of restitution e", "dimensionless", "positive"
+    ),
+    "waveform": Quantity('a vibrating wall\'s motion, "sine" or "triangle"', "-"),
+    "wall_distance": Quantity(
+        "distance between a vibrating wall and the opposite one", "L", "positive"
+    ),
     "tracer_mass": Quantity("mass M of a heavy tracer", "m", "positive"),
     "chi": Quantity("gas density at the tracer's surface over n", "dimensionless", "positive"),
     "diffusion": Quantity(

@@ -30,6 +30,7 @@ from . import driving as _driving
 from ._params import check_positive
 from ._scales import SCALE_HI, SCALE_LO
 from .restitution import ConstantRestitution, RestitutionLaw, engine_law
+from .walls import check_scene_wall, engine_wall
 
 BOUNDARIES = ("periodic", "walls")
 
@@ -497,6 +498,20 @@ PARAMETERS += (
         "``tangential_restitution`` (no Coulomb limit).",
         _friction,
         _same("friction"),
+    ),
+    # a vibrating wall (csrc/vibwall.h; docs/vibrated.md)
+    SceneParameter(
+        "vibrating_wall",
+        "VibratingWall or None",
+        None,
+        None,
+        "",
+        "A wall of a walled box moving along its axis (``granular.VibratingWall``: axis, "
+        "side, amplitude, angular frequency, phase, sine or triangle wave), reflecting in "
+        "its own frame with ``wall_restitution``; the wall sweeps 2A inwards from its face.  "
+        "None: every wall fixed.",
+        check_scene_wall,
+        engine_wall,
     ),
 )
 

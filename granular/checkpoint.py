@@ -44,8 +44,9 @@ from ._npz import check_members, open_regular, read_header, read_member
 from ._rough import rough_keeps_energy
 from ._scene_params import PARAMETERS, shape_of
 from .errors import CheckpointError, GranularError
-from .restitution import TABLE_MAX, describe, from_description, heats, loses_energy
+from .restitution import TABLE_MAX, heats, loses_energy
 from .scene import Scene
+from .walls import describe, from_description
 
 
 class _Run(Protocol):
@@ -104,8 +105,18 @@ def _fault(sim: _Run) -> str | None:
     periodic = start.boundary == "periodic"
     if start.shear_rate != 0.0:
         return _sheared_fault(sim, start, now)
+    if start.vibrating_wall is not None:  # it heats: the energy must be its bookkeeping's
+        c = sim._engine.counters()
+        # (a random driving's kicks add their energy to the wall's work)
+        work, loss = c["wall_work"] + c["drive_energy"], c["collision_loss"]
+        scale = max(e0, e, abs(work), abs(loss))
+        if not abs(e - e0 - (work - loss)) <= _CONSERVED_RTOL * scale:
+            return (
+                f"its kinetic energy {e:.6g} is not the initial {e0:.6g} plus the vibrating "
+                f"wall's work {work:.6g} (with any kicks') less the collisions' loss {loss:.6g}"
+            )
     # (a random driving force adds energy: no bound then)
-    if (periodic or not heats(start.wall_restitution)) and start.driving is None:
+    elif (periodic or not heats(start.wall_restitution)) and start.driving is None:
         if e > e0 * (1.0 + _CONSERVED_RTOL):
             return (
                 f"its kinetic energy {e:.6g} exceeds the initial scene's {e0:.6g}, which "

@@ -47,12 +47,13 @@ The exact float64 (and int64) values granular reads back live in the log section
   ``RUN_PARAMETERS``), each attribute the Scene keeps it in under its own name: ``lower``,
   ``upper``, ``radii``, ``masses``, ``boundary``, ``wall_restitution``, ``restitution``,
   ``contact_duration``, ... .  Arrays and numbers are float64 (a number of shape (1,)), a
-  string UTF-8 bytes, a restitution law the UTF-8 bytes of its JSON description
-  (``restitution.describe``, as checkpoints store it).  They are written and read by
-  iterating the declaration, each read back through its declared check: a parameter
-  declared later needs no change here, and a file without it (written before) reads with
-  its default.  Layout 1 from the start: the parameters after ``boundary`` were added
-  beside the fields earlier readers read, and they read these files still.
+  string UTF-8 bytes, a restitution law or a vibrating wall the UTF-8 bytes of its JSON
+  description (``walls.describe``, as checkpoints store it; no vibrating wall: no field).
+  They are written and read by iterating the declaration, each read back through its
+  declared check: a parameter declared later needs no change here, and a file without it
+  (written before) reads with its default.  Layout 1 from the start: the parameters after
+  ``boundary`` were added beside the fields earlier readers read, and they read these files
+  still.
 
 Rough particles (a trajectory that stored ``angular_velocities``): ``particles/angmom`` and
 ``particles/moment_inertia`` in HOOMD's convention, without orientations (every
@@ -90,7 +91,7 @@ from ._scene_params import REQUIRED, RUN_PARAMETERS, shape_of, spin_shape, split
 from .driving import PairThermostat, WhiteNoise
 from .errors import GSDFileError
 from .interop import box_lengths_3d
-from .restitution import RestitutionLaw, describe, from_description
+from .walls import describe, from_description, is_described
 
 FORMAT = 1  # the version of the log layout above
 _COUNTERS = (
@@ -147,7 +148,8 @@ def _encode(value: Any) -> np.ndarray:
     its JSON description (``restitution.describe``, as checkpoints store it)."""
     if isinstance(value, str):
         return _text(value)
-    if isinstance(value, RestitutionLaw | WhiteNoise | PairThermostat):
+    # a restitution law, a vibrating wall or a random driving
+    if is_described(value) or isinstance(value, WhiteNoise | PairThermostat):
         return _text(json.dumps(describe(value)))
     return np.atleast_1d(np.asarray(value, dtype=np.float64))
 
@@ -232,8 +234,9 @@ def _frame(hoomd, traj, k, lower, upper):
         params = traj.scene_parameters
         for p in RUN_PARAMETERS:
             for field, value in split(p, params[p.name]).items():
-                if value is not None:  # None (no driving) is the default a reader gives
-                    log[f"granular/{field}"] = _encode(value)
+                if value is None:  # an absent option (no driving, no vibrating wall)
+                    continue
+                log[f"granular/{field}"] = _encode(value)
     frame.log = log
     return frame
 
@@ -457,7 +460,8 @@ def _decode(f: _File, name: str, default: Any) -> Any:
     try:
         return from_description(json.loads(text))
     except (ValueError, TypeError, RecursionError) as exc:
-        raise f.error(0, name, f"is not a restitution law's description ({exc})") from exc
+        kind = "vibrating wall's" if name.endswith("vibrating_wall") else "restitution law's"
+        raise f.error(0, name, f"is not a {kind} description ({exc})") from exc
 
 
 def _wrap_checked(f: _File, k: int, x: np.ndarray, p: dict[str, Any]) -> np.ndarray:
@@ -492,7 +496,8 @@ def _scene(
     the run's parameters ``p`` (and spins ``w``, if the file has them), which checks it as
     every scene is checked (finite, the scales, inside the box, no overlaps).  A sheared
     box's (csrc/boundary.h) positions are brought into the box through its images at t, and
-    the Scene gets the offset then."""
+    the Scene gets the offset then.  A vibrating wall's phase is moved on to the frame's
+    time (``VibratingWall.at_time``: where the wall was then)."""
     if p.get("shear_rate", 0.0) != 0.0 and np.all(np.isfinite(x)):
         lower, upper = p["box"]
         rate, d0 = p["shear_rate"], p["shear_offset"]
@@ -502,6 +507,8 @@ def _scene(
         )[0]
         p = {**p, "shear_offset": _shear.offset(rate, d0, lx, ly, t)}
     x = _wrap_checked(f, k, x, p)
+    if p.get("vibrating_wall") is not None:
+        p = {**p, "vibrating_wall": p["vibrating_wall"].at_time(f.array(k, _log("time"), (1,))[0])}
     try:
         if w is not None:
             return make_scene(x, v, angular_velocities=w, **p)

@@ -19,6 +19,7 @@ from ._scene_params import docstring as _parameters_doc
 from .driving import PairThermostat, WhiteNoise
 from .placement import draw_velocities, lattice_order, place_lattice, place_rsa
 from .restitution import RestitutionLaw
+from .walls import VibratingWall
 
 # Random sequential addition jams near these packing fractions (3D ~0.38, 2D ~0.55);
 # above a safe fraction of them Scene.random places on a lattice and melts it instead.
@@ -183,6 +184,7 @@ class Scene:
     tangential_restitution: float
     inertia_factor: float
     friction: float
+    vibrating_wall: VibratingWall | None
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         try:

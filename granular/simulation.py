@@ -221,6 +221,14 @@ class Simulation:
         T_rot / T_tr (NaN when T_tr = 0); for smooth particles their spins' values, which
         never change.
 
+        With a vibrating wall (``granular.VibratingWall``) also
+        wall_work, the work it did on the particles (the sum over its hits of J U, J the
+        normal impulse it gave and U its velocity then), and collision_loss, the kinetic
+        energy dissipated by pair and wall collisions (a heated wall's gain counts as a
+        negative loss): the kinetic energy changed by wall_work - collision_loss since the
+        start, up to rounding; its stale_events also count a particle's arrival at the band
+        the wall sweeps, where the exact search for its hit starts (docs/vibrated.md).
+
         With ``Simulation(stress=True)`` also: stress_collisional, kinetic_time_tensor,
         kinetic_tensor (each d rows of d numbers, a tuple of tuples: ``np.array`` makes
         the matrix; see ``Trajectory``) and pressure_tensor, their average since the start
@@ -267,6 +275,8 @@ class Simulation:
             if c["translational_temperature"] > 0
             else float("nan")
         )
+        if s.vibrating_wall is None:  # kept by the engine only where a wall vibrates
+            del c["wall_work"], c["collision_loss"]
         return c
 
     def _spins(self) -> NDArray[np.float64]:
@@ -278,9 +288,15 @@ class Simulation:
     @property
     def scene(self) -> Scene:
         """The current state as a new Scene (positions wrapped into a periodic box; a
-        sheared box's image offset the one now)."""
+        sheared box's image offset the one now; a vibrating wall's phase moved on to the
+        current time, ``VibratingWall.at_time``)."""
         pos, vel, _ = self._engine.state()
         s = self._initial
+        if s.vibrating_wall is not None:  # (a walled box: never sheared)
+            wall = s.vibrating_wall.at_time(self.time)
+            return s.replace(
+                positions=pos, velocities=vel, angular_velocities=self._spins(), vibrating_wall=wall
+            )
         if s.shear_rate != 0.0:
             offset = shear_offset_at(s, self.time)
             return s.replace(

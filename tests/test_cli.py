@@ -150,6 +150,19 @@ REPRODUCE_MARGINS = {
     "rough.temperature_ratio.": 0.04,
     "rough.walton": 0.04,
     "rough.cooling.": 0.0,
+    # the vibrated gas's T against the uniform-gas energy balance (reproduce_vibrated): an
+    # estimate that ignores the gas being hotter and thinner at the vibrating wall and the
+    # wall's finite excursion; measured 5-9% above it: margin 12%.  Its exponent against the
+    # dilute 2: the excursion A / (s / omega) ~ V / s ~ 0.4 at every V (T ~ V^2), so it
+    # shifts T alike and the exponent little; margin 2%.  The power balance: exact in a
+    # steady state; the runs start uniform at the balance's T, and the profile (hot at the
+    # wall) forms by heat conduction over (H / mean free path)^2 ~ 120 collisions per
+    # particle, which the quick run's 150 of settling do not quite cover: its windows gain
+    # ~1% of their loss (measured 1.010-1.017 +- 0.007; the full run 0.997 +- 0.001):
+    # margin 2%.
+    "vibrated.temperature.": 0.12,
+    "vibrated.temperature_exponent": 0.02,
+    "vibrated.power_balance": 0.02,
 }
 # <v^2> is not a comparison: the theory row is the runs' own temperature, so they agree to
 # rounding (checked as such)

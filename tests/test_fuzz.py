@@ -1,7 +1,8 @@
 """Fuzz: COUNT (1500) seeded random bad and edge inputs to Scene, Scene.random, Simulation.run,
-langevin.run (and its threads=), TabulatedRestitution tables and Simulation.load of damaged or
-crafted checkpoints (tests/helpers/fuzz_cases.py makes them and says what passes). Each ends in
-a clear exception or a result that keeps the invariants -- never a crash, a hang or garbage.
+langevin.run (and its threads=), TabulatedRestitution tables, scenes with a vibrating wall and
+Simulation.load of damaged or crafted checkpoints (tests/helpers/fuzz_cases.py makes them and
+says what passes). Each ends in a clear exception or a result that keeps the invariants --
+never a crash, a hang or garbage.
 
 One worker process runs the cases one after another and answers each over a pipe; a case that
 takes longer than TIMEOUT, or kills the worker (a segfault, an abort under ASan), is recorded
@@ -126,5 +127,15 @@ def test_fuzz_inputs_end_in_a_clear_error_or_a_valid_result():
         f"(tally {dict(tally)}):\n" + "\n".join(failures)
     )
     # not a vacuous run: every entry point both accepted inputs and refused some
-    for kind in ("scene", "random", "run", "langevin", "table", "checkpoint", "threads", "stress"):
+    for kind in (
+        "scene",
+        "random",
+        "run",
+        "langevin",
+        "table",
+        "checkpoint",
+        "threads",
+        "stress",
+        "vibrating",
+    ):
         assert tally[kind, "ok"] >= 10 and tally[kind, "error"] >= 10, dict(tally)

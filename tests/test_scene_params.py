@@ -3,6 +3,7 @@ drives the Scene, the engine's arguments, the checkpoints and GSD files: a param
 one of them but not in the others fails here."""
 
 import inspect
+import math
 
 import numpy as np
 import pytest
@@ -46,8 +47,22 @@ def _examples():
 _PERIODIC_ONLY = {"shear_rate": 0.3, "shear_offset": 0.25}
 
 
+# parameters that take smooth particles (a vibrating wall: the rough loops have none), with
+# their examples; _examples_for gives them the walled examples with smooth particles
+_SMOOTH_ONLY = {"vibrating_wall": granular.VibratingWall(1, "lower", 0.2, 3.0, phase=-np.pi / 2)}
+_SMOOTH = {
+    "angular_velocities": None,
+    "tangential_restitution": -1.0,
+    "inertia_factor": None,
+    "friction": math.inf,
+}
+
+
 def _examples_for(name):
-    """_examples, with ``name``'s example if it needs a periodic box (in one)."""
+    """_examples, with ``name``'s example if it needs a periodic box (in one) or smooth
+    particles (with them)."""
+    if name in _SMOOTH_ONLY:
+        return {**_examples(), **_SMOOTH, name: _SMOOTH_ONLY[name]}
     if name not in _PERIODIC_ONLY:
         return _examples()
     # an offset needs a shear rate; a sheared box takes smooth particles only
@@ -77,7 +92,7 @@ def _same(a, b):
 
 
 def test_every_parameter_has_an_example_unlike_its_default():
-    examples = {**_examples(), **_PERIODIC_ONLY}
+    examples = {**_examples(), **_PERIODIC_ONLY, **_SMOOTH_ONLY}
     assert set(examples) == set(NAMES), "give the new parameter an example value here"
     for p in PARAMETERS:
         assert p.default is REQUIRED or not _same(p.check(p.default, 12, 2), examples[p.name])

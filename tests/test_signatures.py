@@ -19,7 +19,8 @@ pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 
 # what may come before the keyword-only parameters
 THEORY_INDEPENDENT = {
-    "t", "lag", "speed", "eta", "box", "temperature", "height", "stiffness", "collisions"
+    "t", "lag", "speed", "eta", "box", "temperature", "height", "stiffness", "collisions",
+    "peak_velocity",
 }  # fmt: skip
 PLOT_X = {"times", "velocities", "positions", "traj"}
 
@@ -185,6 +186,10 @@ VALID = {
     "tangential_restitution": 0.5,
     "inertia_factor": 0.4,
     "rotational_temperature0": 0.1,
+    "peak_velocity": 0.5,
+    "wall_restitution": 0.9,
+    "waveform": "sine",
+    "wall_distance": 0.9,
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],

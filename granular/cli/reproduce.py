@@ -11,7 +11,8 @@ Public entry points
     ``"transport"`` (elastic viscosity and self-diffusion), ``"langevin-forces"`` (the
     Langevin model in a harmonic trap), ``"driven"`` (a2 of the cooling and the white-noise
     driven state, the driven temperature), ``"rough"`` (rough spheres and disks: T_rot/T_tr,
-    the coupled cooling, Walton's rule).
+    the coupled cooling, Walton's rule), ``"vibrated"`` (a gas kept hot by a vibrating
+    wall).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -702,6 +703,13 @@ def _fig_rough(cfg, out):
     return reproduce_rough._fig_rough(cfg, out, **_tools())
 
 
+def _fig_vibrated(cfg, out):
+    """A gas kept hot by a vibrating wall: see ``reproduce_vibrated``."""
+    from . import reproduce_vibrated
+
+    return reproduce_vibrated._fig_vibrated(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -716,6 +724,7 @@ FIGURES = {
     "langevin-forces": _fig_langevin_forces,
     "driven": _fig_driven,
     "rough": _fig_rough,
+    "vibrated": _fig_vibrated,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -741,6 +750,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
         31.0,
         9.2,
     ),
+    "vibrated": ("gas between a vibrating and a fixed wall: T against V, balance", 25.4, 12.0),
 }
 
 

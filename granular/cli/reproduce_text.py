@@ -231,6 +231,12 @@ def _driven_notes(cfg, by_id):
     return reproduce_driven.driven_notes(by_id)
 
 
+def _vibrated_notes(cfg, by_id):
+    from . import reproduce_vibrated
+
+    return reproduce_vibrated.notes(by_id)
+
+
 # The sections of the report: (title, row id prefix, notes(cfg, by_id) -> sentences)
 SECTIONS = (
     ("Energy (Fig. 4.2)", "energy.", _energy_notes),
@@ -243,6 +249,7 @@ SECTIONS = (
     ("Viscoelastic gases", "visco.", _visco_notes),
     ("The cooling state's velocity distribution (a2)", "hcs.", _hcs_notes),
     ("Gases driven by white noise", "driven.", _driven_notes),
+    ("A gas kept hot by a vibrating wall", "vibrated.", _vibrated_notes),
 )
 
 

@@ -108,6 +108,13 @@ from .udsbm import (
     udsbm_increment_msd,
     udsbm_v0_sq,
 )
+from .vibrated import (
+    DILUTE_EXPONENT,
+    WARR_HUNTLEY_JACQUES_EXPONENT,
+    vibrated_temperature,
+    wall_power,
+    wall_power_leading,
+)
 from .viscoelastic import (
     VISCOELASTIC_C1,
     VISCOELASTIC_C2,
@@ -126,8 +133,10 @@ from .viscoelastic import (
 )
 
 __all__ = [
+    "DILUTE_EXPONENT",
     "VISCOELASTIC_C1",
     "VISCOELASTIC_C2",
+    "WARR_HUNTLEY_JACQUES_EXPONENT",
     "YEH_HUMMER_XI",
     "AKappa",
     "FloatOrArray",
@@ -184,6 +193,7 @@ __all__ = [
     "udsbm_ergodicity_breaking",
     "udsbm_increment_msd",
     "udsbm_v0_sq",
+    "vibrated_temperature",
     "viscoelastic_cooling_rate",
     "viscoelastic_cooling_time",
     "viscoelastic_delta",
@@ -193,6 +203,8 @@ __all__ = [
     "viscoelastic_temperature",
     "viscoelastic_temperature_second_order",
     "wall_adsorption",
+    "wall_power",
+    "wall_power_leading",
 ]
 
 # the public names say they are granular.theory's (where the API reference lists them and

@@ -835,6 +835,83 @@ ROUGH_MUTATIONS = [
 # Rough particles, from a stream of their own (the others' cases stay as they were).
 ROUGH_KINDS = {"rough": (_rough_params, ROUGH_MUTATIONS)}
 ROUGH_SHARE = 0.06
+
+
+# A walled scene with a vibrating wall (granular.VibratingWall), from a stream of its own
+# (the first stream's cases stay as they were, fewer by this share).
+
+
+def _vib_params(rng):
+    """A walled box with its particles on a grid beside the vibrating wall's sweep, the wall
+    on a random axis and side, sine or triangle, amplitude up to a tenth of the box."""
+    n = int(rng.integers(1, 16))
+    dim = int(rng.choice([2, 3]))
+    length = float(rng.choice([1.0, 2.5]))
+    axis, side = int(rng.integers(dim)), str(rng.choice(["lower", "upper"]))
+    amplitude = length * float(rng.uniform(1e-3, 0.1))
+    free = length - 2 * amplitude  # the room beside the sweep
+    pos, spacing = _grid(rng, n, dim, length)
+    pos[:, axis] = pos[:, axis] * free / length + (2 * amplitude if side == "lower" else 0.0)
+    return dict(
+        scene=dict(
+            positions=pos,
+            velocities=rng.normal(size=(n, dim)),
+            radii=np.full(n, spacing * free / length * rng.uniform(0.1, 0.4)),
+            masses=rng.uniform(0.5, 2.0, n),
+            box=length,
+            boundary="walls",
+            wall_restitution=float(rng.choice([1.0, 1.0, 0.9, 1.1])),
+            restitution=float(rng.choice([1.0, 0.9])),
+            contact_duration=float(rng.choice([0.0, 1e-3])),
+        ),
+        wall=dict(
+            axis=axis,
+            side=side,
+            amplitude=amplitude,
+            angular_frequency=_power(rng, -1.0, 3.0),  # 0.1 .. 1000
+            phase=float(rng.uniform(-10, 10)),
+            waveform=str(rng.choice(["sine", "triangle"])),
+        ),
+        t_stop=float(rng.choice([0.5, 2.0])),
+    )
+
+
+def _wall_key(key, values):
+    def mutate(rng, p):
+        v = values[int(rng.integers(len(values)))]
+        p["wall"][key] = v
+        return f"wall {key}={v!r}"
+
+    return mutate
+
+
+def _into_the_sweep(rng, p):
+    """A particle moved to the middle of the wall's sweep (behind the wall at some phase)."""
+    w, x = p["wall"], p["scene"]["positions"]
+    length = p["scene"]["box"]
+    x[0, w["axis"]] = w["amplitude"] if w["side"] == "lower" else length - w["amplitude"]
+    return "particle 0 in the sweep"
+
+
+def _long_run(rng, p):
+    p["t_stop"] = 1e12
+    return "t_stop=1e12 (past float64's timing of the wall)"
+
+
+VIB_MUTATIONS = [
+    _wall_key("amplitude", [*EXTREME, 0.6, 10.0]),
+    _wall_key("angular_frequency", [*EXTREME, 1e12, 1e100]),
+    _wall_key("phase", [NAN, INF, -INF, 1e300, 1e16]),
+    _wall_key("axis", [-1, 3, 1.5, "0", None, True]),
+    _wall_key("side", ["left", None, 0]),
+    _wall_key("waveform", ["square", None, 1]),
+    _into_the_sweep,
+    _long_run,
+    _scene_key("wall_restitution", [0.5, 2.0]),
+]
+VIB_KINDS = {"vibrating": (_vib_params, VIB_MUTATIONS)}
+VIB_SHARE = 0.05
+
 # Langevin runs whose scales are near the ends of float64, from a third stream of their own
 # (the first stream's cases stay as they were, fewer by this share).
 SCALE_KINDS = {"langevin": (_langevin_params, LANGEVIN_SCALE_MUTATIONS)}
@@ -870,13 +947,15 @@ def make_cases(seed, count):
     later, scales = int(LATER_SHARE * count), int(SCALE_SHARE * count)
     stress = int(STRESS_SHARE * count)
     rough = int(ROUGH_SHARE * count)
-    first = _draw(np.random.default_rng(seed), KINDS, count - later - scales - stress - rough)
+    vib = int(VIB_SHARE * count)
+    first = _draw(np.random.default_rng(seed), KINDS, count - later - scales - stress - rough - vib)
     return (
         first
         + _draw(np.random.default_rng([seed, 1]), LATER_KINDS, later, ("threads",))
         + _draw(np.random.default_rng([seed, 2]), SCALE_KINDS, scales, ("langevin",))
         + _draw(np.random.default_rng([seed, 3]), STRESS_KINDS, stress)
         + _draw(np.random.default_rng([seed, 4]), ROUGH_KINDS, rough)
+        + _draw(np.random.default_rng([seed, 5]), VIB_KINDS, vib)
     )
 
 
@@ -1047,6 +1126,40 @@ def _run_scene(scene):
     _check_trajectory(scene, traj, sim)
 
 
+def _run_vibrating(p):
+    """A run with a vibrating wall: finite, no overlaps, nobody behind the wall at any
+    sample (the Scene of each sample, the wall at its phase then, checks it), and the
+    kinetic energy changed by wall_work - collision_loss (to rounding: 1e-12 of the
+    energies in play, far below a lost or doubled hit)."""
+    from granular import Scene, Simulation, VibratingWall
+
+    wall = VibratingWall(**p["wall"])
+    scene = Scene(**p["scene"], vibrating_wall=wall)
+    sim = Simulation(scene)
+    times = np.linspace(0.0, p["t_stop"], 5)
+    traj = sim.run(p["t_stop"], sample_times=times, stop_when={"events": EVENTS})
+    _check_vibrating(scene, traj, sim)
+
+
+@_verified
+def _check_vibrating(scene, traj, sim):
+    from granular import Scene
+
+    for name in ("times", "positions", "velocities", "kinetic_energy"):
+        _check(np.all(np.isfinite(getattr(traj, name))), f"non-finite {name} in the trajectory")
+    st = sim.stats
+    for key in ("wall_work", "collision_loss", "kinetic_energy"):
+        _check(math.isfinite(st[key]), f"non-finite {key}: {st[key]}")
+    for t, x, v in zip(traj.times, traj.positions, traj.velocities, strict=True):
+        Scene(x, v, scene.radii, scene.masses, box=(scene.lower, scene.upper),
+              boundary="walls", vibrating_wall=scene.vibrating_wall.at_time(t))  # fmt: skip
+    _ = sim.scene
+    change = sim.scene.kinetic_energy - scene.kinetic_energy
+    scale = max(scene.kinetic_energy, abs(st["wall_work"]), abs(st["collision_loss"]))
+    miss = abs(change - (st["wall_work"] - st["collision_loss"]))
+    _check(miss <= 1e-12 * scale, f"energy: change {change:.6g} vs work - loss, off by {miss:.3g}")
+
+
 def _run_checkpoint(p, mutated):
     """Save a short run, damage the file (p["edits"]), load it: CheckpointError, or a
     Simulation that runs on within the invariants and bit for bit as the original (when the
@@ -1133,6 +1246,8 @@ def run_case(case):
             _run_scene(Scene(**dict(p["scene"], **{p["side"]: law})))
         elif kind == "checkpoint":
             return _run_checkpoint(p, mutated)
+        elif kind == "vibrating":
+            _run_vibrating(p)
         else:  # langevin, threads
             r = langevin.run(**p)
             _check_langevin(r)

@@ -15,12 +15,19 @@ point is found the obvious way, from rigid-body mechanics alone -- the contact p
 relative velocity g(P) after an impulse P (dv = +-P / m, dw = (contact - centre) x (+-P) /
 I) is affine in P; P solves g(P) = -xi g_n - beta g_t (Huthmann & Zippelius 1997), and
 under Walton's Coulomb rule its tangential part is cut to mu |P_n| where it exceeds that.
-Walls are smooth."""
+Walls are smooth.
+
+A vibrating wall (``vib``, a granular.VibratingWall) is found by brute force
+(helpers/vibwall_reference.py: a fine grid of times up to the next other event, the first
+sign change of the gap bisected) and reflects in its own frame: v_a' = U - e_w (v_a - U), the
+other components scaled by e_w, e_w of the speed relative to the wall."""
 
 import itertools
 import math
 
 import numpy as np
+
+from . import vibwall_reference
 
 
 def pair_times(x, v, r, L, periodic):
@@ -133,6 +140,7 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
         beta=scene.tangential_restitution,
         q=scene.inertia_factor,
         mu=scene.friction,
+        vib=scene.vibrating_wall,
     )
 
 
@@ -193,13 +201,14 @@ def run(
     beta=-1.0,
     q=0.4,
     mu=np.inf,
+    vib=None,
 ):
     """Positions (unwrapped) and velocities at sample_times.  A dict ``tensors`` gets the
     stress tensor's parts at the sample times: "collisional" (sum over pair collisions of
     dr_a dp_b, dr = x_j - x_i, dp j's momentum change) and "kinetic_time" (the integral of
     sum m v_a v_b over time, summed step by step).  ``driving`` (a granular.WhiteNoise or
     PairThermostat): its kicks, drawn as csrc/drive.c draws them.  With ``spin``, the spins
-    too (a third array returned)."""
+    too (a third array returned).  ``vib``: a vibrating wall (module docstring)."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
     w = None if spin is None else spin.astype(float).copy()
     L = hi - lo
@@ -223,9 +232,25 @@ def run(
             with np.errstate(divide="ignore", invalid="ignore"):
                 up = np.where(v > 0, (hi - r[:, None] - x) / v, np.inf)
                 down = np.where(v < 0, (lo + r[:, None] - x) / v, np.inf)
+            if vib is not None:  # its face is no fixed wall
+                (up if vib.side == "upper" else down)[:, vib.axis] = np.inf
             wt = np.minimum(up, down)
             k = np.unravel_index(np.argmin(wt), wt.shape)
             t_wall, wall = max(wt[k], 0.0), k
+        t_vib, moving = np.inf, None
+        if vib is not None:
+            a = vib.axis
+            for p in range(len(x)):
+                horizon = min(t_pair, t_wall, t_stop - t, t_vib, t_kick - t)
+                th = vibwall_reference.first_hit(
+                    vib, lo[a], hi[a], t, x[p, a], v[p, a], r[p], horizon
+                )
+                if th < t_vib:
+                    t_vib, moving = th, p
+            if t_vib < min(t_pair, t_wall):
+                t_wall, wall = t_vib, (moving, a)
+            else:
+                moving = None
         is_kick = t_kick - t < min(t_pair, t_wall)
         dt = min(t_pair, t_wall, t_kick - t)
         while samples and samples[0] <= min(t + dt, t_stop):
@@ -266,6 +291,15 @@ def run(
             v[i] += f * m[j] * dr
             v[j] -= f * m[i] * dr
             coll += np.outer(dr, -f * m[i] * m[j] * dr)
+        elif moving is not None:
+            p, a = wall
+            U = vibwall_reference.velocity(vib, t)
+            e_w = _eps(wall_e, abs(v[p, a] - U))
+            v[p, a] = -(v[p, a] - U)
+            v[p] *= e_w
+            v[p, a] += U
+            X = vibwall_reference.position(vib, t, lo[a], hi[a])
+            x[p, a] = X - r[p] if vib.side == "upper" else X + r[p]
         else:
             p, a = wall
             e_w = _eps(wall_e, abs(v[p, a]))
