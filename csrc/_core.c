@@ -227,9 +227,9 @@ static int parse_law(PyObject *obj, const char *name, gr_law *law, PyArrayObject
 #define COUNT_OF(field) +1
 static char *edmd_names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                              "periodic", GR_SCENE_DOUBLES(NAME_OF) "cell_factor", "big_ratio",
-                             "shell", "law", "wall_law", NULL};
+                             "shell", "law", "wall_law", "gravity", "free_fall", NULL};
 #define EDMD_REQUIRED (7 GR_SCENE_DOUBLES(COUNT_OF))
-#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOO"
+#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOOOp"
 
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
@@ -237,7 +237,8 @@ static char *edmd_names[] = {"positions", "velocities", "radii", "masses", "lowe
 static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_out,
                           npy_intp *n_out)
 {
-    PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None;
+    PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None,
+             *ograv = Py_None;
     gr_edmd_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.cell_factor = 1.0;
@@ -248,7 +249,8 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
                                      sim ? EDMD_FORMAT ":EDMD" : EDMD_FORMAT ":edmd_check",
                                      edmd_names, &opos, &ovel, &orad, &omass, &olo, &ohi,
                                      &cfg.periodic, GR_SCENE_DOUBLES(ADDRESS_OF) &cfg.cell_factor,
-                                     &cfg.big_ratio, &cfg.shell, &olaw, &owall) ||
+                                     &cfg.big_ratio, &cfg.shell, &olaw, &owall, &ograv,
+                                     &cfg.free_fall) ||
         require_keywords(args, kw, edmd_names, EDMD_REQUIRED, sim ? "EDMD" : "edmd_check") < 0)
         return -1;
 #undef ADDRESS_OF
@@ -264,7 +266,7 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
     PyArrayObject *pos = as_f64(opos, "positions", 2, any2);
     npy_intp n = pos ? PyArray_DIM(pos, 0) : 0, d = pos ? PyArray_DIM(pos, 1) : 0;
     npy_intp shp[2] = {n, d}, shn[1] = {n}, shd[1] = {d};
-    PyArrayObject *vel = NULL, *rad = NULL, *mass = NULL, *lo = NULL, *hi = NULL;
+    PyArrayObject *vel = NULL, *rad = NULL, *mass = NULL, *lo = NULL, *hi = NULL, *grav = NULL;
     int ok = 0;
     if (!pos) goto done;
     if (d != 2 && d != 3) {
@@ -276,6 +278,11 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
         !(mass = as_f64(omass, "masses", 1, shn)) || !(lo = as_f64(olo, "lower", 1, shd)) ||
         !(hi = as_f64(ohi, "upper", 1, shd)))
         goto done;
+    /* gravity: None (none, constant velocity) or d components */
+    if (ograv != Py_None) {
+        if (!(grav = as_f64(ograv, "gravity", 1, shd))) goto done;
+        for (int a = 0; a < d; a++) cfg.gravity[a] = ((double *)PyArray_DATA(grav))[a];
+    }
     cfg.dim = (int)d;
     cfg.n = n;
     for (int a = 0; a < d; a++) {
@@ -308,6 +315,7 @@ done:
     Py_XDECREF(mass);
     Py_XDECREF(lo);
     Py_XDECREF(hi);
+    Py_XDECREF(grav);
     Py_XDECREF(law_x);
     Py_XDECREF(law_y);
     Py_XDECREF(wall_x);

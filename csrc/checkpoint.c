@@ -176,6 +176,8 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, cfg->shell);
     io_law(c, &cfg->law);
     io_law(c, &cfg->wall_law);
+    io(c, cfg->gravity, sizeof cfg->gravity);
+    IO(c, cfg->free_fall);
     if (c->law_differs) return; /* read: the rest is not this scene's */
 
     IO(c, s->t);
@@ -194,6 +196,8 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, s->wall_impulse);
     IO(c, s->kinetic);
     IO(c, s->kinetic_time);
+    io(c, s->momentum, sizeof s->momentum);
+    IO(c, s->mass_total);
     IO(c, s->order.next);
     IO(c, s->nl.broken);
 
@@ -358,8 +362,13 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         GR_SCENE_DOUBLES(DIFFERS)
 #undef DIFFERS
         !same_double(a->cell_factor, b->cell_factor) || !same_double(a->big_ratio, b->big_ratio) ||
-        !same_double(a->shell, b->shell))
-        return "its box, restitution, contact duration or engine knobs differ from the scene's";
+        !same_double(a->shell, b->shell) || !same_double(a->gravity[0], b->gravity[0]) ||
+        !same_double(a->gravity[1], b->gravity[1]) || !same_double(a->gravity[2], b->gravity[2]) ||
+        a->free_fall != b->free_fall)
+        return "its box, restitution, contact duration, gravity or engine knobs differ from the "
+               "scene's";
+    if (!same_double(t->mass_total, s->mass_total))
+        return "its total mass differs from the scene's";
     if (t->nl.broken != 0 && t->nl.broken != 1) return "its neighbour-list flag is corrupt";
 
     /* counters: each starts at 0 and grows by one at a time (order.next: events plus a
@@ -427,6 +436,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
      * arithmetic is not built for. */
     if (!(t->t >= 0.0 && t->t < INFINITY) || !isfinite(t->eps_t) || !isfinite(t->kinetic) ||
         !isfinite(t->kinetic_time) || !isfinite(t->virial) || !isfinite(t->wall_impulse) ||
+        !isfinite(t->momentum[0]) || !isfinite(t->momentum[1]) || !isfinite(t->momentum[2]) ||
         t->t_prev_event != t->t_prev_event)
         return "its time or energy counters are not finite";
     for (int32_t i = 0; i < n; i++) {

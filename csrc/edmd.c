@@ -97,8 +97,8 @@ static void predict(gr_edmd *s, int dyn, int dim, int32_t i);
  * dim and laws = 0 (constant restitution) or 1 (a restitution law, restitution.h),
  * constants in each of the four advance_* below: a constant-xi run executes the loop
  * compiled without any law code, not a test per collision, and each dynamics gets its
- * own loop the same way (constant velocity, GR_FLIGHT_LINEAR, is the only one so far: a
- * new one adds its advance_* and its choice in gr_edmd_advance, and no line here). */
+ * own loop the same way (constant velocity, GR_FLIGHT_LINEAR, and gravity: a new one
+ * adds its advance_* and its choice in gr_edmd_advance, and no line here). */
 static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, const int laws,
                                     const gr_edmd_stop *stop, gr_edmd_samples *smp,
                                     gr_error *err)
@@ -179,7 +179,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
         } else if (e->partner >= 0) {
             if (s->sched[e->partner].count != e->pcount) { /* partner collided since: stale */
                 s->invalid++;
-                move(dyn, dim, rec(s, dim, i), te);
+                move(s, dyn, dim, rec(s, dim, i), te);
                 predict(s, dyn, dim, i);
                 continue;
             }
@@ -195,7 +195,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
             const double count = (double)(2 * s->pair + s->wall);
             if (count >= resum || s->kinetic <= kinetic) { /* rarely: resum <= collisions */
                 if (count >= collisions) return GR_STOP_COLLISIONS;
-                s->kinetic = kinetic_total(s, dyn, dim);
+                s->kinetic = kinetic_total(s, dyn, dim, s->momentum);
                 if (count >= resum) resum = fmin(collisions, next_resum(s));
                 if (stop->energy && s->kinetic <= kinetic) return GR_STOP_ENERGY;
             }
@@ -211,6 +211,20 @@ static int advance_2d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp
 static int advance_3d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
     return advance(s, GR_FLIGHT_LINEAR, 3, 0, stop, smp, err);
+}
+
+/* Gravity (flight.h, GR_FLIGHT_GRAVITY): one loop per dimension, compiled with the laws'
+ * code (a constant restitution is then one test of the law's kind per collision). */
+static int advance_2d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                              gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 2, 1, stop, smp, err);
+}
+
+static int advance_3d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                              gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 3, 1, stop, smp, err);
 }
 
 static int advance_2d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
@@ -232,6 +246,9 @@ int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, 
                      "a neighbour list could not grow earlier; the system cannot go on");
         return GR_ERR_NOMEM;
     }
+    if (dynamics_of(s) == GR_FLIGHT_GRAVITY)
+        return s->dim == 2 ? advance_2d_gravity(s, stop, smp, err)
+                           : advance_3d_gravity(s, stop, smp, err);
     if (s->cfg.law.kind != GR_LAW_CONSTANT || s->cfg.wall_law.kind != GR_LAW_CONSTANT)
         return s->dim == 2 ? advance_2d_law(s, stop, smp, err) : advance_3d_law(s, stop, smp, err);
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
@@ -239,11 +256,13 @@ int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, 
 
 /* Move the system clock forward to t, integrating the kinetic energy on the way
  * (flight.h: with constant velocity it changes only at collisions, so the integral is
- * exact up to rounding). */
+ * exact up to rounding; under gravity it changes in flight, and so does the momentum). */
 static inline void set_clock(gr_edmd *s, int dyn, double t)
 {
     if (t > s->t) {
-        s->kinetic_time += fl_kinetic_integral(dyn, s->kinetic, t - s->t);
+        s->kinetic_time += fl_kinetic_integral(dyn, s->dim, &s->kinetic,
+                                               s->momentum, s->mass_total, s->cfg.gravity,
+                                               t - s->t);
         s->t = t;
     }
 }
@@ -276,8 +295,8 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
                                     double t, gr_error *err)
 {
     double *p = rec(s, dim, i), *q = rec(s, dim, j);
-    move(dyn, dim, p, t);
-    move(dyn, dim, q, t);
+    move(s, dyn, dim, p, t);
+    move(s, dyn, dim, q, t);
     double dr[3];
     for (int a = 0; a < dim; a++) {
         dr[a] = q[a] - p[a];
@@ -322,8 +341,10 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
 {
     double *p = rec(s, dim, i), *v = VEL(p, dim);
     const int a = wall >> 1, up = wall & 1;
-    move(dyn, dim, p, t);
-    double before = kinetic_of(s, dyn, dim, i), vn = v[a];
+    move(s, dyn, dim, p, t);
+    double before = kinetic_of(s, dyn, dim, i), vn = v[a], v_before[3];
+    if (dyn == GR_FLIGHT_GRAVITY) /* the wall's impulse changes the total momentum */
+        for (int k = 0; k < dim; k++) v_before[k] = v[k];
     int64_t clamped; /* 1 if e_w is the law's at its range's end */
     const double ew = rule_wall_eps(&s->cfg, laws, vn, t, &s->sched[i], &clamped);
     s->law_clamped += clamped;
@@ -338,6 +359,8 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
     }
     s->wall_impulse += s->mass[i] * (fabs(vn) + fabs(v[a]));
     s->kinetic += kinetic_of(s, dyn, dim, i) - before;
+    if (dyn == GR_FLIGHT_GRAVITY)
+        for (int k = 0; k < dim; k++) s->momentum[k] += s->mass[i] * (v[k] - v_before[k]);
     s->wall++;
     s->sched[i].count++;
     s->sched[i].last = -2 - wall;
@@ -362,7 +385,7 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, d
     gr_sched *e = &s->sched[i];
     int32_t *c = e->c;
     const int a = e->cross >> 1, dir = (e->cross & 1) ? 1 : -1;
-    move(dyn, dim, p, t);
+    move(s, dyn, dim, p, t);
     int32_t old = cell_of(&s->cells, dim, c);
     int32_t q = c[a] + dir;
     if (q >= s->cells.nc[a]) { /* out of the last cell: out of a periodic box (boundary.h) */
@@ -398,7 +421,7 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
 {
     double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
-    move(dyn, dim, p, t);
+    move(s, dyn, dim, p, t);
     int wrapped = 0;
     if (s->cfg.periodic) {
         for (int a = 0; a < dim; a++) /* not wrapped |= ...: that costs the cell-crossing
@@ -463,7 +486,7 @@ static void predict(gr_edmd *s, int dyn, int dim, int32_t i)
     if (s->nl.shell > 0.0) {
         const double *p = rec(s, dim, i);
         s->sched[i].t_cross = TIME(p, dim) + fl_exit_time(dyn, dim, p, VEL(p, dim),
-                                                       s->nl.centre + (size_t)i * (dim + 1),
+                                                       s->cfg.gravity, s->nl.centre + (size_t)i * (dim + 1),
                                                        s->nl.exit2);
 #ifdef GR_SCAN_X86
         /* the four-lane scan is written for straight lines (GR_FL_SEP) */
@@ -498,7 +521,7 @@ static inline void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i)
     int32_t wall = -1;
     for (int a = 0; a < dim; a++) {
         double dt;
-        const int up = fl_wall_time(dyn, p[a], v[a], bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim)),
+        const int up = fl_wall_time(dyn, p[a], v[a], s->cfg.gravity[a], bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim)),
                                     bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim)), &dt);
         if (up < 0) continue;
         if (dt < 0.0) dt = 0.0;
@@ -525,8 +548,8 @@ static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dyn, int dim, int3
     int32_t code = -1;
     for (int a = 0; a < dim; a++) {
         int up, open;
-        double dt = fl_cross_time(dyn, p[a], VEL(p, dim)[a], s->cfg.lo[a], c[a], g->w[a], &up,
-                                  &open);
+        double dt = fl_cross_time(dyn, p[a], VEL(p, dim)[a], s->cfg.gravity[a], s->cfg.lo[a],
+                                  c[a], g->w[a], &up, &open);
         if (!periodic) /* a wall has no cell behind it */
             open &= bd_cell_beyond(up, c[a], g->nc[a]);
         dt = open ? dt : INFINITY;

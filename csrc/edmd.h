@@ -36,6 +36,10 @@ enum {
     GR_STOP_IDLE = 5        /* no event will ever happen again and t_stop is infinite */
 };
 
+/* The largest |g| times the box's longest side (validate.c): a speed squared, within the
+ * square of the scale limit 1e140 (granular/_scales.py). */
+#define GR_GRAVITY_GL_MAX 1e280
+
 typedef struct {
     int dim;                  /* 2 or 3 */
     int64_t n;                /* number of particles, >= 1 */
@@ -51,6 +55,10 @@ typedef struct {
     double shell;             /* > 0: neighbour lists with a shell this many largest
                                * diameters thick (no big particles then); 0: cell
                                * crossings -- a speed knob, see nlist.h */
+    double gravity[3];        /* uniform acceleration on every particle (only the first dim
+                               * used; all 0: constant velocity, flight.h) */
+    int free_fall;            /* 1: gravity in a periodic box allowed (the centre of mass
+                               * falls forever); 0: refused there */
     gr_law law, wall_law;     /* kind GR_LAW_CONSTANT (zeroed): restitution and
                                * wall_restitution above; else eps(v_n) replaces them
                                * (restitution.h).  gr_edmd_new copies the tables. */

@@ -15,9 +15,10 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
         const double dt = ts - TIME(p, dim), m = s->mass[i];
         const size_t out = base + (size_t)s->order.id_of[i] * dim;
         for (int a = 0; a < dim; a++) {
-            double v = fl_vel_at(dyn, VEL(p, dim)[a], dt);
+            const double g = s->cfg.gravity[a];
+            double v = fl_vel_at(dyn, VEL(p, dim)[a], g, dt);
             if (smp->pos)
-                smp->pos[out + a] = bd_unwrap(fl_at(dyn, p[a], VEL(p, dim)[a], dt),
+                smp->pos[out + a] = bd_unwrap(fl_at(dyn, p[a], VEL(p, dim)[a], g, dt),
                                               s->image[(size_t)i * dim + a], s->L[a]);
             if (smp->vel) smp->vel[out + a] = v;
             mom[a] += m * v;
@@ -41,13 +42,13 @@ void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image)
         const double *p = rec(s, d, i);
         double dt = s->t - TIME(p, d);
         for (int a = 0; a < d; a++) {
-            double x = fl_at(dyn, p[a], VEL(p, d)[a], dt);
+            double x = fl_at(dyn, p[a], VEL(p, d)[a], s->cfg.gravity[a], dt);
             int64_t img = s->image[(size_t)i * d + a];
             size_t out = (size_t)s->order.id_of[i] * d + a;
             /* a crossing due exactly now may not have been processed yet */
             if (s->cfg.periodic) bd_reenter(&x, s->cfg.lo[a], s->cfg.hi[a], s->L[a], &img);
             if (pos) pos[out] = x;
-            if (vel) vel[out] = fl_vel_at(dyn, VEL(p, d)[a], dt);
+            if (vel) vel[out] = fl_vel_at(dyn, VEL(p, d)[a], s->cfg.gravity[a], dt);
             if (image) image[out] = img;
         }
     }
@@ -67,7 +68,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->virial = s->virial;
     c->wall_impulse = s->wall_impulse;
     c->kinetic_time = s->kinetic_time;
-    c->kinetic = kinetic_total(s, dynamics_of(s), s->dim);
+    c->kinetic = kinetic_total(s, dynamics_of(s), s->dim, NULL);
     for (int a = 0; a < 3; a++) c->ncell[a] = s->cells.nc[a];
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;
 }

@@ -81,6 +81,16 @@ _SCENE_PARAMS = tuple(p.name for p in PARAMETERS if not p.is_array)
 _CONSERVED_RTOL = 1e-6
 
 
+def potential_energy(scene: Any) -> float:
+    """The potential energy of ``scene``'s particles in its gravity, measured from the
+    box's corner that g points to (so it is >= 0): sum of m g . (corner - x)."""
+    g = scene.gravity
+    if g is None:
+        return 0.0
+    corner = np.where(g > 0, scene.upper, scene.lower)
+    return float(np.sum(scene.masses * ((corner - scene.positions) @ g)))
+
+
 def _version() -> str:
     from . import __version__
 
@@ -99,6 +109,16 @@ def _fault(sim: _Run) -> str | None:
     start = sim._initial
     e0, e = start.kinetic_energy, now.kinetic_energy
     periodic = start.boundary == "periodic"
+    if start.gravity is not None:
+        # gravity: between walls the energy kept is kinetic + potential; in a freely
+        # falling periodic box the motion relative to the fall (v - g t) is that of a gas
+        # without gravity, so the same checks apply to it
+        if periodic:
+            fall = start.gravity * sim.time
+            now = now.replace(velocities=now.velocities - fall, gravity=None, free_fall=False)
+            e = now.kinetic_energy
+        else:
+            e0, e = (x.kinetic_energy + potential_energy(x) for x in (start, now))
     if periodic or not heats(start.wall_restitution):
         if e > e0 * (1.0 + _CONSERVED_RTOL):
             return (
@@ -144,7 +164,11 @@ def dumps(sim: _Run) -> bytes:
         "scene": {name: describe(getattr(scene, name)) for name in _SCENE_PARAMS},
         "engine_state_sha256": hashlib.sha256(state.data).hexdigest(),
     }
-    arrays = {f"scene_{name}": getattr(scene, name) for name in _SCENE_ARRAYS}
+    # an unset array (gravity None) is stored as zeros, which its check reads as unset
+    stored = {name: getattr(scene, name) for name in _SCENE_ARRAYS}
+    arrays = {
+        f"scene_{name}": np.zeros(scene.dim) if a is None else a for name, a in stored.items()
+    }
     buf = io.BytesIO()
     np.savez(buf, meta=np.array(json.dumps(meta)), engine_state=state, **arrays)
     return buf.getvalue()

@@ -187,7 +187,8 @@ def _frame(hoomd, traj, k, lower, upper):
         params = traj.scene_parameters
         for p in RUN_PARAMETERS:
             for field, value in split(p, params[p.name]).items():
-                log[f"granular/{field}"] = _encode(value)
+                if value is not None:  # an unset array (gravity): read back as the default
+                    log[f"granular/{field}"] = _encode(value)
     frame.log = log
     return frame
 
