@@ -122,24 +122,27 @@ static inline void move(const gr_edmd *s, int dyn, int dim, double *p, double t)
  * hold the velocities at each particle's own clock: right for constant velocity, where
  * they do not change in flight; under gravity they are brought to s->t first, and the
  * total momentum at s->t is summed into momentum[dim] (if not NULL) on the way. */
+static GR_NOINLINE double kinetic_total_gravity(const gr_edmd *s, int dim, double *momentum)
+{
+    double k = 0.0, mom[3] = {0.0, 0.0, 0.0};
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *p = rec(s, dim, i), dt = s->t - TIME(p, dim);
+        double v[3];
+        for (int a = 0; a < dim; a++) {
+            v[a] = fl_vel_at(GR_FLIGHT_GRAVITY, VEL(p, dim)[a], s->cfg.gravity[a], dt);
+            mom[a] += s->mass[i] * v[a];
+        }
+        k += fl_kinetic(GR_FLIGHT_GRAVITY, dim, s->mass[i], v);
+    }
+    if (momentum)
+        for (int a = 0; a < dim; a++) momentum[a] = mom[a];
+    return k;
+}
+
 static inline double kinetic_total(const gr_edmd *s, int dyn, int dim, double *momentum)
 {
     double k = 0.0;
-    if (dyn == GR_FLIGHT_GRAVITY) {
-        double mom[3] = {0.0, 0.0, 0.0};
-        for (int32_t i = 0; i < s->n; i++) {
-            const double *p = rec(s, dim, i), dt = s->t - TIME(p, dim);
-            double v[3];
-            for (int a = 0; a < dim; a++) {
-                v[a] = fl_vel_at(dyn, VEL(p, dim)[a], s->cfg.gravity[a], dt);
-                mom[a] += s->mass[i] * v[a];
-            }
-            k += fl_kinetic(dyn, dim, s->mass[i], v);
-        }
-        if (momentum)
-            for (int a = 0; a < dim; a++) momentum[a] = mom[a];
-        return k;
-    }
+    if (dyn == GR_FLIGHT_GRAVITY) return kinetic_total_gravity(s, dim, momentum);
     (void)momentum;
     for (int32_t i = 0; i < s->n; i++)
         k += fl_kinetic(dyn, dim, s->mass[i], VEL(rec(s, dim, i), dim));
@@ -171,5 +174,11 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts);
 
 /* The first predictions of every particle (edmd.c); lists and cells must be built. */
 int gr_predict_all(gr_edmd *s, gr_error *err);
+
+/* Gravity's loop and first predictions (edmd.c compiled again as edmd_gravity.c), which
+ * gr_edmd_advance and gr_predict_all call for a system under gravity. */
+int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                            gr_error *err);
+int gr_predict_all_gravity(gr_edmd *s, gr_error *err);
 
 #endif

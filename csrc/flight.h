@@ -48,6 +48,14 @@ enum {
 /* Every function takes the acceleration: g (one axis) or g[dim]; constant velocity
  * ignores it, so its inlined code does not even load it. */
 
+/* A function compiled once, called rather than inlined (unused: units that do not call
+ * it are not warned about it). */
+#if defined(__GNUC__) || defined(__clang__)
+#define GR_NOINLINE __attribute__((noinline, unused))
+#else
+#define GR_NOINLINE
+#endif
+
 /* The scalar operations, for the forms below that the AVX2 lanes share (scan_avx2.h
  * passes _mm256_add_pd and friends). */
 #define GR_FL_ADD(a, b) ((a) + (b))
@@ -123,6 +131,10 @@ static inline int fl_pair_beats(int dyn, int dim, const double *dr, const double
     return gr_pair_beats(dim, dr, dv, sigma, horizon, dt);
 }
 
+/* Gravity's longer branches are functions of their own, not inlined (GR_NOINLINE): in
+ * the constant-velocity loops they are dead code, but a larger body would change what
+ * the compiler inlines there, and with it the plain loop's instructions an event. */
+
 /* Under gravity: the time from now until x + v t + a t^2 (a = g/2 != 0) crosses the
  * level x + d upwards (increasing), or +inf if it never does from now on.  Of the two
  * roots of a t^2 + v t - d = 0, the one with dx/dt = +sqrt(D) > 0 (D = v^2 + 4 a d) is
@@ -145,8 +157,8 @@ static inline double fl_up_time(double d, double v, double a)
  * hi upwards (lo <= hi; a cell's faces, or the walls less the radius): its time, with
  * *up 1 for hi and 0 for lo.  One of them is always reached (the pull turns any flight
  * towards one), unless the time overflows: *reaches then 0 (the result is not a time). */
-static inline double fl_level_pair(double x, double v, double g, double lo, double hi, int *up,
-                                   int *reaches)
+static GR_NOINLINE double fl_level_pair(double x, double v, double g, double lo, double hi,
+                                        int *up, int *reaches)
 {
     const double a = 0.5 * g;
     const double t_hi = fl_up_time(hi - x, v, a), t_lo = fl_up_time(x - lo, -v, -a);
@@ -194,28 +206,33 @@ static inline int fl_wall_time(int dyn, double x, double v, double g, double lo_
     return v > 0.0;
 }
 
+/* Under gravity: |d + v t + g t^2/2| <= |d| + |v| t + |g| t^2/2, and the time at which
+ * that bound reaches the shell's radius is a lower bound of the exit (the exact one is a
+ * root of a quartic); an early exit only rebuilds the list early.  At a rebuild d = 0,
+ * and along a straight line the bound is the exit. */
+static GR_NOINLINE double fl_exit_time_gravity(int dim, const double *x, const double *v,
+                                               const double *g, const double *centre,
+                                               double exit2)
+{
+    double d2 = 0.0, v2 = 0.0, g2 = 0.0;
+    for (int k = 0; k < dim; k++) {
+        const double dk = x[k] - centre[k];
+        d2 += dk * dk;
+        v2 += v[k] * v[k];
+        g2 += g[k] * g[k];
+    }
+    const double room = sqrt(exit2) - sqrt(d2), speed = sqrt(v2), half_g = 0.5 * sqrt(g2);
+    if (!(room > 0.0)) return 0.0;
+    /* the positive root of half_g t^2 + speed t - room = 0, without cancellation */
+    return 2.0 * room / (speed + sqrt(speed * speed + 4.0 * half_g * room));
+}
+
 /* When a particle at x with velocity v leaves the sphere of squared radius exit2 about
  * `centre` (neighbour lists' shell): the time from now, +inf if never. */
 static inline double fl_exit_time(int dyn, int dim, const double *x, const double *v,
                                   const double *g, const double *centre, double exit2)
 {
-    if (dyn == GR_FLIGHT_GRAVITY) {
-        /* |d + v t + g t^2/2| <= |d| + |v| t + |g| t^2/2: the time at which that bound
-         * reaches the shell's radius is a lower bound of the exit (the exact one is a
-         * root of a quartic), and an early exit only rebuilds the list early.  At a
-         * rebuild d = 0 and along a straight line the bound is the exit. */
-        double d2 = 0.0, v2 = 0.0, g2 = 0.0;
-        for (int k = 0; k < dim; k++) {
-            const double dk = x[k] - centre[k];
-            d2 += dk * dk;
-            v2 += v[k] * v[k];
-            g2 += g[k] * g[k];
-        }
-        const double room = sqrt(exit2) - sqrt(d2), speed = sqrt(v2), half_g = 0.5 * sqrt(g2);
-        if (!(room > 0.0)) return 0.0;
-        /* the positive root of half_g t^2 + speed t - room = 0, without cancellation */
-        return 2.0 * room / (speed + sqrt(speed * speed + 4.0 * half_g * room));
-    }
+    if (dyn == GR_FLIGHT_GRAVITY) return fl_exit_time_gravity(dim, x, v, g, centre, exit2);
     (void)g;
     double a = 0.0, b = 0.0, c = -exit2;
     for (int k = 0; k < dim; k++) {
@@ -246,20 +263,26 @@ static inline double fl_kinetic(int dyn, int dim, double m, const double *v)
  * d/dt K = g . P and the total momentum P (mass M) as dP/dt = M g between collisions, so
  * K(t) = K + g.P t + M g^2 t^2 / 2, whose integral this returns, and *kinetic and
  * momentum[dim] are brought to the flight's end. */
+static GR_NOINLINE double fl_kinetic_integral_gravity(int dim, double *kinetic,
+                                                      double *momentum, double mass,
+                                                      const double *g, double dt)
+{
+    double gp = 0.0, g2 = 0.0;
+    for (int a = 0; a < dim; a++) {
+        gp += g[a] * momentum[a];
+        g2 += g[a] * g[a];
+        momentum[a] += mass * g[a] * dt;
+    }
+    const double k = *kinetic;
+    *kinetic = k + (gp + 0.5 * mass * g2 * dt) * dt;
+    return (k + (0.5 * gp + mass * g2 * dt / 6.0) * dt) * dt;
+}
+
 static inline double fl_kinetic_integral(int dyn, int dim, double *kinetic, double *momentum,
                                          double mass, const double *g, double dt)
 {
-    if (dyn == GR_FLIGHT_GRAVITY) {
-        double gp = 0.0, g2 = 0.0;
-        for (int a = 0; a < dim; a++) {
-            gp += g[a] * momentum[a];
-            g2 += g[a] * g[a];
-            momentum[a] += mass * g[a] * dt;
-        }
-        const double k = *kinetic;
-        *kinetic = k + (gp + 0.5 * mass * g2 * dt) * dt;
-        return (k + (0.5 * gp + mass * g2 * dt / 6.0) * dt) * dt;
-    }
+    if (dyn == GR_FLIGHT_GRAVITY)
+        return fl_kinetic_integral_gravity(dim, kinetic, momentum, mass, g, dt);
     (void)dim;
     (void)momentum;
     (void)mass;

@@ -18,7 +18,7 @@ from granular.errors import shown
 pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 
 # what may come before the keyword-only parameters
-THEORY_INDEPENDENT = {"t", "lag", "speed", "eta", "box", "temperature"}
+THEORY_INDEPENDENT = {"t", "lag", "speed", "eta", "box", "temperature", "z"}
 PLOT_X = {"times", "velocities", "positions", "traj"}
 
 # names the package used, or a user might reach for, for a quantity that has another name
@@ -171,6 +171,11 @@ VALID = {
     "v0_sq": 0.5,
     "order": 1,
     "points": 50,
+    "z": 0.5,
+    "gravity": 1.0,
+    "area": 1.0,
+    "bottom": 0.0,
+    "top": 1.0,
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],

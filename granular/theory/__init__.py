@@ -48,6 +48,10 @@ from .equation_of_state import (
 from .ergodicity import (
     udsbm_ergodicity_breaking,
 )
+from .gravity import (
+    excess_chemical_potential,
+    hydrostatic_density,
+)
 from .haff import (
     LangevinCoefficients,
     collision_frequency,
@@ -112,8 +116,10 @@ __all__ = [
     "cooling_rate",
     "critical_box_size",
     "diffusion_d0",
+    "excess_chemical_potential",
     "haff_tau0",
     "haff_temperature",
+    "hydrostatic_density",
     "langevin_coefficients",
     "maxwell_boltzmann_moments",
     "maxwell_boltzmann_pdf",

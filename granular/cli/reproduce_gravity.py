@@ -1,0 +1,137 @@
+"""The reproduction's gravity experiment: an elastic gas of hard disks in a tall box under
+gravity against its hydrostatic profile (``theory.hydrostatic_density``: dP/dz = -n m g
+with granular's own equation of state, Henderson's in 2D).
+
+Each run: N = 400 disks (r = 0.01) in a walled box 1 wide and 2 high, g = 2 down, placed
+uniformly at random with speed sqrt(2) and let fall; the fall heats the gas to T ~ 1.6,
+a scale height l = T / (m g) ~ 0.8 = 40 diameters, and the floor's area fraction ~0.13
+(Henderson's Z ~ 1.3 there: the profile is measurably not barometric).  After
+``EQUILIBRATE`` time units (several sound crossings of the column, many collisions per
+particle) the profile is sampled every 0.1 for ``MEASURE`` time units.  It is measured
+away from the walls (``PAD`` = 3 diameters from the floor, ceiling and side walls), where
+the hard walls' layering does not reach and the local-density approximation holds, and
+the theory is normalised to the mean number of centres in that window and evaluated at
+the run's mean kinetic temperature (uniform in equilibrium: checked by
+tests/test_gravity_profile.py).
+
+The row ``gravity.profile.elastic`` is, per run, the mean height of the centres in the
+window over the theory's (bin-averaged), against 1: a scalar that a wrong equation of
+state, a wrong temperature or a wrong flight would move (the barometric, ideal-gas
+profile at the same count gives ~0.96-0.97 of it here).  The figure shows the profile
+pooled over the runs with its error bars, the theory and the barometric curve, and the
+residuals in units of their errors with their chi^2.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import Scene, Simulation, analysis, theory
+
+WIDTH, HEIGHT, RADIUS, G, N = 1.0, 2.0, 0.01, 2.0, 400
+PAD = 6 * RADIUS  # three diameters
+BINS = 20
+EQUILIBRATE, MEASURE = 20.0, 20.0
+
+
+def column(seed: int, *, equilibrate: float = EQUILIBRATE, measure: float = MEASURE) -> dict:
+    """One run of the column: its profile (``analysis.profile`` in the window, 10 blocks),
+    the theory's bin averages at its count and temperature, and the barometric ones."""
+    box = (np.zeros(2), np.array([WIDTH, HEIGHT]))
+    s = Scene.random(N, RADIUS, dim=2, box=box, boundary="walls", seed=seed)
+    sim = Simulation(s.replace(gravity=(0.0, -G)))
+    sim.run(t_stop=equilibrate, store=())
+    times = np.linspace(equilibrate, equilibrate + measure, round(measure / 0.1) + 1)
+    tr = sim.run(t_stop=times[-1], sample_times=times, store=("positions", "velocities"))
+    temperature = float(np.mean(tr.temperature))
+    bottom, top = PAD, HEIGHT - PAD
+    edges = np.linspace(bottom, top, BINS + 1)
+    prof = analysis.profile(tr, bins=edges, within=([PAD, 0.0], [WIDTH - PAD, HEIGHT]), blocks=10)
+    count = float(prof.count.sum())
+    area = WIDTH - 2 * PAD
+    fine = np.linspace(bottom, top, 20 * BINS + 1)  # 20 intervals a bin: Simpson's rule
+    n_fine = np.asarray(
+        theory.hydrostatic_density(
+            fine, n=count, area=area, bottom=bottom, top=top, radius=RADIUS, gravity=G,
+            temperature=temperature, dim=2,
+        )
+    )  # fmt: skip
+    w = np.ones(21)
+    w[1:-1:2], w[2:-1:2] = 4.0, 2.0
+    w /= w.sum()
+    bin_mean = np.array([np.sum(w * n_fine[20 * k : 20 * k + 21]) for k in range(BINS)])
+    scale = temperature / G
+    # the barometric profile exp(-z / l) with the same count, averaged over each bin
+    share = np.exp(-(edges[:-1] - bottom) / scale) - np.exp(-(edges[1:] - bottom) / scale)
+    baro = count / area * share / (np.diff(edges) * np.sum(share))
+    return dict(
+        profile=prof,
+        theory=bin_mean,
+        barometric=baro,
+        temperature=temperature,
+        count=count,
+        collisions=sim.stats["pair_collisions"],
+    )
+
+
+def mean_height(centres: np.ndarray, density: np.ndarray) -> float:
+    """The mean height of a profile given in bins of equal width."""
+    return float(np.sum(centres * density) / np.sum(density))
+
+
+def _fig_gravity(cfg, out, *, ensemble, save, fig, row, mean_row):
+    """Run the columns, write ``gravity_profile.png``, return (file names, rows)."""
+    runs = 10 if cfg.quick else 20
+    kw = dict(equilibrate=10.0, measure=10.0) if cfg.quick else {}
+    results = [column(seed, **kw) for seed in range(runs)]
+    c = results[0]["profile"].centres
+    ratios = [mean_height(c, r["profile"].density) / mean_height(c, r["theory"]) for r in results]
+    baro = float(
+        np.mean([mean_height(c, r["barometric"]) / mean_height(c, r["theory"]) for r in results])
+    )
+    # the profile pooled over the runs: each run's mean profile, their mean and standard error
+    dens = np.array([r["profile"].density for r in results])
+    th = np.mean([r["theory"] for r in results], axis=0)
+    bar = np.mean([r["barometric"] for r in results], axis=0)
+    mean, err = dens.mean(0), dens.std(0, ddof=1) / math.sqrt(runs)
+    z = (mean - th) / err
+    chi2 = float(np.sum(z**2))
+    temperature = float(np.mean([r["temperature"] for r in results]))
+    eta0 = float(th[0]) * math.pi * RADIUS**2
+    rows = [
+        mean_row(
+            "gravity.profile.elastic",
+            f"mean height of the centres over the hydrostatic theory's (EDMD, 2D, N = {N} "
+            f"disks r = {RADIUS} in a {WIDTH:g} x {HEIGHT:g} box, g = {G:g}, T = "
+            f"{temperature:.3f}, scale height T/mg = {temperature / G / (2 * RADIUS):.0f} "
+            f"diameters, area fraction {eta0:.3f} at the bottom of the window; the window 3 "
+            f"diameters from every wall); theory: dP/dz = -n m g with Henderson's equation of "
+            f"state (theory.hydrostatic_density), 1; the barometric (ideal-gas) profile gives "
+            f"{baro:.4f}; the pooled profile's chi^2 against the theory is {chi2:.1f} for "
+            f"{BINS} bins",
+            ratios,
+            None,
+            1.0,
+        )
+    ]
+    f, (ax, ax2) = fig(2)
+    ax.errorbar(c, mean, err, fmt="o", ms=3, label=f"EDMD, {runs} runs")
+    ax.plot(c, th, "-", label="hydrostatic, Henderson EOS")
+    ax.plot(c, bar, ":", label="barometric (ideal gas)")
+    ax.set_yscale("log")
+    ax.set_xlabel("height z")
+    ax.set_ylabel("number density n(z)")
+    ax.legend(fontsize=8)
+    ax.set_title("elastic disks under gravity")
+    ax2.axhline(0.0, color="0.6")
+    ax2.plot(c, z, "o", ms=4, label="hydrostatic theory")
+    ax2.plot(c, (mean - bar) / err, "x", ms=4, label="barometric")
+    ax2.set_xlabel("height z")
+    ax2.set_ylabel("(ours - theory) / error")
+    ax2.set_ylim(-12, 12)
+    ax2.legend(fontsize=8)
+    ax2.set_title(f"residuals: chi^2 = {chi2:.1f} for {BINS} bins")
+    names = [save(f, out, "gravity_profile.png")]
+    return names, rows
