@@ -74,7 +74,9 @@ QUANTITIES: dict[str, Quantity] = {
     "tracer_mass": Quantity("mass M of a heavy tracer", "m", "positive"),
     "chi": Quantity("gas density at the tracer's surface over n", "dimensionless", "positive"),
     "gravity": Quantity("magnitude |g| of a uniform acceleration", "eps/(m L)", "positive"),
-    "area": Quantity("cross-section the centres spread over (a length in 2D)", "L^(d-1)", "positive"),
+    "area": Quantity(
+        "cross-section the centres spread over (a length in 2D)", "L^(d-1)", "positive"
+    ),
     "bottom": Quantity("height from which particles are counted", "L"),
     "top": Quantity("height up to which particles are counted", "L"),
     # the models' coefficients

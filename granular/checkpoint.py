@@ -58,6 +58,9 @@ class _Run(Protocol):
     @property
     def scene(self) -> Scene: ...
 
+    @property
+    def time(self) -> float: ...
+
 
 _S = TypeVar("_S", bound=_Run)
 
@@ -166,7 +169,7 @@ def dumps(sim: _Run) -> bytes:
     }
     # an unset array (gravity None) is stored as zeros, which its check reads as unset
     stored = {name: getattr(scene, name) for name in _SCENE_ARRAYS}
-    arrays = {
+    arrays: dict[str, Any] = {
         f"scene_{name}": np.zeros(scene.dim) if a is None else a for name, a in stored.items()
     }
     buf = io.BytesIO()
