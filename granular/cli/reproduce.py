@@ -669,6 +669,14 @@ def _fig_visco(cfg, out):
     return reproduce_visco._fig_visco(cfg, out, **_tools())
 
 
+def _fig_gravity(cfg, out):
+    """An elastic gas under gravity against its hydrostatic profile: see
+    ``reproduce_gravity``."""
+    from . import reproduce_gravity
+
+    return reproduce_gravity._fig_gravity(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -679,6 +687,7 @@ FIGURES = {
     "4.17-4.23": _fig_4_17_to_4_23,
     "clustering": _fig_clustering,
     "viscoelastic": _fig_visco,
+    "gravity": _fig_gravity,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -696,6 +705,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
+    "gravity": ("elastic disks under gravity: the hydrostatic density profile", 60.0, 25.0),
 }
 
 
