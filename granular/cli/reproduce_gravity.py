@@ -29,6 +29,7 @@ import math
 import numpy as np
 
 from .. import Scene, Simulation, analysis, theory
+from ..errors import InelasticCollapseError
 
 WIDTH, HEIGHT, RADIUS, G, N = 1.0, 2.0, 0.01, 2.0, 400
 PAD = 6 * RADIUS  # three diameters
@@ -135,3 +136,67 @@ def _fig_gravity(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax2.set_title(f"residuals: chi^2 = {chi2:.1f} for {BINS} bins")
     names = [save(f, out, "gravity_profile.png")]
     return names, rows
+
+
+BED_XIS = (0.9, 0.7, 0.5, 0.3)
+BED_TCS = (0.0, 1e-5, 1e-4, 1e-3)
+
+
+def bed_map(xis=BED_XIS, contact_durations=BED_TCS, t_stop=1.0, events_per_particle=10_000, n=200):
+    """Where an inelastic bed resting on its floor collapses: 2D disks (r = 0.01) dropped
+    in a walled box 0.3 wide and 1 high under g = 10 (they settle within t ~ 0.5), pairs
+    and floor of restitution xi, with the TC model's t_c; each run to ``t_stop`` within a
+    budget of ``events_per_particle`` events a particle.  Each cell: 'collapse' (with its
+    time), 'budget' (the rattling bed's events ran out first: the time reached), or 'ok';
+    and the events per particle per unit time over the run's last tenth."""
+    cells = []
+    box = (np.zeros(2), np.array([0.3, 1.0]))
+    for tc in contact_durations:
+        for xi in xis:
+            s = Scene.random(
+                n, 0.01, dim=2, box=box, boundary="walls", restitution=xi,
+                wall_restitution=xi, contact_duration=tc, seed=4,
+            ).replace(gravity=(0.0, -10.0))  # fmt: skip
+            sim = Simulation(s)
+            cell = dict(xi=xi, contact_duration=tc)
+            budget = events_per_particle * n
+            try:
+                sim.run(t_stop=0.9 * t_stop, stop_when={"events": budget}, store=())
+                e0, t0 = sim.stats["events"], sim.time
+                tr = sim.run(t_stop=t_stop, stop_when={"events": budget - e0}, store=())
+                status = "budget" if tr.stop_reason == "events" else "ok"
+                rate = (sim.stats["events"] - e0) / (n * max(sim.time - t0, 1e-300))
+                cell.update(status=status, time=sim.time, events_per_particle_time=rate)
+            except InelasticCollapseError as exc:
+                cell.update(status="collapse", time=exc.time)
+            cell.update(tc_elastic=sim.stats["tc_elastic_collisions"], events=sim.stats["events"])
+            cells.append(cell)
+    return cells
+
+
+def bed_map_figure(cells, path):
+    """The map as a grid of coloured cells, xi across, t_c down, each labelled."""
+    import matplotlib.pyplot as plt
+
+    xis = sorted({c["xi"] for c in cells}, reverse=True)
+    tcs = sorted({c["contact_duration"] for c in cells})
+    colour = {"collapse": "#d62728", "budget": "#ff7f0e", "ok": "#2ca02c"}
+    fig, ax = plt.subplots(figsize=(6.0, 3.6), layout="constrained")
+    for c in cells:
+        x, y = xis.index(c["xi"]), tcs.index(c["contact_duration"])
+        ax.add_patch(plt.Rectangle((x - 0.5, y - 0.5), 1, 1, color=colour[c["status"]], alpha=0.6))
+        text = {
+            "collapse": f"collapse\nt = {c['time']:.3f}",
+            "budget": f"budget\nt = {c['time']:.2f}",
+            "ok": f"ok\n{c.get('events_per_particle_time', 0):.2g} ev/(N t)",
+        }[c["status"]]
+        ax.text(x, y, text, ha="center", va="center", fontsize=8)
+    ax.set_xlim(-0.5, len(xis) - 0.5)
+    ax.set_ylim(-0.5, len(tcs) - 0.5)
+    ax.set_xticks(range(len(xis)), [f"{x:g}" for x in xis])
+    ax.set_yticks(range(len(tcs)), ["off" if t == 0 else f"{t:g}" for t in tcs])
+    ax.set_xlabel("restitution xi (pairs and floor)")
+    ax.set_ylabel("TC model t_c")
+    ax.set_title("a bed settling on an inelastic floor (g = 10, N = 200, to t = 1)")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
