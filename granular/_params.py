@@ -73,7 +73,7 @@ QUANTITIES: dict[str, Quantity] = {
     "tracer_radius": Quantity("radius R of a heavy tracer", "L", "positive"),
     "tracer_mass": Quantity("mass M of a heavy tracer", "m", "positive"),
     "chi": Quantity("gas density at the tracer's surface over n", "dimensionless", "positive"),
-    "gravity": Quantity("magnitude |g| of a uniform acceleration", "eps/(m L)", "positive"),
+    "gravity": Quantity("magnitude of a uniform acceleration g", "eps/(m L)", "positive"),
     "area": Quantity(
         "cross-section the centres spread over (a length in 2D)", "L^(d-1)", "positive"
     ),

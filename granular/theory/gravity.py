@@ -1,19 +1,19 @@
 """An elastic gas of hard disks or spheres in equilibrium under uniform gravity: the
 hydrostatic density profile along the field.
 
-Hydrostatic balance dP/dz = -n m g (z against the field, g = |g|) with the equation of
+Hydrostatic balance dP/dz = -n m g (z against the field, g its magnitude) with the equation of
 state P = n T Z(eta) at a uniform temperature T (an elastic gas in equilibrium) is, by
 the isothermal Gibbs-Duhem relation dP = n d(mu), the constancy of the chemical potential
 plus the potential energy, mu(n(z)) + m g z = const (the local-density approximation of
 equilibrium statistical mechanics; Hansen & McDonald, *Theory of Simple Liquids*, 4th ed.
-2013, sec. 3.4 and eq. 2.4.29 for mu from Z).  With mu / T = ln(n Lambda^d) +
+2013, on the chemical potential from the equation of state).  With mu / T = ln(n Lambda^d) +
 mu_ex(eta) / T and mu_ex / T = integral_0^eta (Z(x) - 1) / x dx + Z(eta) - 1:
 
     ln eta(z) + mu_ex(eta(z)) / T = c - z / l,    l = T / (m g)  (the scale height),
 
 c fixed by the number of particles between two heights.  The equations of state are
 granular's own (``theory.compressibility_factor``): Carnahan-Starling in 3D (Carnahan &
-Starling, J. Chem. Phys. 51, 635 (1969), eq. 10), whose excess chemical potential is
+Starling, J. Chem. Phys. 51, 635 (1969)), whose excess chemical potential is
 ``(8 eta - 9 eta^2 + 3 eta^3) / (1 - eta)^3``; Henderson's in 2D (Henderson, Mol. Phys.
 30, 971 (1975)), Z = (1 + eta^2/8) / (1 - eta)^2, whose integral gives
 ``(9/8) eta / (1 - eta) - (7/8) ln(1 - eta) + Z - 1``.  In the dilute limit the profile is
@@ -121,7 +121,7 @@ def hydrostatic_density(
     mass : float
         Particle mass [m].
     gravity : float
-        |g|, the field's magnitude [eps/(m L)].
+        The magnitude of the acceleration g [eps/(m L)].
     temperature : float
         The uniform temperature T [eps].
     dim : int
