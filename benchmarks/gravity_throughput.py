@@ -37,7 +37,8 @@ def main(n=10_000, eta=0.1, windows=7, events=400_000):
             sim.run(stop_when={"events": events}, store=())
             rate[name] = (sim.stats["pair_collisions"] - pairs) / (time.process_time() - t0)
         ratios.append(rate["gravity"] / rate["plain"])
-        print(f"plain {rate['plain']:.3g}/s  gravity {rate['gravity']:.3g}/s  ratio {ratios[-1]:.3f}")
+        plain, grav = rate["plain"], rate["gravity"]
+        print(f"plain {plain:.3g}/s  gravity {grav:.3g}/s  ratio {ratios[-1]:.3f}")
     print(f"median ratio {np.median(ratios):.3f} (min {min(ratios):.3f}, max {max(ratios):.3f})")
 
 
