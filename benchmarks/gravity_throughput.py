@@ -3,6 +3,7 @@ between walls with and without gravity (same N, same packing), in alternating wi
 one process so that both see the same machine load.
 
     python benchmarks/gravity_throughput.py [N] [packing] [windows]
+    python benchmarks/gravity_throughput.py --tiny     (N = 300: that it runs)
 
 g is chosen so that the scale height T / (m g) is the box's height: the gas is stratified
 by a factor e from floor to ceiling, its mean packing the one asked for.  Prints the
@@ -43,5 +44,8 @@ def main(n=10_000, eta=0.1, windows=7, events=400_000):
 
 
 if __name__ == "__main__":
-    args = [float(a) for a in sys.argv[1:]]
-    main(int(args[0]) if args else 10_000, *(args[1:2] or [0.1]), *[int(a) for a in args[2:3]])
+    if sys.argv[1:] == ["--tiny"]:  # that it runs, not a measurement
+        main(300, 0.1, 1, 2000)
+    else:
+        args = [float(a) for a in sys.argv[1:]]
+        main(int(args[0]) if args else 10_000, *(args[1:2] or [0.1]), *[int(a) for a in args[2:3]])

@@ -138,6 +138,17 @@ def _fig_gravity(cfg, out, *, ensemble, save, fig, row, mean_row):
     return names, rows
 
 
+def notes(by_id):
+    """Sentences for report.md's gravity section."""
+    return [
+        "The theory is the local-density approximation of equilibrium statistical mechanics "
+        "with granular's own equation of state; it is measured away from the walls, where "
+        "hard walls layer the gas, and normalised to the count there (reproduce_gravity).  "
+        "The quantity text gives the barometric profile's value: the ideal gas is far off, "
+        "so the row resolves the hard cores' pressure."
+    ]
+
+
 BED_XIS = (0.9, 0.7, 0.5, 0.3)
 BED_TCS = (0.0, 1e-5, 1e-4, 1e-3)
 

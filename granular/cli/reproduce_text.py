@@ -219,6 +219,12 @@ def _visco_notes(cfg, by_id):
     return reproduce_visco.notes(by_id)
 
 
+def _gravity_notes(cfg, by_id):
+    from . import reproduce_gravity
+
+    return reproduce_gravity.notes(by_id)
+
+
 # The sections of the report: (title, row id prefix, notes(cfg, by_id) -> sentences)
 SECTIONS = (
     ("Energy (Fig. 4.2)", "energy.", _energy_notes),
@@ -229,6 +235,7 @@ SECTIONS = (
     ("Ergodicity (Figs 4.21-4.23)", "ergodicity.", _ergodicity_notes),
     ("Where homogeneous cooling ends (clustering)", "cluster.", _clustering_notes),
     ("Viscoelastic gases", "visco.", _visco_notes),
+    ("Gravity: the hydrostatic profile", "gravity.", _gravity_notes),
 )
 
 
