@@ -254,9 +254,9 @@ static int parse_vibwall(PyObject *obj, gr_vibwall *w)
 static char *edmd_names[] = {"positions", "velocities", "radii", "masses", "lower", "upper",
                              "periodic", GR_SCENE_DOUBLES(NAME_OF) "cell_factor", "big_ratio",
                              "shell", "law", "wall_law", "stress", "angular_velocities",
-                             "vibrating_wall", NULL};
+                             "vibrating_wall", "gravity", "free_fall", NULL};
 #define EDMD_REQUIRED (7 GR_SCENE_DOUBLES(COUNT_OF))
-#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOOpOO"
+#define EDMD_FORMAT "|$OOOOOOp" GR_SCENE_DOUBLES(FORMAT_OF) "dddOOpOOOp"
 
 /* Parse EDMD's arguments and build a system into *sim, or with sim == NULL only check
  * them (gr_edmd_check: the same checks without building).  Returns 0, or -1 with an
@@ -267,6 +267,7 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
     PyObject *opos, *ovel, *orad, *omass, *olo, *ohi, *olaw = Py_None, *owall = Py_None;
     PyObject *ospin = Py_None; /* rough particles' angular velocities, or None: smooth */
     PyObject *ovib = Py_None;
+    PyObject *ograv = Py_None;
     gr_edmd_config cfg;
     memset(&cfg, 0, sizeof cfg);
     cfg.cell_factor = 1.0;
@@ -278,7 +279,7 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
                                      edmd_names, &opos, &ovel, &orad, &omass, &olo, &ohi,
                                      &cfg.periodic, GR_SCENE_DOUBLES(ADDRESS_OF) &cfg.cell_factor,
                                      &cfg.big_ratio, &cfg.shell, &olaw, &owall, &cfg.stress,
-                                     &ospin, &ovib) ||
+                                     &ospin, &ovib, &ograv, &cfg.free_fall) ||
         require_keywords(args, kw, edmd_names, EDMD_REQUIRED, sim ? "EDMD" : "edmd_check") < 0)
         return -1;
 #undef ADDRESS_OF
@@ -295,7 +296,8 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
     PyArrayObject *pos = as_f64(opos, "positions", 2, any2);
     npy_intp n = pos ? PyArray_DIM(pos, 0) : 0, d = pos ? PyArray_DIM(pos, 1) : 0;
     npy_intp shp[2] = {n, d}, shn[1] = {n}, shd[1] = {d};
-    PyArrayObject *vel = NULL, *rad = NULL, *mass = NULL, *lo = NULL, *hi = NULL, *spin = NULL;
+    PyArrayObject *vel = NULL, *rad = NULL, *mass = NULL, *lo = NULL, *hi = NULL, *spin = NULL,
+                  *grav = NULL;
     npy_intp shw[2] = {n, 3};
     int ok = 0;
     if (!pos) goto done;
@@ -312,6 +314,11 @@ static int edmd_from_args(PyObject *args, PyObject *kw, gr_edmd **sim, int *dim_
     if (ospin != Py_None && !(spin = as_f64(ospin, "angular_velocities", d == 2 ? 1 : 2, shw)))
         goto done;
     cfg.spin = spin ? PyArray_DATA(spin) : NULL;
+    /* gravity: None (none, constant velocity) or d components */
+    if (ograv != Py_None) {
+        if (!(grav = as_f64(ograv, "gravity", 1, shd))) goto done;
+        for (int a = 0; a < d; a++) cfg.gravity[a] = ((double *)PyArray_DATA(grav))[a];
+    }
     cfg.dim = (int)d;
     cfg.n = n;
     for (int a = 0; a < d; a++) {
@@ -345,6 +352,7 @@ done:
     Py_XDECREF(lo);
     Py_XDECREF(hi);
     Py_XDECREF(spin);
+    Py_XDECREF(grav);
     Py_XDECREF(law_x);
     Py_XDECREF(law_y);
     Py_XDECREF(wall_x);

@@ -160,6 +160,7 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
             p[a] = pos[i * d + a];
             p[d + a] = vel[i * d + a];
             v2m += mass[i] * vel[i * d + a] * vel[i * d + a];
+            s->momentum[a] += mass[i] * vel[i * d + a];
         }
         TIME(p, d) = 0.0;
         RAD(p, d) = radius[i];
@@ -174,9 +175,13 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     }
     s->kinetic = 0.5 * v2m;
     if (cfg->stress) stress_resum(s, d); /* the rest of the tensor starts at 0 (calloc) */
+    s->mass_total = msum;
     /* The collapse test's notion of "one instant": a billionth of the time a particle
-     * of typical speed needs to cross the smallest diameter. */
-    double vrms = sqrt(v2m / msum);
+     * of typical speed needs to cross the smallest diameter.  Under gravity the speed
+     * is at least that of a fall through it from rest, sqrt(|g| sigma). */
+    double vrms = sqrt(v2m / msum), g2 = 0.0;
+    for (int a = 0; a < d; a++) g2 += cfg->gravity[a] * cfg->gravity[a];
+    vrms = fmax(vrms, sqrt(sqrt(g2) * sigma_min));
     s->eps_t = vrms > 0.0 ? 1e-9 * sigma_min / vrms : 0.0;
     s->t_prev_event = -INFINITY;
     s->drive_next = cfg->drive_kind != GR_DRIVE_NONE ? gr_drive_wait(cfg, 0) : INFINITY;

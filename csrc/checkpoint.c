@@ -181,6 +181,8 @@ static void transfer(cursor *c, gr_edmd *s)
     IO(c, cfg->stress);
     io_law(c, &cfg->law);
     io_law(c, &cfg->wall_law);
+    io(c, cfg->gravity, sizeof cfg->gravity);
+    IO(c, cfg->free_fall);
     if (c->law_differs) return; /* read: the rest is not this scene's */
     IO(c, cfg->vib.on); /* the vibrating wall: compared with the scene's in check_state */
     IO(c, cfg->vib.axis);
@@ -213,6 +215,8 @@ static void transfer(cursor *c, gr_edmd *s)
     io(c, s->st_kin, sizeof s->st_kin);
     io(c, s->st_kin_time, sizeof s->st_kin_time);
     IO(c, s->stress_t);
+    io(c, s->momentum, sizeof s->momentum);
+    IO(c, s->mass_total);
     IO(c, s->order.next);
     IO(c, s->nl.broken);
     IO(c, s->drive_next);
@@ -383,12 +387,17 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         GR_SCENE_DOUBLES(DIFFERS)
 #undef DIFFERS
         !same_double(a->cell_factor, b->cell_factor) || !same_double(a->big_ratio, b->big_ratio) ||
-        !same_double(a->shell, b->shell) || a->stress != b->stress)
-        return "its box, restitution, contact duration or engine knobs differ from the scene's";
+        !same_double(a->shell, b->shell) || a->stress != b->stress ||
+        !same_double(a->gravity[0], b->gravity[0]) || !same_double(a->gravity[1], b->gravity[1]) ||
+        !same_double(a->gravity[2], b->gravity[2]) || a->free_fall != b->free_fall)
+        return "its box, restitution, contact duration, gravity or engine knobs differ from the "
+               "scene's";
     if (a->vib.on != b->vib.on || a->vib.axis != b->vib.axis || a->vib.side != b->vib.side ||
         a->vib.waveform != b->vib.waveform || !same_double(a->vib.amplitude, b->vib.amplitude) ||
         !same_double(a->vib.omega, b->vib.omega) || !same_double(a->vib.phase, b->vib.phase))
         return "its vibrating wall differs from the scene's";
+    if (!same_double(t->mass_total, s->mass_total))
+        return "its total mass differs from the scene's";
     if (t->nl.broken != 0 && t->nl.broken != 1) return "its neighbour-list flag is corrupt";
 
     /* counters: each starts at 0 and grows by one at a time (order.next: events plus a
@@ -461,6 +470,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         !isfinite(t->kinetic_time) || !isfinite(t->virial) || !isfinite(t->wall_impulse) ||
         !isfinite(t->shear_work) ||
         !isfinite(t->wall_work) || !isfinite(t->collision_loss) ||
+        !isfinite(t->momentum[0]) || !isfinite(t->momentum[1]) || !isfinite(t->momentum[2]) ||
         t->t_prev_event != t->t_prev_event)
         return "its time or energy counters are not finite";
     if (!(t->stress_t >= 0.0 && t->stress_t <= t->t)) return "its stress tensor's clock is out of range";

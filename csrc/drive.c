@@ -66,8 +66,8 @@ static int kick(gr_edmd *s, gr_error *err)
     if (j > n - 2) j = n - 2;
     if (j >= i) j++;
     double *p = rec(s, d, i), *q = rec(s, d, j);
-    move(dyn, d, p, t);
-    move(dyn, d, q, t);
+    move(s, dyn, d, p, t);
+    move(s, dyn, d, q, t);
     double *vi = VEL(p, d), *vj = VEL(q, d);
     const double mi = s->mass[i], mj = s->mass[j];
     const double before = fl_kinetic(dyn, d, mi, vi) + fl_kinetic(dyn, d, mj, vj);

@@ -95,6 +95,8 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, d
 static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i, double t,
                                           gr_error *err);
 static void predict(gr_edmd *s, int dyn, int dim, int32_t i);
+static int advance_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                       gr_error *err);
 static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
                            double t, gr_error *err);
 static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up,
@@ -107,8 +109,8 @@ static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, i
  * GR_RULE_ROUGH (rough particles, rule.h),
  * constants in each of the four advance_* below: a constant-xi run executes the loop
  * compiled without any law code, not a test per collision, and each dynamics gets its
- * own loop the same way (constant velocity, GR_FLIGHT_LINEAR, is the only one so far: a
- * new one adds its advance_* and its choice in gr_edmd_advance, and no line here). */
+ * own loop the same way (constant velocity, GR_FLIGHT_LINEAR, and gravity: a new one
+ * adds its advance_* and its choice in gr_edmd_advance, and no line here). */
 static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, const int laws,
                                     const gr_edmd_stop *stop, gr_edmd_samples *smp,
                                     gr_error *err, const int vib)
@@ -189,7 +191,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
         } else if (e->partner >= 0) {
             if (s->sched[e->partner].count != e->pcount) { /* partner collided since: stale */
                 s->invalid++;
-                move(dyn, dim, rec(s, dim, i), te);
+                move(s, dyn, dim, rec(s, dim, i), te);
                 predict(s, dyn, dim, i);
                 continue;
             }
@@ -212,7 +214,7 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
             const double count = (double)(2 * s->pair + s->wall);
             if (count >= resum || s->kinetic <= kinetic) { /* rarely: resum <= collisions */
                 if (count >= collisions) return GR_STOP_COLLISIONS;
-                s->kinetic = kinetic_total(s, dyn, dim);
+                s->kinetic = kinetic_total(s, dyn, dim, s->momentum);
                 if (s->cfg.stress) { /* the kinetic tensor too (stress.h) */
                     stress_sync(s, dim, s->t);
                     stress_resum(s, dim);
@@ -224,6 +226,12 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
     }
 }
 
+/* This file is compiled twice: as itself, the loops of constant velocity, and by
+ * edmd_gravity.c (GR_EDMD_GRAVITY_UNIT) for gravity's.  Apart, the compiler's choices
+ * of what to inline and clone for the constant-velocity loops are those it made
+ * before gravity came: in one unit, the search functions' clones for both dynamics
+ * outgrew its limits and the plain loop ran 7 % more instructions an event. */
+#ifndef GR_EDMD_GRAVITY_UNIT
 static int advance_2d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
     return advance(s, GR_FLIGHT_LINEAR, 2, 0, stop, smp, err, 0);
@@ -260,21 +268,6 @@ static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
     return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err, 1);
 }
 
-/* A vibrating wall's run: refused where float64 cannot time the wall's phase at the end of
- * the run (or, without a time limit, now): there omega t's rounding, omega ulp(t), passes
- * GR_VIB_PHASE_RESOLUTION and the wall's position is known to less than A 2^-26. */
-static int advance_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
-{
-    const double t_end = stop->t_stop < INFINITY ? stop->t_stop : s->t;
-    if (!(vw_phase_resolution(&s->cfg.vib, t_end) <= GR_VIB_PHASE_RESOLUTION)) {
-        gr_error_set(err, GR_ERR_VALUE, -1, -1, t_end, s->cfg.vib.omega,
-                     "float64 cannot time the vibrating wall at this time: its phase omega t "
-                     "would be resolved to worse than 2^-26 radians (omega ulp(t)); a run may "
-                     "last up to about t = 2^26 / omega");
-        return GR_ERR_VALUE;
-    }
-    return s->dim == 2 ? advance_2d_vib(s, stop, smp, err) : advance_3d_vib(s, stop, smp, err);
-}
 
 /* Rough particles (rule.h): the law rule's code with the tangential impulse and spins. */
 static int advance_2d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
@@ -304,6 +297,7 @@ int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
                      "a neighbour list could not grow earlier; the system cannot go on");
         return GR_ERR_NOMEM;
     }
+    if (dynamics_of(s) == GR_FLIGHT_GRAVITY) return gr_edmd_advance_gravity(s, stop, smp, err);
     if (s->spin) /* a scene with spins: the rough rule, with or without laws */
         return s->dim == 2 ? advance_2d_rough(s, stop, smp, err)
                            : advance_3d_rough(s, stop, smp, err);
@@ -312,14 +306,70 @@ int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
         return s->dim == 2 ? advance_2d_law(s, stop, smp, err) : advance_3d_law(s, stop, smp, err);
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
 }
+#else
+/* Gravity (flight.h, GR_FLIGHT_GRAVITY): one loop per dimension, compiled with the laws'
+ * code (a constant restitution is then one test of the law's kind per collision). */
+static int advance_2d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                              gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 2, 1, stop, smp, err, 0);
+}
+
+static int advance_3d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                              gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 3, 1, stop, smp, err, 0);
+}
+
+/* a vibrating floor under gravity (vibwall.h: its search bounds the gap's curvature by
+ * |g| + A omega^2): advance_vib's loops in this unit */
+static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 2, 1, stop, smp, err, 1);
+}
+
+static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 3, 1, stop, smp, err, 1);
+}
+
+int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                            gr_error *err)
+{
+    if (s->cfg.vib.on) return advance_vib(s, stop, smp, err);
+    return s->dim == 2 ? advance_2d_gravity(s, stop, smp, err)
+                       : advance_3d_gravity(s, stop, smp, err);
+}
+#endif
+
+/* A vibrating wall's run: the vibrating-wall loops of this unit's dynamics (advance_2d_vib, advance_3d_vib) unless float64
+ * cannot time the wall's phase at the end of the run (or, without a time limit, now):
+ * there omega t's rounding, omega ulp(t), passes GR_VIB_PHASE_RESOLUTION and the wall's
+ * position is known to less than A 2^-26. */
+static int advance_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
+{
+    const double t_end = stop->t_stop < INFINITY ? stop->t_stop : s->t;
+    if (!(vw_phase_resolution(&s->cfg.vib, t_end) <= GR_VIB_PHASE_RESOLUTION)) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, t_end, s->cfg.vib.omega,
+                     "float64 cannot time the vibrating wall at this time: its phase omega t "
+                     "would be resolved to worse than 2^-26 radians (omega ulp(t)); a run may "
+                     "last up to about t = 2^26 / omega");
+        return GR_ERR_VALUE;
+    }
+    return s->dim == 2 ? advance_2d_vib(s, stop, smp, err) : advance_3d_vib(s, stop, smp, err);
+}
 
 /* Move the system clock forward to t, integrating the kinetic energy on the way
  * (flight.h: with constant velocity it changes only at collisions, so the integral is
- * exact up to rounding). */
+ * exact up to rounding; under gravity it changes in flight, and so does the momentum). */
 static inline void set_clock(gr_edmd *s, int dyn, double t)
 {
     if (t > s->t) {
-        s->kinetic_time += fl_kinetic_integral(dyn, s->kinetic, t - s->t);
+        s->kinetic_time += fl_kinetic_integral(dyn, s->dim, &s->kinetic,
+                                               s->momentum, s->mass_total, s->cfg.gravity,
+                                               t - s->t);
         s->t = t;
     }
 }
@@ -353,8 +403,8 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
 {
     if (s->le) return do_pair_sheared(s, dyn, dim, laws, i, j, t, err);
     double *p = rec(s, dim, i), *q = rec(s, dim, j);
-    move(dyn, dim, p, t);
-    move(dyn, dim, q, t);
+    move(s, dyn, dim, p, t);
+    move(s, dyn, dim, q, t);
     double dr[3];
     for (int a = 0; a < dim; a++) {
         dr[a] = q[a] - p[a];
@@ -416,12 +466,14 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
 {
     double *p = rec(s, dim, i), *v = VEL(p, dim);
     const int a = wall >> 1, up = wall & 1;
-    move(dyn, dim, p, t);
+    move(s, dyn, dim, p, t);
     if (wall == 2 * dim) { /* a sheared box's slide (lees_edwards.h): rescan */
         predict(s, dyn, dim, i);
         return GR_OK;
     }
-    double before = kinetic_of(s, dyn, dim, i), vn = v[a];
+    double before = kinetic_of(s, dyn, dim, i), vn = v[a], v_before[3];
+    if (dyn == GR_FLIGHT_GRAVITY) /* the wall's impulse changes the total momentum */
+        for (int k = 0; k < dim; k++) v_before[k] = v[k];
     int64_t clamped; /* 1 if e_w is the law's at its range's end */
     const double ew = rule_wall_eps(&s->cfg, laws, vn, t, &s->sched[i], &clamped);
     s->law_clamped += clamped;
@@ -440,6 +492,8 @@ static GR_ALWAYS_INLINE int do_wall(gr_edmd *s, int dyn, int dim, int laws, int3
     }
     s->wall_impulse += s->mass[i] * (fabs(vn) + fabs(v[a]));
     s->kinetic += kinetic_of(s, dyn, dim, i) - before;
+    if (dyn == GR_FLIGHT_GRAVITY)
+        for (int k = 0; k < dim; k++) s->momentum[k] += s->mass[i] * (v[k] - v_before[k]);
     s->wall++;
     s->sched[i].count++;
     s->sched[i].last = -2 - wall;
@@ -469,7 +523,7 @@ static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, i
     const gr_vibwall *w = &s->cfg.vib;
     double *p = rec(s, dim, i), *v = VEL(p, dim);
     const int a = w->axis;
-    move(dyn, dim, p, t);
+    move(s, dyn, dim, p, t);
     const double U = vw_velocity(w, t), vn = v[a], rel = vn - U;
     /* entering the wall's band (the search starts now), or a graze at rounding's scale */
     if (!vw_touching(w, s->cfg.lo[a], s->cfg.hi[a], t, p[a], vn, RAD(p, dim)) ||
@@ -481,9 +535,8 @@ static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, i
     const double m = s->mass[i], before = kinetic_of(s, dyn, dim, i);
     double w2 = 0.0; /* |v - U|^2 */
     for (int k = 0; k < dim; k++) w2 += k == a ? rel * rel : v[k] * v[k];
-    double vb[3]; /* the velocity before, for the stress tensor */
-    if (s->cfg.stress)
-        for (int k = 0; k < dim; k++) vb[k] = v[k];
+    double vb[3]; /* the velocity before, for the stress tensor and the momentum */
+    for (int k = 0; k < dim; k++) vb[k] = v[k];
     int64_t clamped;
     const double ew = rule_wall_eps(&s->cfg, laws, rel, t, &s->sched[i], &clamped);
     s->law_clamped += clamped;
@@ -499,6 +552,8 @@ static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, i
         }
     }
     if (s->cfg.stress) stress_wall(s, dim, t, m, vb, v);
+    if (dyn == GR_FLIGHT_GRAVITY) /* the wall's impulse changes the total momentum */
+        for (int k = 0; k < dim; k++) s->momentum[k] += m * (v[k] - (k == a ? vn : vb[k]));
     const double J = m * (v[a] - vn);
     s->wall_impulse += fabs(J);
     s->wall_work += J * U;
@@ -532,8 +587,8 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
                            double t, gr_error *err)
 {
     double *p = rec(s, dim, i), *q = rec(s, dim, j);
-    move(dyn, dim, p, t);
-    move(dyn, dim, q, t);
+    move(s, dyn, dim, p, t);
+    move(s, dyn, dim, q, t);
     double dr[3], vq[3];
     for (int a = 0; a < dim; a++) dr[a] = bd_nearest(q[a] - p[a], s->L[a]);
     const double delta = bd_le_offset(s->cfg.shear_offset, s->le_u, t, s->L[0]);
@@ -616,7 +671,7 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, d
     gr_sched *e = &s->sched[i];
     int32_t *c = e->c;
     const int a = e->cross >> 1, dir = (e->cross & 1) ? 1 : -1;
-    move(dyn, dim, p, t);
+    move(s, dyn, dim, p, t);
     int32_t old = cell_of(&s->cells, dim, c);
     int32_t q = c[a] + dir;
     if (q >= s->cells.nc[a]) { /* out of the last cell: out of a periodic box (boundary.h) */
@@ -660,7 +715,7 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
 {
     double *p = rec(s, dim, i);
     gr_sched *e = &s->sched[i];
-    move(dyn, dim, p, t);
+    move(s, dyn, dim, p, t);
     int wrapped = 0;
     if (s->cfg.periodic) {
         for (int a = 0; a < dim; a++) /* not wrapped |= ...: that costs the cell-crossing
@@ -699,6 +754,7 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
 
 /* The list scan's compilation in use: AVX2's four lanes where the CPU has them, unless
  * GRANULAR_SCAN_KERNEL=plain (the tests run both: the bits must not depend on it). */
+#ifndef GR_EDMD_GRAVITY_UNIT
 static int scan_avx2;
 
 void gr_scan_init(void)
@@ -714,6 +770,9 @@ const char *gr_scan_kernel(void)
 {
     return scan_avx2 ? "avx2" : "plain";
 }
+#else
+static const int scan_avx2 = 0; /* gravity runs the plain scan (predict) */
+#endif
 
 static void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i);
 
@@ -725,7 +784,7 @@ static void predict(gr_edmd *s, int dyn, int dim, int32_t i)
     if (s->nl.shell > 0.0) {
         const double *p = rec(s, dim, i);
         s->sched[i].t_cross = TIME(p, dim) + fl_exit_time(dyn, dim, p, VEL(p, dim),
-                                                       s->nl.centre + (size_t)i * (dim + 1),
+                                                       s->cfg.gravity, s->nl.centre + (size_t)i * (dim + 1),
                                                        s->nl.exit2);
 #ifdef GR_SCAN_X86
         /* the four-lane scan is written for straight lines (GR_FL_SEP) */
@@ -756,7 +815,7 @@ static void predict_wall_vib(gr_edmd *s, int dyn, int dim, int32_t i)
     const double *p = rec(s, dim, i), *v = VEL(p, dim);
     const gr_vibwall *w = &s->cfg.vib;
     gr_sched *e = &s->sched[i];
-    double best = vw_hit_time(w, dyn, w->axis, s->cfg.lo[w->axis], s->cfg.hi[w->axis],
+    double best = vw_hit_time(w, dyn, s->cfg.gravity[w->axis], s->cfg.lo[w->axis], s->cfg.hi[w->axis],
                               TIME(p, dim), p[w->axis], v[w->axis], RAD(p, dim));
     int32_t wall = best < INFINITY ? 2 * w->axis + w->side : -1;
     for (int a = 0; a < dim; a++) {
@@ -767,7 +826,7 @@ static void predict_wall_vib(gr_edmd *s, int dyn, int dim, int32_t i)
             if (w->side) hi_stop = INFINITY;
             else lo_stop = -INFINITY;
         }
-        const int up = fl_wall_time(dyn, p[a], v[a], lo_stop, hi_stop, &dt);
+        const int up = fl_wall_time(dyn, p[a], v[a], s->cfg.gravity[a], lo_stop, hi_stop, &dt);
         if (up < 0 || !(dt < INFINITY)) continue;
         if (dt < 0.0) dt = 0.0;
         if (dt < best) {
@@ -797,7 +856,7 @@ static inline void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i)
     int32_t wall = -1;
     for (int a = 0; a < dim; a++) {
         double dt;
-        const int up = fl_wall_time(dyn, p[a], v[a], bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim)),
+        const int up = fl_wall_time(dyn, p[a], v[a], s->cfg.gravity[a], bd_wall_stop_lo(s->cfg.lo[a], RAD(p, dim)),
                                     bd_wall_stop_hi(s->cfg.hi[a], RAD(p, dim)), &dt);
         if (up < 0) continue;
         if (dt < 0.0) dt = 0.0;
@@ -824,8 +883,8 @@ static GR_ALWAYS_INLINE void predict_cross_in(gr_edmd *s, int dyn, int dim, int3
     int32_t code = -1;
     for (int a = 0; a < dim; a++) {
         int up, open;
-        double dt = fl_cross_time(dyn, p[a], VEL(p, dim)[a], s->cfg.lo[a], c[a], g->w[a], &up,
-                                  &open);
+        double dt = fl_cross_time(dyn, p[a], VEL(p, dim)[a], s->cfg.gravity[a], s->cfg.lo[a],
+                                  c[a], g->w[a], &up, &open);
         if (!periodic) /* a wall has no cell behind it */
             open &= bd_cell_beyond(up, c[a], g->nc[a]);
         dt = open ? dt : INFINITY;
@@ -862,10 +921,11 @@ static int start(gr_edmd *s, int dyn, int dim, gr_error *err)
     return GR_OK;
 }
 
+#ifndef GR_EDMD_GRAVITY_UNIT
 int gr_predict_all(gr_edmd *s, gr_error *err)
 {
-    const int dyn = dynamics_of(s);
-    return s->dim == 2 ? start(s, dyn, 2, err) : start(s, dyn, 3, err);
+    if (dynamics_of(s) == GR_FLIGHT_GRAVITY) return gr_predict_all_gravity(s, err);
+    return s->dim == 2 ? start(s, GR_FLIGHT_LINEAR, 2, err) : start(s, GR_FLIGHT_LINEAR, 3, err);
 }
 
 void gr_predict_one(gr_edmd *s, int32_t i)
@@ -874,3 +934,9 @@ void gr_predict_one(gr_edmd *s, int32_t i)
     if (s->dim == 2) predict(s, dyn, 2, i); /* the clones the loops use */
     else predict(s, dyn, 3, i);
 }
+#else
+int gr_predict_all_gravity(gr_edmd *s, gr_error *err)
+{
+    return s->dim == 2 ? start(s, GR_FLIGHT_GRAVITY, 2, err) : start(s, GR_FLIGHT_GRAVITY, 3, err);
+}
+#endif

@@ -49,6 +49,10 @@ typedef struct {
     double phase;             /* radians, finite */
 } gr_vibwall;
 
+/* The largest |g| times the box's longest side (validate.c): a speed squared, within the
+ * square of the scale limit 1e140 (granular/_scales.py). */
+#define GR_GRAVITY_GL_MAX 1e280
+
 typedef struct {
     int dim;                  /* 2 or 3 */
     int64_t n;                /* number of particles, >= 1 */
@@ -67,6 +71,10 @@ typedef struct {
     double shear_rate;        /* periodic only: Lees-Edwards images across the y faces
                                * sliding along x at shear_rate * L_y (boundary.h); 0: none */
     double shear_offset;      /* their x offset at time 0, in [0, L_x) */
+    double gravity[3];        /* uniform acceleration on every particle (only the first dim
+                               * used; all 0: constant velocity, flight.h) */
+    int free_fall;            /* 1: gravity in a periodic box allowed (the centre of mass
+                               * falls forever); 0: refused there */
     gr_law law, wall_law;     /* kind GR_LAW_CONSTANT (zeroed): restitution and
                                * wall_restitution above; else eps(v_n) replaces them
                                * (restitution.h).  gr_edmd_new copies the tables. */

@@ -76,6 +76,10 @@ struct gr_edmd {
     double drive_energy;
     double wall_work;      /* vibrating wall (vibwall.h): the work it did on the particles */
     double collision_loss; /* vibrating wall: the energy collisions dissipated */
+    /* gravity only (flight.h, fl_kinetic_integral): the total momentum at time t, which
+     * the kinetic energy's growth in flight needs, and the total mass */
+    double momentum[3];
+    double mass_total;
 };
 
 /* Consecutive collisions of one particle, each within eps_t of the previous, that are
@@ -120,28 +124,48 @@ static inline double *rec(const gr_edmd *s, int dim, int32_t i)
 /* The caller's index of internal particle i (negative codes pass through). */
 static inline int64_t uid(const gr_edmd *s, int32_t i) { return i < 0 ? -1 : s->order.id_of[i]; }
 
-/* The dynamics of system s (flight.h): constant velocity, the only one so far.  A second
- * one is a config field read here, and gr_edmd_advance chooses its loop from it. */
+/* The dynamics of system s (flight.h): gravity when the config's acceleration is not
+ * zero, else constant velocity; gr_edmd_advance chooses its loop from it. */
 static inline int dynamics_of(const gr_edmd *s)
 {
-    (void)s;
-    return GR_FLIGHT_LINEAR;
+    const double *g = s->cfg.gravity;
+    return g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0 ? GR_FLIGHT_GRAVITY : GR_FLIGHT_LINEAR;
 }
 
-/* Move record p in free flight (flight.h) to time t. */
-static inline void move(int dyn, int dim, double *p, double t)
+/* Move record p of system s in free flight (flight.h) to time t. */
+static inline void move(const gr_edmd *s, int dyn, int dim, double *p, double t)
 {
-    fl_move(dyn, dim, p, VEL(p, dim), &TIME(p, dim), t);
+    fl_move(dyn, dim, p, VEL(p, dim), s->cfg.gravity, &TIME(p, dim), t);
 }
 
 /* The total kinetic energy summed from the velocities: the event loop's (with its
  * constant dim, a loop of a few instructions a particle) and the counters' give the same
  * bits, so a run stopped on energy reads at most its target in the counters.  Records
  * hold the velocities at each particle's own clock: right for constant velocity, where
- * they do not change in flight (a dynamics where they do brings them to s->t first). */
-static inline double kinetic_total(const gr_edmd *s, int dyn, int dim)
+ * they do not change in flight; under gravity they are brought to s->t first, and the
+ * total momentum at s->t is summed into momentum[dim] (if not NULL) on the way. */
+static GR_NOINLINE double kinetic_total_gravity(const gr_edmd *s, int dim, double *momentum)
+{
+    double k = 0.0, mom[3] = {0.0, 0.0, 0.0};
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *p = rec(s, dim, i), dt = s->t - TIME(p, dim);
+        double v[3];
+        for (int a = 0; a < dim; a++) {
+            v[a] = fl_vel_at(GR_FLIGHT_GRAVITY, VEL(p, dim)[a], s->cfg.gravity[a], dt);
+            mom[a] += s->mass[i] * v[a];
+        }
+        k += fl_kinetic(GR_FLIGHT_GRAVITY, dim, s->mass[i], v);
+    }
+    if (momentum)
+        for (int a = 0; a < dim; a++) momentum[a] = mom[a];
+    return k;
+}
+
+static inline double kinetic_total(const gr_edmd *s, int dyn, int dim, double *momentum)
 {
     double k = 0.0;
+    if (dyn == GR_FLIGHT_GRAVITY) return kinetic_total_gravity(s, dim, momentum);
+    (void)momentum;
     for (int32_t i = 0; i < s->n; i++)
         k += fl_kinetic(dyn, dim, s->mass[i], VEL(rec(s, dim, i), dim));
     return k;
@@ -180,5 +204,11 @@ void gr_predict_one(gr_edmd *s, int32_t i);
  * driving force: drive.c runs it between kicks. */
 int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err);
+
+/* Gravity's loop and first predictions (edmd.c compiled again as edmd_gravity.c), which
+ * gr_edmd_advance and gr_predict_all call for a system under gravity. */
+int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                            gr_error *err);
+int gr_predict_all_gravity(gr_edmd *s, gr_error *err);
 
 #endif

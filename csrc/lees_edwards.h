@@ -75,8 +75,8 @@ static inline void le_try_pair(const gr_edmd *s, int dyn, int dim, int32_t i, co
     const double *q = rec(s, dim, j);
     double dtj = TIME(p, dim) - TIME(q, dim), dr[3], dv[3];
     for (int a = 0; a < dim; a++) {
-        dr[a] = fl_sep(dyn, q[a], VEL(q, dim)[a], dtj, p[a]) + shift[a];
-        dv[a] = fl_relvel(dyn, VEL(q, dim)[a], VEL(p, dim)[a]);
+        dr[a] = fl_sep(dyn, q[a], VEL(q, dim)[a], s->cfg.gravity[a], dtj, p[a]) + shift[a];
+        dv[a] = fl_relvel(dyn, VEL(q, dim)[a], VEL(p, dim)[a], s->cfg.gravity[a], dtj);
     }
     dv[0] += vx;
     double dt;

@@ -20,7 +20,7 @@ static void stress_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
     for (int32_t i = 0; i < s->n; i++) {
         const double *p = rec(s, dim, i), m = s->mass[i], dt = ts - TIME(p, dim);
         double v[3];
-        for (int a = 0; a < dim; a++) v[a] = fl_vel_at(dyn, VEL(p, dim)[a], dt);
+        for (int a = 0; a < dim; a++) v[a] = fl_vel_at(dyn, VEL(p, dim)[a], s->cfg.gravity[a], dt);
         for (int a = 0; a < dim; a++)
             for (int b = 0; b < dim; b++) k[a * dim + b] += m * v[a] * v[b];
     }
@@ -38,9 +38,10 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
         const double dt = ts - TIME(p, dim), m = s->mass[i];
         const size_t out = base + (size_t)s->order.id_of[i] * dim;
         for (int a = 0; a < dim; a++) {
-            double v = fl_vel_at(dyn, VEL(p, dim)[a], dt);
+            const double g = s->cfg.gravity[a];
+            double v = fl_vel_at(dyn, VEL(p, dim)[a], g, dt);
             if (smp->pos)
-                smp->pos[out + a] = bd_unwrap(fl_at(dyn, p[a], VEL(p, dim)[a], dt),
+                smp->pos[out + a] = bd_unwrap(fl_at(dyn, p[a], VEL(p, dim)[a], g, dt),
                                               s->image[(size_t)i * dim + a], s->L[a]);
             if (smp->pos && a == 0 && s->le) /* boundary.h: + img_y D(t) */
                 smp->pos[out] += (double)s->image[(size_t)i * dim + 1] *
@@ -75,8 +76,8 @@ static void state_sheared(const gr_edmd *s, int32_t i, double *pos, double *vel,
     double x[3], v[3];
     int64_t img[3];
     for (int a = 0; a < d; a++) {
-        x[a] = fl_at(dyn, p[a], VEL(p, d)[a], dt);
-        v[a] = fl_vel_at(dyn, VEL(p, d)[a], dt);
+        x[a] = fl_at(dyn, p[a], VEL(p, d)[a], s->cfg.gravity[a], dt);
+        v[a] = fl_vel_at(dyn, VEL(p, d)[a], s->cfg.gravity[a], dt);
         img[a] = s->image[(size_t)i * d + a];
     }
     const int64_t img_y = img[1];
@@ -108,13 +109,13 @@ void gr_edmd_state(const gr_edmd *s, double *pos, double *vel, int64_t *image)
         const double *p = rec(s, d, i);
         double dt = s->t - TIME(p, d);
         for (int a = 0; a < d; a++) {
-            double x = fl_at(dyn, p[a], VEL(p, d)[a], dt);
+            double x = fl_at(dyn, p[a], VEL(p, d)[a], s->cfg.gravity[a], dt);
             int64_t img = s->image[(size_t)i * d + a];
             size_t out = (size_t)s->order.id_of[i] * d + a;
             /* a crossing due exactly now may not have been processed yet */
             if (s->cfg.periodic) bd_reenter(&x, s->cfg.lo[a], s->cfg.hi[a], s->L[a], &img);
             if (pos) pos[out] = x;
-            if (vel) vel[out] = fl_vel_at(dyn, VEL(p, d)[a], dt);
+            if (vel) vel[out] = fl_vel_at(dyn, VEL(p, d)[a], s->cfg.gravity[a], dt);
             if (image) image[out] = img;
         }
     }
@@ -148,7 +149,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     c->collision_loss = s->collision_loss;
     c->kinetic_time = s->kinetic_time;
     c->shear_work = s->shear_work;
-    c->kinetic = kinetic_total(s, dynamics_of(s), s->dim);
+    c->kinetic = kinetic_total(s, dynamics_of(s), s->dim, NULL);
     for (int a = 0; a < 3; a++) c->ncell[a] = s->cells.nc[a];
     for (int k = 0; k < 9; k++) { /* zeros without cfg.stress (calloc) */
         c->stress_collisional[k] = s->st_coll[k];

@@ -36,10 +36,10 @@ static GR_ALWAYS_INLINE void try_pair(const gr_edmd *s, int dyn, int dim, int32_
     const double *q = rec(s, dim, j);
     double dtj = TIME(p, dim) - TIME(q, dim), dr[3], dv[3];
     for (int a = 0; a < dim; a++) {
-        dr[a] = fl_sep(dyn, q[a], VEL(q, dim)[a], dtj, p[a]);
+        dr[a] = fl_sep(dyn, q[a], VEL(q, dim)[a], s->cfg.gravity[a], dtj, p[a]);
         if (shift) dr[a] += shift[a];
         if (nearest) dr[a] = bd_nearest(dr[a], s->L[a]);
-        dv[a] = fl_relvel(dyn, VEL(q, dim)[a], VEL(p, dim)[a]);
+        dv[a] = fl_relvel(dyn, VEL(q, dim)[a], VEL(p, dim)[a], s->cfg.gravity[a], dtj);
     }
     double dt;
     if (!fl_pair_beats(dyn, dim, dr, dv, RAD(p, dim) + RAD(q, dim), *best, &dt)) return;

@@ -244,6 +244,48 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
                      "shell must be 0 (cells) or finite and at least 0.01 (largest diameters)");
         return GR_ERR_VALUE;
     }
+    /* gravity: finite; in a periodic box only as the free-fall frame asked for; and
+     * small enough that g times any length in the box (the quadratics' 4 a d, a speed
+     * squared, flight.h) stays within the square of the scale limit (granular/_scales.py):
+     * beyond, a flight across a cell cannot be timed in float64 */
+    int pulls = 0;
+    double box_diag = 0.0;
+    for (int a = 0; a < d; a++) box_diag = fmax(box_diag, cfg->hi[a] - cfg->lo[a]);
+    for (int a = 0; a < 3; a++) {
+        const double g = cfg->gravity[a];
+        if (!isfinite(g) || (a >= d && g != 0.0)) {
+            gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, g,
+                         "gravity must be finite, with one component per axis");
+            return GR_ERR_VALUE;
+        }
+        if (g != 0.0 && !(fabs(g) * box_diag <= GR_GRAVITY_GL_MAX)) {
+            gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, g,
+                         "gravity times the box length exceeds 1e280: float64 cannot time a "
+                         "flight across a cell; choose units nearer the scene's");
+            return GR_ERR_VALUE;
+        }
+        pulls |= g != 0.0;
+    }
+    if (pulls && cfg->periodic && !cfg->free_fall) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN,
+                     "gravity in a periodic box has no floor: the centre of mass falls forever; "
+                     "pass free_fall=True to simulate that frame, or use walls");
+        return GR_ERR_VALUE;
+    }
+    /* gravity's loops (edmd_gravity.c) have neither the rough rule, nor the sliding images'
+     * slide events, nor a flight integral of the kinetic tensor (stress.h) */
+    const char *unlike = !pulls ? NULL
+                         : cfg->spin ? "gravity is not offered with rough particles (a tangential "
+                                       "restitution above -1) yet"
+                         : cfg->shear_rate != 0.0 ? "gravity is not offered in a sheared box yet"
+                         : cfg->stress ? "gravity is not offered with the stress tensor "
+                                         "(stress=True) yet: its kinetic part would need the "
+                                         "flight integral under gravity"
+                         : NULL;
+    if (unlike) {
+        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, unlike);
+        return GR_ERR_VALUE;
+    }
     const int32_t n = (int32_t)cfg->n;
     double sigma_max = 0.0;
     for (int32_t i = 0; i < n; i++) {

@@ -47,11 +47,9 @@
 #define GR_VW_PI 3.14159265358979323846
 
 /* A bound on the particle's acceleration along axis a under dynamics dyn. */
-static inline double vw_normal_accel(int dyn, int a)
+static inline double vw_normal_accel(int dyn, double g)
 {
-    (void)dyn;
-    (void)a;
-    return 0.0;
+    return dyn == GR_FLIGHT_GRAVITY ? fabs(g) : 0.0;
 }
 
 /* The wall's phase omega t + phase at absolute time t. */
@@ -160,7 +158,7 @@ static inline int vw_touching(const gr_vibwall *w, double lo, double hi, double 
  * wall's axis a, radius r) to its first contact with the vibrating wall w of the box
  * [lo, hi] along a, approaching it, or the time it enters the wall's band if it is outside
  * (vw_touching tells the two apart); +inf if there is neither. */
-static inline double vw_hit_time(const gr_vibwall *w, int dyn, int a, double lo, double hi,
+static inline double vw_hit_time(const gr_vibwall *w, int dyn, double g, double lo, double hi,
                                  double t0, double x0, double v0, double r)
 {
     const double sigma = w->side ? -1.0 : 1.0;
@@ -168,19 +166,19 @@ static inline double vw_hit_time(const gr_vibwall *w, int dyn, int a, double lo,
     /* the innermost face of the band the wall sweeps, less the radius: the centre plane
      * beyond which no contact is possible */
     const double band = w->side ? hi - 2.0 * A - r : lo + 2.0 * A + r;
-    const double K = vw_normal_accel(dyn, a) +
+    const double K = vw_normal_accel(dyn, g) +
                      (w->waveform == GR_WAVE_SINE ? A * w->omega * w->omega : 0.0);
     const double tol = vw_tol(w, lo, hi, t0);
     const double min_step = K > 0.0 ? sqrt(2.0 * tol / K) : 0.0;
     double tau = 0.0;
     for (int it = 0; it < GR_VIB_MAX_STEPS; it++) {
-        const double x = fl_at(dyn, x0, v0, tau), v = fl_vel_at(dyn, v0, tau);
+        const double x = fl_at(dyn, x0, v0, g, tau), v = fl_vel_at(dyn, v0, g, tau);
         /* outside the band (by more than rounding: a particle flown to its face is in it):
          * fly to its face */
         if (sigma * (x - band) > tol) {
             double dt = INFINITY;
-            const int which = w->side ? fl_wall_time(dyn, x, v, -INFINITY, band, &dt)
-                                      : fl_wall_time(dyn, x, v, band, INFINITY, &dt);
+            const int which = w->side ? fl_wall_time(dyn, x, v, g, -INFINITY, band, &dt)
+                                      : fl_wall_time(dyn, x, v, g, band, INFINITY, &dt);
             if (which != w->side || !(dt < INFINITY)) return INFINITY;
             /* the time it enters the band: an event there (vw_touching says it is no
              * contact) starts the exact search, so that a particle far from the wall costs

@@ -52,6 +52,7 @@ QUANTITIES: dict[str, Quantity] = {
     "speed": Quantity("particle speed", "sqrt(eps/m)", "nonnegative"),
     "eta": Quantity("packing fraction (area fraction in 2D)", "dimensionless", "packing"),
     "box": Quantity("side length of a periodic box", "L", "positive"),
+    "z": Quantity("height along the axis opposite to gravity", "L"),
     # the gas
     "n": Quantity("number of particles N", "dimensionless count", "positive"),
     "density": Quantity("number density N / V (N / A in 2D)", "L^-d", "positive"),
@@ -86,6 +87,11 @@ QUANTITIES: dict[str, Quantity] = {
         "self-diffusion coefficient per dimension, <dx^2> = 2 D t", "L^2 / time", "positive"
     ),
     "viscosity": Quantity("shear viscosity", "m / (L^(d-2) time)", "positive"),
+    "area": Quantity(
+        "cross-section the centres spread over (a length in 2D)", "L^(d-1)", "positive"
+    ),
+    "bottom": Quantity("height from which particles are counted", "L"),
+    "top": Quantity("height up to which particles are counted", "L"),
     # the models' coefficients
     "D0": Quantity("diffusivity per dimension at t = 0", "L^2 / time", "positive"),
     "gamma0": Quantity("friction rate at t = 0", "1 / time", "positive"),

@@ -276,6 +276,28 @@ def _spin_keywords(kept: Any) -> dict[str, Any]:
     return {"angular_velocities": kept}
 
 
+def _gravity(value: Any, n: int, d: int) -> np.ndarray | None:
+    """None (no field) or a read-only length-d acceleration, finite; all zeros is None
+    (the engine's constant-velocity loop either way)."""
+    if value is None:
+        return None
+    a = real(value, "gravity")
+    if a.shape != (d,):
+        raise ValueError(f"gravity must have one component per axis, shape ({d},), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"gravity must be finite, got {a.tolist()}")
+    if not np.any(a):
+        return None
+    return array(a, "gravity", (d,))
+
+
+def _free_fall(value: Any, n: int, d: int) -> bool:
+    # a number 0 or 1 too: a GSD file logs it as one
+    if not (isinstance(value, (bool, np.bool_)) or (np.ndim(value) == 0 and value in (0, 1))):
+        raise TypeError(f"free_fall must be True or False, got {value!r}")
+    return bool(value)
+
+
 def _law_keywords(number: str, law: str) -> Callable[[Any], dict[str, Any]]:
     """A restitution's keywords: the number (1, unused, for a law) and the law (None for a
     number: the engine's constant loop)."""
@@ -512,6 +534,33 @@ PARAMETERS += (
         "None: every wall fixed.",
         check_scene_wall,
         engine_wall,
+    ),
+    # gravity (csrc/flight.h; docs/gravity.md)
+    SceneParameter(
+        "gravity",
+        "array_like or None",
+        ("d",),
+        None,
+        "eps/(m L)",
+        "Uniform acceleration g on every particle (an acceleration: length per time "
+        "squared), one component per axis: parabolic flight between events "
+        "(docs/gravity.md).  None (or zeros): none.  Between walls the floor is the wall g "
+        "points at; in a periodic box it needs ``free_fall=True``.",
+        _gravity,
+        _same("gravity"),
+    ),
+    SceneParameter(
+        "free_fall",
+        "bool",
+        None,
+        False,
+        "",
+        "Allow gravity in a periodic box: the lab frame of a box falling freely, where the "
+        "centre of mass accelerates forever (v grows as g t) while the motion relative to "
+        "it is that of the gas without gravity.  Without it such a scene is refused; "
+        "between walls it changes nothing.",
+        _free_fall,
+        _same("free_fall"),
     ),
 )
 

@@ -8,6 +8,7 @@ dimension, as in ``granular.theory``.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -495,3 +496,160 @@ def ensemble_mean(
     if m < 2:
         raise ValueError("ensemble_mean needs at least two runs for an error")
     return a.mean(axis=axis), a.std(axis=axis, ddof=1) / math.sqrt(m)
+
+
+# -- profiles along an axis ------------------------------------------------------------------
+
+
+class Profile:
+    """Profiles of a gas along one axis, from ``profile``: each quantity in bins, with the
+    standard error of its mean over blocks of samples.
+
+    Attributes
+    ----------
+    axis : int
+        The axis along which the bins lie.
+    edges : ndarray (B + 1,)
+        Bin edges [L]; ``centres`` (B,) their midpoints.
+    density, density_error : ndarray (B,)
+        Number density of centres in each bin (count over the bin's volume: its width
+        times the cross-section of ``within``) [L^-d].
+    temperature, temperature_error : ndarray (B, d)
+        Temperature per velocity component, ``T_a = sum m (v_a - u_a)^2 / count`` with
+        u the bin's mass-weighted mean velocity [eps]; NaN where a block has no particle
+        in the bin.
+    velocity, velocity_error : ndarray (B, d)
+        The mass-weighted mean velocity u in each bin [sqrt(eps/m)].
+    count : ndarray (B,)
+        Mean number of centres in each bin per sample.
+    blocks : int
+        The number of blocks the errors come from.
+    """
+
+    def __init__(self, **fields: Any) -> None:
+        self.__dict__.update(fields)
+
+    axis: int
+    edges: NDArray[np.float64]
+    centres: NDArray[np.float64]
+    density: NDArray[np.float64]
+    density_error: NDArray[np.float64]
+    temperature: NDArray[np.float64]
+    temperature_error: NDArray[np.float64]
+    velocity: NDArray[np.float64]
+    velocity_error: NDArray[np.float64]
+    count: NDArray[np.float64]
+    blocks: int
+
+
+def profile(
+    trajectory: Any,
+    axis: int = -1,
+    *,
+    bins: int | ArrayLike = 20,
+    within: tuple[ArrayLike, ArrayLike] | None = None,
+    blocks: int = 10,
+) -> Profile:
+    """Number density, temperature per component and mean velocity along ``axis``, in bins.
+
+    Each of the ``blocks`` consecutive blocks of samples gives its own profile (the sums
+    of its samples); the result is their mean, its error the standard error of that mean,
+    ``std(block values, ddof=1) / sqrt(blocks)``.  Block averaging: samples closer in time
+    than a correlation time are not independent, and whole blocks much longer than it
+    are; so choose samples spread over many correlation times (a block of a few, its
+    errors are then honest; with blocks shorter than the correlation time they are too
+    small).  With one sample per block (blocks = samples) the samples are taken as
+    independent.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+        A run with positions and velocities stored (``store=("positions", "velocities")``).
+    axis : int
+        The axis of the profile (default the last: z in 3D, y in 2D).
+    bins : int or array_like
+        Number of equal bins across the box along ``axis`` (or across ``within``), or
+        the bin edges [L].
+    within : (lower, upper), optional
+        Count only the centres inside this box (length-d corners) [L]; the density is per
+        its cross-section.  Default: the trajectory's box.  Keep away from side walls,
+        where a dense gas layers, with a narrower box.
+    blocks : int
+        Blocks of consecutive samples for the error bars (>= 2, at most the samples).
+
+    Returns
+    -------
+    Profile
+    """
+    x = trajectory._need("positions")
+    v = trajectory._need("velocities")
+    samples, n, d = x.shape
+    if not -d <= axis < d:
+        raise ValueError(f"axis must be one of the {d} axes, got {axis}")
+    axis %= d
+    if not (isinstance(blocks, (int, np.integer)) and 2 <= blocks <= samples):
+        raise ValueError(
+            f"blocks must be an integer from 2 to the number of samples ({samples}), got "
+            f"{shown(blocks)}"
+        )
+    lower = np.asarray(trajectory.lower, dtype=np.float64)
+    upper = np.asarray(trajectory.upper, dtype=np.float64)
+    if within is not None:
+        lower = np.broadcast_to(np.asarray(within[0], dtype=np.float64), (d,)).copy()
+        upper = np.broadcast_to(np.asarray(within[1], dtype=np.float64), (d,)).copy()
+        if not (
+            np.all(np.isfinite(lower)) and np.all(np.isfinite(upper)) and np.all(upper > lower)
+        ):
+            raise ValueError(f"within needs finite lower < upper, got {lower} and {upper}")
+    if np.ndim(bins) == 0:
+        if not (isinstance(bins, (int, np.integer)) and bins >= 1):
+            raise ValueError(f"bins must be a positive integer or the edges, got {shown(bins)}")
+        edges = np.linspace(lower[axis], upper[axis], int(bins) + 1)
+    else:
+        edges = np.asarray(bins, dtype=np.float64)
+        if edges.ndim != 1 or len(edges) < 2 or np.any(np.diff(edges) <= 0):
+            raise ValueError("bins as edges must be increasing, at least two of them")
+        if not np.all(np.isfinite(edges)):
+            raise ValueError("bins as edges must be finite")
+    # positions inside the box (a periodic box's images wrapped back)
+    if trajectory.boundary == "periodic":
+        length = trajectory.upper - trajectory.lower
+        x = trajectory.lower + np.mod(x - trajectory.lower, length)
+    m = np.asarray(trajectory.masses, dtype=np.float64)
+    cross = float(np.prod(np.delete(upper - lower, axis)))
+    nb = len(edges) - 1
+    inside = np.all((x >= lower) & (x < upper), axis=-1) & (x[..., axis] >= edges[0])
+    inside &= x[..., axis] < edges[-1]
+    which = np.clip(np.searchsorted(edges, x[..., axis], side="right") - 1, 0, nb - 1)
+    dens, temp, vel = [], [], []
+    for part in np.array_split(np.arange(samples), blocks):
+        sel = inside[part]
+        b = which[part][sel]
+        mm = np.broadcast_to(m, (len(part), n))[sel]
+        vv = v[part][sel]
+        count = np.bincount(b, minlength=nb).astype(np.float64)
+        msum = np.bincount(b, weights=mm, minlength=nb)
+        p = np.stack([np.bincount(b, weights=mm * vv[:, a], minlength=nb) for a in range(d)], 1)
+        e2 = np.stack(
+            [np.bincount(b, weights=mm * vv[:, a] ** 2, minlength=nb) for a in range(d)], 1
+        )
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = p / msum[:, None]
+            temp.append((e2 - p * u) / count[:, None])
+        vel.append(u)
+        dens.append(count / (len(part) * cross * np.diff(edges)))
+    dens_a, temp_a, vel_a = np.array(dens), np.array(temp), np.array(vel)
+    root = math.sqrt(blocks)
+    return Profile(
+        axis=axis,
+        edges=edges,
+        centres=0.5 * (edges[1:] + edges[:-1]),
+        density=dens_a.mean(0),
+        density_error=dens_a.std(0, ddof=1) / root,
+        temperature=temp_a.mean(0),
+        temperature_error=temp_a.std(0, ddof=1) / root,
+        velocity=vel_a.mean(0),
+        velocity_error=vel_a.std(0, ddof=1) / root,
+        count=dens_a.mean(0) * cross * np.diff(edges),
+        blocks=blocks,
+    )

@@ -60,6 +60,9 @@ class _Run(Protocol):
     @property
     def scene(self) -> Scene: ...
 
+    @property
+    def time(self) -> float: ...
+
 
 _S = TypeVar("_S", bound=_Run)
 
@@ -83,6 +86,16 @@ _SCENE_PARAMS = tuple(p.name for p in PARAMETERS if not p.is_array)
 _CONSERVED_RTOL = 1e-6
 
 
+def potential_energy(scene: Any) -> float:
+    """The potential energy of ``scene``'s particles in its gravity, measured from the
+    box's corner that g points to (so it is >= 0): sum of m g . (corner - x)."""
+    g = scene.gravity
+    if g is None:
+        return 0.0
+    corner = np.where(g > 0, scene.upper, scene.lower)
+    return float(np.sum(scene.masses * ((corner - scene.positions) @ g)))
+
+
 def _version() -> str:
     from . import __version__
 
@@ -103,6 +116,16 @@ def _fault(sim: _Run) -> str | None:
     e0 = start.kinetic_energy + start.rotational_energy
     e = now.kinetic_energy + now.rotational_energy
     periodic = start.boundary == "periodic"
+    if start.gravity is not None:
+        # gravity: between walls the energy kept is kinetic + potential; in a freely
+        # falling periodic box the motion relative to the fall (v - g t) is that of a gas
+        # without gravity, so the same checks apply to it
+        if periodic:
+            fall = start.gravity * sim.time
+            now = now.replace(velocities=now.velocities - fall, gravity=None, free_fall=False)
+            e = now.kinetic_energy
+        else:
+            e0, e = (x.kinetic_energy + potential_energy(x) for x in (start, now))
     if start.shear_rate != 0.0:
         return _sheared_fault(sim, start, now)
     if start.vibrating_wall is not None:  # it heats: the energy must be its bookkeeping's
@@ -201,7 +224,11 @@ def dumps(sim: _Run) -> bytes:
         "scene": {name: describe(getattr(scene, name)) for name in _SCENE_PARAMS},
         "engine_state_sha256": hashlib.sha256(state.data).hexdigest(),
     }
-    arrays = {f"scene_{name}": getattr(scene, name) for name in _SCENE_ARRAYS}
+    # an unset array (gravity None) is stored as zeros, which its check reads as unset
+    stored = {name: getattr(scene, name) for name in _SCENE_ARRAYS}
+    arrays: dict[str, Any] = {
+        f"scene_{name}": np.zeros(scene.dim) if a is None else a for name, a in stored.items()
+    }
     buf = io.BytesIO()
     np.savez(buf, meta=np.array(json.dumps(meta)), engine_state=state, **arrays)
     return buf.getvalue()

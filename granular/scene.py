@@ -117,6 +117,26 @@ def _check_spin_scales(scene):
     )
 
 
+def _check_gravity(scene: Scene) -> None:
+    """Gravity that needs the box and the boundary: in a periodic box only with
+    ``free_fall=True`` (else the centre of mass falls forever unasked), and |g| times the
+    box's longest edge (a speed squared: the flight quadratics' 4 a d, csrc/flight.h)
+    within SCALE_HI**2, where float64 can still time a flight across a cell."""
+    g = scene.gravity
+    if g is None:
+        return
+    if scene.boundary == "periodic" and not scene.free_fall:
+        raise ValueError(
+            f"gravity = {g.tolist()} in a periodic box has no floor: the centre of mass would "
+            "fall forever, its speed growing as g t.  Use boundary='walls' for a floor, or "
+            "pass free_fall=True to simulate the freely falling box"
+        )
+    edge = float(np.max(scene.upper - scene.lower))
+    _check_range(
+        "|g| times the longest box edge", float(np.max(np.abs(g))) * edge, 0.0, SCALE_HI**2
+    )
+
+
 def frozen_energy(radii, masses):
     """Total kinetic energy below which the speeds times the smallest diameter fall below
     SCALE_LO, where the contact-time arithmetic underflows and pairs would pass through
@@ -185,6 +205,8 @@ class Scene:
     inertia_factor: float
     friction: float
     vibrating_wall: VibratingWall | None
+    gravity: NDArray[np.float64] | None
+    free_fall: bool
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         try:
@@ -212,6 +234,7 @@ class Scene:
                         "the kinetic energy overflows: velocities too large for float64"
                     )
         _check_spin_scales(self)
+        _check_gravity(self)
         # The geometry (inside the box, overlaps, a periodic box wide enough), checked by
         # the engine's own rules in O(N) through a cell grid, without building an engine.
         _core.edmd_check(**self._engine_keywords())

@@ -39,6 +39,7 @@ def _examples():
         "tangential_restitution": 0.5,
         "inertia_factor": 0.3,
         "friction": 0.2,
+        "free_fall": True,
     }
 
 
@@ -47,9 +48,13 @@ def _examples():
 _PERIODIC_ONLY = {"shear_rate": 0.3, "shear_offset": 0.25}
 
 
-# parameters that take smooth particles (a vibrating wall: the rough loops have none), with
+# parameters that take smooth particles (a vibrating wall, gravity: the rough loops have
+# neither), with
 # their examples; _examples_for gives them the walled examples with smooth particles
-_SMOOTH_ONLY = {"vibrating_wall": granular.VibratingWall(1, "lower", 0.2, 3.0, phase=-np.pi / 2)}
+_SMOOTH_ONLY = {
+    "vibrating_wall": granular.VibratingWall(1, "lower", 0.2, 3.0, phase=-np.pi / 2),
+    "gravity": np.array([0.1, -0.5]),
+}
 _SMOOTH = {
     "angular_velocities": None,
     "tangential_restitution": -1.0,
@@ -84,6 +89,8 @@ def _alternative(name):
 
 
 def _same(a, b):
+    if a is None or b is None:  # an unset array parameter (gravity)
+        return a is b
     if isinstance(a, tuple):
         return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
     if isinstance(a, np.ndarray):

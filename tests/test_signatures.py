@@ -20,7 +20,7 @@ pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 # what may come before the keyword-only parameters
 THEORY_INDEPENDENT = {
     "t", "lag", "speed", "eta", "box", "temperature", "height", "stiffness", "collisions",
-    "peak_velocity",
+    "peak_velocity", "z",
 }  # fmt: skip
 PLOT_X = {"times", "velocities", "positions", "traj"}
 
@@ -190,6 +190,10 @@ VALID = {
     "wall_restitution": 0.9,
     "waveform": "sine",
     "wall_distance": 0.9,
+    "z": 0.5,
+    "area": 1.0,
+    "bottom": 0.0,
+    "top": 1.0,
 }
 BAD = {
     "positive": [-1.0, 0.0, math.nan, math.inf],

@@ -12,7 +12,7 @@ Public entry points
     Langevin model in a harmonic trap), ``"driven"`` (a2 of the cooling and the white-noise
     driven state, the driven temperature), ``"rough"`` (rough spheres and disks: T_rot/T_tr,
     the coupled cooling, Walton's rule), ``"vibrated"`` (a gas kept hot by a vibrating
-    wall).
+    wall), ``"gravity"`` (the hydrostatic profile of an elastic column).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -710,6 +710,14 @@ def _fig_vibrated(cfg, out):
     return reproduce_vibrated._fig_vibrated(cfg, out, **_tools())
 
 
+def _fig_gravity(cfg, out):
+    """An elastic gas under gravity against its hydrostatic profile: see
+    ``reproduce_gravity``."""
+    from . import reproduce_gravity
+
+    return reproduce_gravity._fig_gravity(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -725,6 +733,7 @@ FIGURES = {
     "driven": _fig_driven,
     "rough": _fig_rough,
     "vibrated": _fig_vibrated,
+    "gravity": _fig_gravity,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -751,6 +760,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
         9.2,
     ),
     "vibrated": ("gas between a vibrating and a fixed wall: T against V, balance", 25.4, 12.0),
+    "gravity": ("elastic disks under gravity: the hydrostatic density profile", 60.0, 25.0),
 }
 
 

@@ -237,6 +237,12 @@ def _vibrated_notes(cfg, by_id):
     return reproduce_vibrated.notes(by_id)
 
 
+def _gravity_notes(cfg, by_id):
+    from . import reproduce_gravity
+
+    return reproduce_gravity.notes(by_id)
+
+
 # The sections of the report: (title, row id prefix, notes(cfg, by_id) -> sentences)
 SECTIONS = (
     ("Energy (Fig. 4.2)", "energy.", _energy_notes),
@@ -250,6 +256,7 @@ SECTIONS = (
     ("The cooling state's velocity distribution (a2)", "hcs.", _hcs_notes),
     ("Gases driven by white noise", "driven.", _driven_notes),
     ("A gas kept hot by a vibrating wall", "vibrated.", _vibrated_notes),
+    ("Gravity: the hydrostatic profile", "gravity.", _gravity_notes),
 )
 
 

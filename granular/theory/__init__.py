@@ -48,6 +48,10 @@ from .equation_of_state import (
 from .ergodicity import (
     udsbm_ergodicity_breaking,
 )
+from .gravity import (
+    excess_chemical_potential,
+    hydrostatic_density,
+)
 from .haff import (
     LangevinCoefficients,
     collision_frequency,
@@ -154,9 +158,11 @@ __all__ = [
     "driven_temperature",
     "enskog_diffusion",
     "enskog_viscosity",
+    "excess_chemical_potential",
     "gravity_mean_displacement",
     "haff_tau0",
     "haff_temperature",
+    "hydrostatic_density",
     "langevin_coefficients",
     "maxwell_boltzmann_moments",
     "maxwell_boltzmann_pdf",

@@ -306,6 +306,19 @@ def _bad_driving():
 
 _BAD_DRIVING = _bad_driving()
 
+
+def _gravity(rng, p):
+    """Gravity along the last axis of any strength from the representable to the absurd
+    (or NaN), with or without the free-fall frame (which a periodic box needs)."""
+    dim = np.asarray(p["positions"]).shape[1]
+    g = np.zeros(dim)
+    g[-1] = -float(rng.choice([1.0, 50.0, 1e-300, 1e-150, 1e140, 1e279, 1e300, NAN, -INF]))
+    g[0] = float(rng.choice([0.0, 0.0, 0.5]))
+    p["gravity"] = g
+    p["free_fall"] = bool(rng.random() < 0.5)
+    return f"gravity={g.tolist()} free_fall={p['free_fall']}"
+
+
 SCENE_MUTATIONS = [
     _entry("positions", [NAN, INF, -INF]),
     _shape("positions"),
@@ -336,6 +349,10 @@ SCENE_MUTATIONS = [
     _set("shear_rate", [*EXTREME, 1e200, 1e-200, "x", None, 1j]),
     _set("shear_offset", [*EXTREME, 0.99, 1e200, "x", None]),
     _set("driving", ["x", 0.5, {"strength": 1.0}, *_BAD_DRIVING]),
+    _gravity,
+    _gravity,
+    _set("gravity", [*WRONG_TYPES[:1], 1j, [0.0, 0.0, 0.0, -1.0], [[0.0, -1.0]], 1.0]),
+    _set("free_fall", ["yes", None, 2, NAN]),
     _overlap("same place"),
     _overlap("overlap 1e-9"),
     _overlap("touching"),
@@ -1057,6 +1074,19 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
     if traj.rotational_energy is not None:  # rough particles trade the two
         _check(np.all(np.isfinite(traj.rotational_energy)), "non-finite rotational energy")
         e = e + np.asarray(traj.rotational_energy, dtype=float)
+    g = scene.gravity
+    if g is not None:
+        # gravity: the energy kept is kinetic + potential between walls (measured from the
+        # corner g points to, >= 0); in the freely falling periodic box, the kinetic
+        # energy of the motion relative to the fall (v - g t); none without the samples
+        if traj.positions is None or traj.velocities is None:
+            e = e[:0]
+        elif scene.boundary == "periodic":
+            v = traj.velocities - np.asarray(traj.times)[:, None, None] * g
+            e = 0.5 * np.einsum("n,tnd,tnd->t", scene.masses, v, v)
+        else:
+            corner = np.where(g > 0, scene.upper, scene.lower)
+            e = e + np.einsum("n,tnd,d->t", scene.masses, corner - traj.positions, g)
     if elastic and len(e):
         drift = np.max(np.abs(e - e[0])) / e[0] if e[0] > 0 else np.max(np.abs(e))
         _check(drift <= ENERGY_RTOL, f"elastic run: kinetic energy drifted by {drift:.3g}")
