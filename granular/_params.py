@@ -76,6 +76,9 @@ QUANTITIES: dict[str, Quantity] = {
         "self-diffusion coefficient per dimension, <dx^2> = 2 D t", "L^2 / time", "positive"
     ),
     "viscosity": Quantity("shear viscosity", "m / (L^(d-2) time)", "positive"),
+    "shear_rate": Quantity(
+        "shear rate d u_x / d y of a uniform shear flow", "1 / time", "positive"
+    ),
     # the models' coefficients
     "D0": Quantity("diffusivity per dimension at t = 0", "L^2 / time", "positive"),
     "gamma0": Quantity("friction rate at t = 0", "1 / time", "positive"),

@@ -9,7 +9,8 @@ Public entry points
     ``"viscoelastic"`` (the viscoelastic gas and its power-law UDSBM; ``reproduce_visco``),
     ``"transport"`` (elastic viscosity and self-diffusion; ``reproduce_transport``),
     ``"langevin-forces"`` (the Langevin model in a harmonic trap;
-    ``reproduce_langevin_forces``).
+    ``reproduce_langevin_forces``), ``"shear"`` (uniform shear flow of the inelastic gas;
+    ``reproduce_shear``).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -686,6 +687,13 @@ def _fig_langevin_forces(cfg, out):
     return reproduce_langevin_forces._fig_langevin_forces(cfg, out, **_tools())
 
 
+def _fig_shear(cfg, out):
+    """Uniform shear flow of the inelastic gas: see ``reproduce_shear``."""
+    from . import reproduce_shear
+
+    return reproduce_shear._fig_shear(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -698,6 +706,7 @@ FIGURES = {
     "viscoelastic": _fig_visco,
     "transport": _fig_transport,
     "langevin-forces": _fig_langevin_forces,
+    "shear": _fig_shear,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -715,8 +724,9 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
-    "transport": ("elastic hard spheres: Green-Kubo viscosity and self-diffusion", 30.0, 8.0),
+    "transport": ("elastic hard spheres: Green-Kubo and NEMD viscosity, self-diffusion", 70.0, 15.0),
     "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),
+    "shear": ("uniform shear flow of the inelastic gas: steady state, stresses", 15.0, 5.0),
 }
 
 

@@ -68,6 +68,11 @@ from .msd import (
     msd_langevin,
     msd_logarithmic,
 )
+from .shear import (
+    usf_shear_rate,
+    usf_temperature,
+    usf_viscosity,
+)
 from .tracer import (
     tracer_contact_value,
     tracer_friction,
@@ -164,6 +169,9 @@ __all__ = [
     "udsbm_ergodicity_breaking",
     "udsbm_increment_msd",
     "udsbm_v0_sq",
+    "usf_shear_rate",
+    "usf_temperature",
+    "usf_viscosity",
     "viscoelastic_cooling_rate",
     "viscoelastic_cooling_time",
     "viscoelastic_delta",
