@@ -724,7 +724,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
-    "transport": ("elastic hard spheres: Green-Kubo and NEMD viscosity, self-diffusion", 70.0, 15.0),
+    "transport": ("elastic hard spheres: Green-Kubo, NEMD viscosity; diffusion", 70.0, 15.0),
     "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),
     "shear": ("uniform shear flow of the inelastic gas: steady state, stresses", 15.0, 5.0),
 }

@@ -12,6 +12,14 @@ infinite system (Yeh & Hummer 2004, with the measured viscosity).  Errors: ten b
 run (std / sqrt(10)).  Values in reduced units, eta* = eta sigma^2 / sqrt(m T) and D* = D
 sqrt(m / T) / sigma.
 
+The NEMD route (``viscosity.elastic.nemd``): sheared runs of the same fluid with no
+thermostat (``nemd_run``: N = 1000 full, 500 quick; 8 runs full, 4 quick).  The gas heats,
+so its reduced shear rate gamma* = gamma sigma / sqrt(T / m) falls through the run; the
+viscosity of each window (``transport.shear_windows``) is extrapolated to gamma* -> 0 by
+eta*_0 + c gamma*^2 (``transport.nemd_viscosity``), the error from the runs' spread.  The
+row's text gives the sqrt(gamma*) extrapolation too and how far the two routes lie apart
+(``viscosity_nemd.png``).
+
 The reference is Enskog's theory in the first Sonine approximation
 (``theory.enskog_viscosity``, ``theory.enskog_diffusion``), which neglects correlated
 collisions: near-exact at eta = 0.05 (within its 1.6 % (eta) and 1.9 % (D) Sonine
