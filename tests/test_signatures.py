@@ -19,6 +19,7 @@ pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 
 # what may come before the keyword-only parameters
 THEORY_INDEPENDENT = {"t", "lag", "speed", "eta", "box", "temperature", "height", "stiffness"}
+THEORY_INDEPENDENT |= {"shear_rate"}  # theory.usf_temperature
 PLOT_X = {"times", "velocities", "positions", "traj"}
 
 # names the package used, or a user might reach for, for a quantity that has another name
@@ -166,6 +167,7 @@ VALID = {
     "chi": 1.2,
     "diffusion": 0.01,
     "viscosity": 0.3,
+    "shear_rate": 1.5,
     "D0": 0.07,
     "gamma0": 9.26,
     "tau0": 10.0,

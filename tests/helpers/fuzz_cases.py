@@ -933,6 +933,17 @@ def _check_sheared(scene, traj, sim):
         gap = abs(st["kinetic_energy"] - e0 - st["shear_work"])
         scale = max(e0, st["kinetic_energy"], abs(st["shear_work"]))
         _check(gap <= ENERGY_RTOL * scale, f"sheared elastic run: energy - work off by {gap:.3g}")
+    k, kt, w = traj.kinetic_tensor, traj.kinetic_time_tensor, traj.stress_collisional
+    if scene.restitution == 1 and k is not None and len(traj.times) >= 2:
+        # stress=True: the peculiar energy rose by the viscous heating -rate V int P_yx dt
+        assert kt is not None and w is not None
+        gained = 0.5 * (np.trace(k[-1]) - np.trace(k[0]))
+        heated = -scene.shear_rate * (kt[-1, 0, 1] - kt[0, 0, 1] + w[-1, 1, 0] - w[0, 1, 0])
+        scale = max(np.trace(k[-1]), np.trace(k[0]), abs(heated))
+        _check(
+            abs(gained - heated) <= ENERGY_RTOL * scale,
+            f"sheared elastic run: peculiar energy - viscous heating off by {gained - heated:.3g}",
+        )
 
 
 def _check_langevin(r):
