@@ -161,15 +161,15 @@ def _fig_shear(cfg, out, *, ensemble, save, fig, row, mean_row):
         colour = f"C{k}"
         c, m, err, line = velocity_profile(tr, rate)
         ax_prof.errorbar(c / sigma, m * sigma, yerr=err * sigma, fmt="o", color=colour,
-                         capsize=2, label=f"xi = {xi}: mean v_x in slabs")  # fmt: skip
+                         capsize=2, label=rf"$\xi$ = {xi}: mean $v_x$ in slabs")  # fmt: skip
         ax_prof.plot(c / sigma, line * sigma, color=colour, lw=0.8,
-                     label=f"xi = {xi}: gamma (y - y_c)")  # fmt: skip
+                     label=rf"$\xi$ = {xi}: $\dot\gamma\,(y - y_c)$")  # fmt: skip
         t_mid = w.times / sigma
         ax_p.plot(t_mid, -p_win[:, 0, 1] * sigma**3, color=colour, lw=0.8,
-                  label=f"xi = {xi}: -P_xy")  # fmt: skip
+                  label=rf"$\xi$ = {xi}: $-P_{{xy}}$")  # fmt: skip
         ax_p.plot(t_mid, (p_win[:, 0, 0] - p_win[:, 1, 1]) * sigma**3, color=colour, lw=0.8,
-                  ls="--", label=f"xi = {xi}: P_xx - P_yy")  # fmt: skip
-        ax_t.plot(t_mid, w.temperature, color=colour, lw=0.8, label=f"xi = {xi}: simulated")
+                  ls="--", label=rf"$\xi$ = {xi}: $P_{{xx}} - P_{{yy}}$")  # fmt: skip
+        ax_t.plot(t_mid, w.temperature, color=colour, lw=0.8, label=rf"$\xi$ = {xi}: simulated")
         ax_t.axhline(1.0, color="k", lw=0.6, ls=":")
         ax_t.axhline(t_ratio, color=colour, lw=0.6, ls="--")
     ax_prof.set_xlabel(r"$y / \sigma$")

@@ -145,7 +145,10 @@ def _nemd_rows(cfg, out, save, fig, row, green_kubo):
         e = np.concatenate([w.viscosity for w in windows])
         ax.plot(g, e, ".", color="0.6", ms=3, label="windows (all runs)")
         grid = np.linspace(0.0, fit, 50)
-        for res, colour, what in ((quad, "C0", "gamma*^2"), (root, "C1", "sqrt(gamma*)")):
+        for res, colour, what in (
+            (quad, "C0", r"$\propto \dot\gamma^{*2}$"),
+            (root, "C1", r"$\propto \sqrt{\dot\gamma^*}$"),
+        ):
             ax.plot(grid, res.value + res.slope * grid**res.power, colour,
                     label=f"fit {what}: {res.value:.4f} +- {res.error:.4f}")  # fmt: skip
         ax.errorbar([0.0], [gk], yerr=[gk_err], fmt="s", color="C2", capsize=3,
