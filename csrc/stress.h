@@ -61,7 +61,9 @@ static inline void stress_le_at(int dim, double g, const double *k, double s, do
         }
 }
 
-/* The peculiar velocity of particle i (record p, clock at its own time) at time t. */
+/* The peculiar velocity of particle i (record p, clock at its own time) at time t.  Straight
+ * flight (GR_FLIGHT_LINEAR, the polynomials above assume it too): a dynamics with forces
+ * must bring its own flight of y and v here, or be refused with shear. */
 static inline void stress_le_peculiar(const gr_edmd *s, int dim, const double *p, double t,
                                       double *V)
 {
