@@ -601,6 +601,11 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
                                     &s->sched[j], &clamped, &s->elastic_tc);
     const double before = kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j);
     const double vq0 = vq[0];
+    double Vb[6]; /* the peculiar velocities before, for the stress tensor (stress.h) */
+    if (s->cfg.stress) {
+        stress_le_peculiar(s, dim, p, t, Vb);
+        stress_le_peculiar(s, dim, q, t, Vb + 3);
+    }
     const double vir = rule_pair_apply(dim, dr, VEL(p, dim), vq, s->mass[i], s->mass[j], xi);
     if (vir < 0.0) { /* grazing (do_pair) */
         s->invalid++;
@@ -610,6 +615,12 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
     }
     for (int a = 0; a < dim; a++) VEL(q, dim)[a] = vq[a];
     VEL(q, dim)[0] = vq[0] - vx;
+    if (s->cfg.stress) { /* dr: through the image; j's impulse as its image received it */
+        double Va[6];
+        stress_le_peculiar(s, dim, p, t, Va);
+        stress_le_peculiar(s, dim, q, t, Va + 3);
+        stress_pair(s, dim, t, dr, s->mass[i], Vb, Va, s->mass[j], Vb + 3, Va + 3);
+    }
     /* the image's x momentum change, -m_j (vq' - vq), crossed the face: work -ky u of it */
     s->shear_work -= vx * s->mass[j] * (vq[0] - vq0);
     s->kinetic += kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j) - before;

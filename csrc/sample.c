@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include "engine.h"
+#include "stress.h"
 
 /* Sample k's stress tensor parts at ts (stress.h): the cumulative collisional sum and
  * kinetic integral, and the kinetic tensor summed from the velocities at ts. */
@@ -10,6 +11,24 @@ static void stress_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
 {
     const int dim = s->dim, dd = dim * dim, dyn = dynamics_of(s);
     const size_t at = (size_t)smp->next * dd;
+    if (s->le) { /* the peculiar tensor, polynomial in flight (stress.h) */
+        double k[9], kt[9];
+        stress_le_at(dim, s->cfg.shear_rate, s->st_kin, ts - s->stress_t, k, kt);
+        for (int c = 0; c < dd; c++) {
+            if (smp->stress_collisional) smp->stress_collisional[at + c] = s->st_coll[c];
+            if (smp->kinetic_time_tensor) smp->kinetic_time_tensor[at + c] = s->st_kin_time[c] + kt[c];
+        }
+        if (!smp->kinetic_tensor) return;
+        double ks[9] = {0.0}; /* summed from the particles, as below */
+        for (int32_t i = 0; i < s->n; i++) {
+            double V[3];
+            stress_le_peculiar(s, dim, rec(s, dim, i), ts, V);
+            for (int a = 0; a < dim; a++)
+                for (int b = 0; b < dim; b++) ks[a * dim + b] += s->mass[i] * V[a] * V[b];
+        }
+        for (int c = 0; c < dd; c++) smp->kinetic_tensor[at + c] = ks[c];
+        return;
+    }
     for (int c = 0; c < dd; c++) {
         if (smp->stress_collisional) smp->stress_collisional[at + c] = s->st_coll[c];
         if (smp->kinetic_time_tensor)
@@ -155,6 +174,15 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
         c->stress_collisional[k] = s->st_coll[k];
         c->kinetic_time_tensor[k] = s->st_kin_time[k] + s->st_kin[k] * (s->t - s->stress_t);
         c->kinetic_tensor[k] = s->st_kin[k];
+    }
+    if (s->le && s->cfg.stress) { /* the peculiar tensor, polynomial in flight (stress.h) */
+        double k[9], kt[9];
+        const int dd = s->dim * s->dim;
+        stress_le_at(s->dim, s->cfg.shear_rate, s->st_kin, s->t - s->stress_t, k, kt);
+        for (int a = 0; a < dd; a++) {
+            c->kinetic_time_tensor[a] = s->st_kin_time[a] + kt[a];
+            c->kinetic_tensor[a] = k[a];
+        }
     }
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;
     c->kicks = s->kicks;

@@ -25,21 +25,88 @@
 
 #include "engine.h"
 
+/* ---- a sheared box (Lees-Edwards, boundary.h) ----
+ * There the kinetic tensor is that of the peculiar velocities, V = v - g (y - y_c) e_x
+ * (g the shear rate, y the position in the box, y_c its centre), which change in flight:
+ * dV/dt = -g v_y e_x = -g V_y e_x.  So K_ab = sum m V_a V_b obeys, between events,
+ *     dK_ab/dt = -g (delta_ax K_yb + delta_bx K_ay),
+ * whose solution is polynomial in the time s since stress_t (x = 0, y = 1):
+ *     K_yy, K_yz, K_zz        constant,
+ *     K_xb(s) = K_xb - g K_yb s  and  K_ax(s) = K_ax - g K_ay s   (a, b != x),
+ *     K_xx(s) = K_xx - g (K_xy + K_yx) s + g^2 K_yy s^2,
+ * and its integral follows exactly (stress_le_at).  Kept this way, K is the peculiar
+ * tensor itself: no flow energy to cancel against.  A collision changes it by
+ * m (V'V' - V V) for each particle (V from the box velocity and position, or equally from
+ * an image's: the image's velocity and flow differ by the same u); a face crossing not at
+ * all, as V is continuous through it (v_x and y jump together by -+u and -+L_y). */
+
+/* K and its integral advanced by s from k (at stress_t) in a sheared box with rate g. */
+static inline void stress_le_at(int dim, double g, const double *k, double s, double *k_out,
+                                double *int_out)
+{
+    for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++) {
+            const int c = a * dim + b;
+            double k1 = 0.0, k2 = 0.0; /* K_ab(s) = k[c] + k1 s + k2 s^2 */
+            if (a == 0 && b == 0) {
+                k1 = -g * (k[1] + k[dim]);
+                k2 = g * g * k[dim + 1];
+            } else if (a == 0) {
+                k1 = -g * k[dim + b];
+            } else if (b == 0) {
+                k1 = -g * k[a * dim + 1];
+            }
+            k_out[c] = k[c] + (k1 + k2 * s) * s;
+            int_out[c] = (k[c] + (0.5 * k1 + k2 * s / 3.0) * s) * s;
+        }
+}
+
+/* The peculiar velocity of particle i (record p, clock at its own time) at time t.  Straight
+ * flight (GR_FLIGHT_LINEAR, the polynomials above assume it too): a dynamics with forces
+ * must bring its own flight of y and v here, or be refused with shear. */
+static inline void stress_le_peculiar(const gr_edmd *s, int dim, const double *p, double t,
+                                      double *V)
+{
+    const double *v = VEL(p, dim);
+    const double y = p[1] + v[1] * (t - TIME(p, dim)) - 0.5 * (s->cfg.lo[1] + s->cfg.hi[1]);
+    for (int a = 0; a < dim; a++) V[a] = v[a];
+    V[0] -= s->cfg.shear_rate * y;
+}
+
+/* Bring a sheared box's kinetic tensor and its integral to time t (>= stress_t). */
+static void stress_le_sync(gr_edmd *s, int dim, double t)
+{
+    double k[9], kt[9];
+    stress_le_at(dim, s->cfg.shear_rate, s->st_kin, t - s->stress_t, k, kt);
+    for (int c = 0; c < dim * dim; c++) {
+        s->st_kin[c] = k[c];
+        s->st_kin_time[c] += kt[c];
+    }
+    s->stress_t = t;
+}
+
 /* Bring the kinetic tensor's integral to time t (>= stress_t). */
 static inline void stress_sync(gr_edmd *s, int dim, double t)
 {
+    if (s->le) {
+        stress_le_sync(s, dim, t);
+        return;
+    }
     const double dt = t - s->stress_t;
     for (int k = 0; k < dim * dim; k++) s->st_kin_time[k] += s->st_kin[k] * dt;
     s->stress_t = t;
 }
 
 /* The kinetic tensor summed from the velocities (records hold the velocities at each
- * particle's own clock: right for constant velocity, see kinetic_total). */
+ * particle's own clock: right for constant velocity, see kinetic_total; a sheared box's
+ * peculiar ones are taken at stress_t). */
 static inline void stress_resum(gr_edmd *s, int dim)
 {
     double k[9] = {0.0};
     for (int32_t i = 0; i < s->n; i++) {
-        const double *v = VEL(rec(s, dim, i), dim), m = s->mass[i];
+        double V[3]; /* sheared: the peculiar velocity at stress_t */
+        if (s->le) stress_le_peculiar(s, dim, rec(s, dim, i), s->stress_t, V);
+        const double *v = s->le ? V : VEL(rec(s, dim, i), dim), m = s->mass[i];
         for (int a = 0; a < dim; a++)
             for (int b = 0; b < dim; b++) k[a * dim + b] += m * v[a] * v[b];
     }

@@ -72,14 +72,6 @@ static int validate_shear(const gr_edmd_config *cfg, const double *vel, gr_error
                      "axis y cannot slide");
         return GR_ERR_VALUE;
     }
-    if (cfg->stress) {
-        /* the sheared stress wants the peculiar kinetic tensor, sum m (v - u(y)) (v - u(y)),
-         * which changes in flight as y does: stress.h keeps the lab-frame one only */
-        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shear_rate,
-                     "the stress tensor (stress=True) is not kept in a sheared box yet: its "
-                     "kinetic part would need the peculiar velocities integrated in flight");
-        return GR_ERR_VALUE;
-    }
     const double Lx = cfg->hi[0] - cfg->lo[0], u = cfg->shear_rate * (cfg->hi[1] - cfg->lo[1]);
     if (!(cfg->shear_offset >= 0.0 && cfg->shear_offset < Lx)) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shear_offset,

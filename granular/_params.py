@@ -92,6 +92,9 @@ QUANTITIES: dict[str, Quantity] = {
     ),
     "bottom": Quantity("height from which particles are counted", "L"),
     "top": Quantity("height up to which particles are counted", "L"),
+    "shear_rate": Quantity(
+        "shear rate d u_x / d y of a uniform shear flow", "1 / time", "positive"
+    ),
     # the models' coefficients
     "D0": Quantity("diffusivity per dimension at t = 0", "L^2 / time", "positive"),
     "gamma0": Quantity("friction rate at t = 0", "1 / time", "positive"),

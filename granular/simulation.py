@@ -210,7 +210,9 @@ class Simulation:
         less the mean flow (granular/_shear.py); and the pressure averaged over
         the whole simulation from the virial theorem, P = (2 <E_kin>_t + W / t) / (d V)
         with the time average <E_kin>_t (exact for a cooling gas too) and W the pair
-        collisions' virial.  In a periodic box V is the box volume.  In a walled box the
+        collisions' virial (in a sheared box, whose kinetic part is that of the velocities
+        less the mean flow, trace(pressure_tensor) / d with ``stress=True`` and NaN
+        without).  In a periodic box V is the box volume.  In a walled box the
         walls' virial is -P d V_reach, so V is the volume the centres reach, the box shrunk
         by one radius at each face (see ``Trajectory.pressure``: exact for equal radii,
         approximate for mixtures).
@@ -254,6 +256,12 @@ class Simulation:
             tensors["pressure_tensor"] = np.full((d, d), np.nan)
         if self._knobs.get("stress"):
             c.update({k: tuple(map(tuple, v.tolist())) for k, v in tensors.items()})
+        if s.shear_rate != 0.0:  # the peculiar velocities' pressure: the tensor's alone
+            c["pressure"] = (
+                float(np.trace(tensors["pressure_tensor"])) / d
+                if self._knobs.get("stress")
+                else float("nan")
+            )
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
         if s.shear_rate != 0.0:  # the peculiar velocities' (granular/_shear.py)
             from ._shear import flow_temperature

@@ -252,10 +252,21 @@ class Trajectory:
         diameter), so V = V_reach: the same pressure as ``wall_pressure``, estimated from
         the pair collisions instead of the wall hits.  Exact for equal radii; for a mixture
         V_reach uses the largest radius, which is approximate (smaller particles reach
-        closer to the walls), to a relative error of order (r_max - r_min) / L."""
+        closer to the walls), to a relative error of order (r_max - r_min) / L.
+
+        In a sheared box the kinetic part is that of the velocities less the mean flow, which
+        only the stress tensor keeps: there the pressure is trace(``pressure_tensor()``) / d,
+        and it needs ``Simulation(stress=True)``."""
         t = self.times
         if len(t) < 2 or t[-1] <= t[0]:
             raise ValueError("pressure needs at least two samples spanning some time")
+        if self._parameters_dict().get("shear_rate", 0.0) != 0.0:
+            if self.kinetic_time_tensor is None:
+                raise ValueError(
+                    "the pressure of a sheared gas counts the velocities less the mean flow, "
+                    "which only the stress tensor keeps: run with Simulation(stress=True)"
+                )
+            return float(np.trace(self.pressure_tensor()) / self.dim)
         span = t[-1] - t[0]
         mean_k = np.trapezoid(self.kinetic_energy, t) / span
         w = self.virial[-1] - self.virial[0]

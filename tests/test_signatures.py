@@ -20,7 +20,7 @@ pytestmark = pytest.mark.filterwarnings("error::FutureWarning")
 # what may come before the keyword-only parameters
 THEORY_INDEPENDENT = {
     "t", "lag", "speed", "eta", "box", "temperature", "height", "stiffness", "collisions",
-    "peak_velocity", "z",
+    "peak_velocity", "z", "shear_rate",
 }  # fmt: skip
 PLOT_X = {"times", "velocities", "positions", "traj"}
 
@@ -169,6 +169,7 @@ VALID = {
     "chi": 1.2,
     "diffusion": 0.01,
     "viscosity": 0.3,
+    "shear_rate": 1.5,
     "D0": 0.07,
     "gamma0": 9.26,
     "tau0": 10.0,

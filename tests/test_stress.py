@@ -120,15 +120,6 @@ def test_stress_must_be_asked_for_and_a_bool():
     assert np.isnan(np.array(st["pressure_tensor"])).all()  # no time yet
 
 
-def test_stress_in_a_sheared_box_is_refused_until_its_kinetic_part_is_peculiar():
-    """The sheared stress wants sum m (v - u(y)) (v - u(y)), which changes in flight; the
-    engine keeps the lab-frame kinetic tensor only, so it says so rather than give that."""
-    s = Scene.random(20, 0.05, dim=2, seed=1).replace(shear_rate=0.5)
-    Simulation(s)  # sheared alone is fine
-    with pytest.raises(ValueError, match="not kept in a sheared box"):
-        Simulation(s, stress=True)
-
-
 @pytest.mark.parametrize("dim", [2, 3])
 def test_gsd_carries_the_tensor_and_hoomds_pressure_tensor(dim, tmp_path):
     """granular.read gives the tensor's parts back to the bit; HOOMD's log field

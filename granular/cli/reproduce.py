@@ -12,7 +12,8 @@ Public entry points
     Langevin model in a harmonic trap), ``"driven"`` (a2 of the cooling and the white-noise
     driven state, the driven temperature), ``"rough"`` (rough spheres and disks: T_rot/T_tr,
     the coupled cooling, Walton's rule), ``"vibrated"`` (a gas kept hot by a vibrating
-    wall), ``"gravity"`` (the hydrostatic profile of an elastic column).
+    wall), ``"gravity"`` (the hydrostatic profile of an elastic column),
+    ``"shear"`` (uniform shear flow of the inelastic gas).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
     files written and the experiment's rows for ``summary.json``.
@@ -718,6 +719,13 @@ def _fig_gravity(cfg, out):
     return reproduce_gravity._fig_gravity(cfg, out, **_tools())
 
 
+def _fig_shear(cfg, out):
+    """Uniform shear flow of the inelastic gas: see ``reproduce_shear``."""
+    from . import reproduce_shear
+
+    return reproduce_shear._fig_shear(cfg, out, **_tools())
+
+
 FIGURES = {
     "4.1": _fig_4_1,
     "4.2-4.4": _fig_4_2_to_4_4,
@@ -734,6 +742,7 @@ FIGURES = {
     "rough": _fig_rough,
     "vibrated": _fig_vibrated,
     "gravity": _fig_gravity,
+    "shear": _fig_shear,
 }
 
 # What each experiment shows (``--help`` lists them), and its wall time in seconds on the
@@ -751,7 +760,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
-    "transport": ("elastic hard spheres: Green-Kubo viscosity and self-diffusion", 30.0, 8.0),
+    "transport": ("elastic hard spheres: Green-Kubo, NEMD viscosity; diffusion", 70.0, 15.0),
     "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),
     "driven": ("a2 of cooling and white-noise driven gases, driven temperature", 101.6, 18.7),
     "rough": (
@@ -761,6 +770,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     ),
     "vibrated": ("gas between a vibrating and a fixed wall: T against V, balance", 25.4, 12.0),
     "gravity": ("elastic disks under gravity: the hydrostatic density profile", 60.0, 25.0),
+    "shear": ("uniform shear flow of the inelastic gas: steady state, stresses", 15.0, 5.0),
 }
 
 

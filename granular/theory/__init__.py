@@ -79,6 +79,11 @@ from .rough import (
     rough_temperature_ratio,
     rough_temperatures,
 )
+from .shear import (
+    usf_shear_rate,
+    usf_temperature,
+    usf_viscosity,
+)
 from .sonine import (
     driven_temperature,
     sonine_a2_cooling,
@@ -199,6 +204,9 @@ __all__ = [
     "udsbm_ergodicity_breaking",
     "udsbm_increment_msd",
     "udsbm_v0_sq",
+    "usf_shear_rate",
+    "usf_temperature",
+    "usf_viscosity",
     "vibrated_temperature",
     "viscoelastic_cooling_rate",
     "viscoelastic_cooling_time",

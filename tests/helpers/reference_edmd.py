@@ -103,12 +103,10 @@ def rough_collide(dr, vi, vj, wi, wj, ri, rj, mi, mj, q, xi, beta, mu, dim):
 
 def run_scene(scene, t_stop, sample_times, tensors=None):
     """``run`` for a granular.Scene: its state, box, restitution and wall restitution
-    (``run_sheared`` for a sheared one, which sums no tensors); for rough particles
-    (tangential_restitution > -1) positions, velocities and spins."""
+    (``run_sheared`` for a sheared one); for rough particles (tangential_restitution > -1)
+    positions, velocities and spins."""
     rough = getattr(scene, "tangential_restitution", -1.0) != -1.0
     if getattr(scene, "shear_rate", 0.0) != 0.0:
-        if tensors is not None:
-            raise NotImplementedError("the sheared reference sums no stress tensors")
         return run_sheared(
             np.array(scene.positions),
             np.array(scene.velocities),
@@ -121,6 +119,7 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
             sample_times,
             scene.shear_rate,
             scene.shear_offset,
+            tensors=tensors,
         )[:2]
     return run(
         np.array(scene.positions),
@@ -356,7 +355,9 @@ def sheared_images(d, kx_max=2):
     return [(kx, ky, kz) for kx in range(-kx_max, kx_max + 1) for ky in (-1, 0, 1) for kz in zs]
 
 
-def run_sheared(x, v, r, m, lo, hi, xi, t_stop, sample_times, shear_rate, shear_offset=0.0):
+def run_sheared(
+    x, v, r, m, lo, hi, xi, t_stop, sample_times, shear_rate, shear_offset=0.0, tensors=None
+):
     """``run`` in a periodic box with Lees-Edwards images across the y faces (flow along x):
     the image across the upper face is displaced along x by delta(t) = (shear_offset +
     u t) mod L_x and moves with u = shear_rate * L_y.  A particle leaving through the upper
@@ -369,9 +370,27 @@ def run_sheared(x, v, r, m, lo, hi, xi, t_stop, sample_times, shear_rate, shear_
     tried.  Returns (positions, velocities, kinetic energies, boundary work) at
     sample_times; the work is summed from the momentum carried across the faces (a
     crossing's m (v + v') / 2, a collision's impulse through an image) times the velocity
-    jump u, and the energy from the velocities."""
+    jump u, and the energy from the velocities.
+
+    A dict ``tensors`` gets the stress tensor's parts at the sample times, as ``run``'s but
+    with the peculiar velocities V = v - shear_rate (y - y_c) e_x: "kinetic_time" integrates
+    sum m V_a V_b step by step by Simpson's rule (exact: V is linear in time within a step),
+    "collisional" sums dr_a dp_b with dr through the image that touched."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
     n, d = x.shape
+    y_c = 0.5 * (lo[1] + hi[1])
+    coll, kin_time = np.zeros((d, d)), np.zeros((d, d))
+    coll_out, kin_out = [], []
+
+    def peculiar_tensor(xs):
+        vp = v.copy()
+        vp[:, 0] -= shear_rate * (xs[:, 1] - y_c)
+        return np.einsum("i,ia,ib->ab", m, vp, vp)
+
+    def kin_integral(span):
+        mid, end = x + v * (0.5 * span), x + v * span
+        return span / 6.0 * (peculiar_tensor(x) + 4 * peculiar_tensor(mid) + peculiar_tensor(end))
+
     L = hi - lo
     u = shear_rate * L[1]
     unwrapped = x.copy()
@@ -407,8 +426,12 @@ def run_sheared(x, v, r, m, lo, hi, xi, t_stop, sample_times, shear_rate, shear_
             out_v.append(v.copy())
             out_k.append(0.5 * (m[:, None] * v * v).sum())
             out_w.append(work)
+            coll_out.append(coll.copy())
+            kin_out.append(kin_time + kin_integral(ts - t))
         if t + dt > t_stop:
             break
+        if tensors is not None:
+            kin_time = kin_time + kin_integral(dt)
         x += v * dt
         unwrapped += lab * dt
         t += dt
@@ -447,4 +470,8 @@ def run_sheared(x, v, r, m, lo, hi, xi, t_stop, sample_times, shear_rate, shear_
         v[j] -= f * m[i] * dr
         # i's x momentum change came across the face from j's image
         work += kyy * u * m[i] * f * m[j] * dr[0]
+        coll += np.outer(dr, -f * m[i] * m[j] * dr)
+    if tensors is not None:
+        tensors["collisional"] = np.array(coll_out)
+        tensors["kinetic_time"] = np.array(kin_out)
     return np.array(out_x), np.array(out_v), np.array(out_k), np.array(out_w)
