@@ -95,8 +95,10 @@ static GR_ALWAYS_INLINE void do_cross(gr_edmd *s, int dyn, int dim, int32_t i, d
 static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i, double t,
                                           gr_error *err);
 static void predict(gr_edmd *s, int dyn, int dim, int32_t i);
+#if defined(GR_EDMD_GRAVITY_UNIT) || defined(GR_EDMD_EXTRA_UNIT)
 static int advance_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                        gr_error *err);
+#endif
 static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
                            double t, gr_error *err);
 static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up,
@@ -226,12 +228,14 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
     }
 }
 
-/* This file is compiled twice: as itself, the loops of constant velocity, and by
- * edmd_gravity.c (GR_EDMD_GRAVITY_UNIT) for gravity's.  Apart, the compiler's choices
- * of what to inline and clone for the constant-velocity loops are those it made
- * before gravity came: in one unit, the search functions' clones for both dynamics
- * outgrew its limits and the plain loop ran 7 % more instructions an event. */
-#ifndef GR_EDMD_GRAVITY_UNIT
+/* This file is compiled three times: as itself, the loops of constant velocity with
+ * smooth particles and fixed walls (the plain loop's unit); by edmd_gravity.c
+ * (GR_EDMD_GRAVITY_UNIT) for gravity's loops; and by edmd_extra.c (GR_EDMD_EXTRA_UNIT) for
+ * the loops of rough particles and of a vibrating wall.  Apart, the compiler's choices of
+ * what to inline and clone for the plain loop are those it made before the others came:
+ * in one unit, the search functions' clones for every loop outgrew its limits and the plain
+ * loop ran 7-13 % more instructions an event. */
+#if !defined(GR_EDMD_GRAVITY_UNIT) && !defined(GR_EDMD_EXTRA_UNIT)
 static int advance_2d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
     return advance(s, GR_FLIGHT_LINEAR, 2, 0, stop, smp, err, 0);
@@ -254,34 +258,6 @@ static int advance_3d_law(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
     return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err, 0);
 }
 
-/* A vibrating wall's loops (vibwall.h): compiled with the law rule (which takes a
- * constant restitution from the config as well), so two loops, not four. */
-static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                          gr_error *err)
-{
-    return advance(s, GR_FLIGHT_LINEAR, 2, 1, stop, smp, err, 1);
-}
-
-static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                          gr_error *err)
-{
-    return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err, 1);
-}
-
-
-/* Rough particles (rule.h): the law rule's code with the tangential impulse and spins. */
-static int advance_2d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                            gr_error *err)
-{
-    return advance(s, GR_FLIGHT_LINEAR, 2, GR_RULE_ROUGH, stop, smp, err, 0);
-}
-
-static int advance_3d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                            gr_error *err)
-{
-    return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err, 0);
-}
-
 int gr_edmd_advance(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
     /* a driven gas runs the plain loop between kicks (drive.c): nothing per event here */
@@ -298,15 +274,12 @@ int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
         return GR_ERR_NOMEM;
     }
     if (dynamics_of(s) == GR_FLIGHT_GRAVITY) return gr_edmd_advance_gravity(s, stop, smp, err);
-    if (s->spin) /* a scene with spins: the rough rule, with or without laws */
-        return s->dim == 2 ? advance_2d_rough(s, stop, smp, err)
-                           : advance_3d_rough(s, stop, smp, err);
-    if (s->cfg.vib.on) return advance_vib(s, stop, smp, err);
+    if (s->spin || s->cfg.vib.on) return gr_edmd_advance_extra(s, stop, smp, err);
     if (s->cfg.law.kind != GR_LAW_CONSTANT || s->cfg.wall_law.kind != GR_LAW_CONSTANT)
         return s->dim == 2 ? advance_2d_law(s, stop, smp, err) : advance_3d_law(s, stop, smp, err);
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
 }
-#else
+#elif defined(GR_EDMD_GRAVITY_UNIT)
 /* Gravity (flight.h, GR_FLIGHT_GRAVITY): one loop per dimension, compiled with the laws'
  * code (a constant restitution is then one test of the law's kind per collision). */
 static int advance_2d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
@@ -342,9 +315,47 @@ int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_sample
     return s->dim == 2 ? advance_2d_gravity(s, stop, smp, err)
                        : advance_3d_gravity(s, stop, smp, err);
 }
+#else
+/* A vibrating wall's loops (vibwall.h): compiled with the law rule (which takes a
+ * constant restitution from the config as well), so two loops, not four. */
+static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 2, 1, stop, smp, err, 1);
+}
+
+static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err, 1);
+}
+
+
+/* Rough particles (rule.h): the law rule's code with the tangential impulse and spins. */
+static int advance_2d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                            gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 2, GR_RULE_ROUGH, stop, smp, err, 0);
+}
+
+static int advance_3d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                            gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err, 0);
+}
+
+int gr_edmd_advance_extra(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    if (s->spin) /* a scene with spins: the rough rule, with or without laws */
+        return s->dim == 2 ? advance_2d_rough(s, stop, smp, err)
+                           : advance_3d_rough(s, stop, smp, err);
+    return advance_vib(s, stop, smp, err);
+}
 #endif
 
-/* A vibrating wall's run: the vibrating-wall loops of this unit's dynamics (advance_2d_vib, advance_3d_vib) unless float64
+#if defined(GR_EDMD_GRAVITY_UNIT) || defined(GR_EDMD_EXTRA_UNIT)
+/* A vibrating wall's run: this unit's loops for it (advance_2d_vib, advance_3d_vib) unless float64
  * cannot time the wall's phase at the end of the run (or, without a time limit, now):
  * there omega t's rounding, omega ulp(t), passes GR_VIB_PHASE_RESOLUTION and the wall's
  * position is known to less than A 2^-26. */
@@ -360,6 +371,7 @@ static int advance_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
     }
     return s->dim == 2 ? advance_2d_vib(s, stop, smp, err) : advance_3d_vib(s, stop, smp, err);
 }
+#endif
 
 /* Move the system clock forward to t, integrating the kinetic energy on the way
  * (flight.h: with constant velocity it changes only at collisions, so the integral is
@@ -765,8 +777,13 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
 
 /* The list scan's compilation in use: AVX2's four lanes where the CPU has them, unless
  * GRANULAR_SCAN_KERNEL=plain (the tests run both: the bits must not depend on it). */
-#ifndef GR_EDMD_GRAVITY_UNIT
-static int scan_avx2;
+#if defined(GR_EDMD_GRAVITY_UNIT)
+static const int scan_avx2 = 0; /* gravity runs the plain scan (predict) */
+#elif defined(GR_EDMD_EXTRA_UNIT)
+#define scan_avx2 gr_scan_avx2 /* the plain unit's, set once */
+#else
+int gr_scan_avx2;
+#define scan_avx2 gr_scan_avx2
 
 void gr_scan_init(void)
 {
@@ -781,8 +798,6 @@ const char *gr_scan_kernel(void)
 {
     return scan_avx2 ? "avx2" : "plain";
 }
-#else
-static const int scan_avx2 = 0; /* gravity runs the plain scan (predict) */
 #endif
 
 static void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i);
@@ -917,6 +932,7 @@ static inline void predict_cross(gr_edmd *s, int dyn, int dim, int32_t i)
 
 /* ---- the start ---- */
 
+#ifndef GR_EDMD_EXTRA_UNIT /* (the extra loops start from the plain unit's predictions) */
 static int start(gr_edmd *s, int dyn, int dim, gr_error *err)
 {
     if (s->nl.shell > 0.0) {
@@ -931,23 +947,32 @@ static int start(gr_edmd *s, int dyn, int dim, gr_error *err)
     for (int32_t i = 0; i < s->n; i++) predict(s, dyn, dim, i);
     return GR_OK;
 }
+#endif
 
-#ifndef GR_EDMD_GRAVITY_UNIT
+#if !defined(GR_EDMD_GRAVITY_UNIT) && !defined(GR_EDMD_EXTRA_UNIT)
 int gr_predict_all(gr_edmd *s, gr_error *err)
 {
     if (dynamics_of(s) == GR_FLIGHT_GRAVITY) return gr_predict_all_gravity(s, err);
     return s->dim == 2 ? start(s, GR_FLIGHT_LINEAR, 2, err) : start(s, GR_FLIGHT_LINEAR, 3, err);
 }
 
+/* A constant dynamics at every call of predict in this unit: a run-time one would make
+ * the compiler's clones of the scans generic and cost the plain loop instructions. */
 void gr_predict_one(gr_edmd *s, int32_t i)
 {
-    const int dyn = dynamics_of(s);
-    if (s->dim == 2) predict(s, dyn, 2, i); /* the clones the loops use */
-    else predict(s, dyn, 3, i);
+    if (dynamics_of(s) == GR_FLIGHT_GRAVITY) gr_predict_one_gravity(s, i);
+    else if (s->dim == 2) predict(s, GR_FLIGHT_LINEAR, 2, i); /* the clones the loops use */
+    else predict(s, GR_FLIGHT_LINEAR, 3, i);
 }
-#else
+#elif defined(GR_EDMD_GRAVITY_UNIT)
 int gr_predict_all_gravity(gr_edmd *s, gr_error *err)
 {
     return s->dim == 2 ? start(s, GR_FLIGHT_GRAVITY, 2, err) : start(s, GR_FLIGHT_GRAVITY, 3, err);
+}
+
+void gr_predict_one_gravity(gr_edmd *s, int32_t i)
+{
+    if (s->dim == 2) predict(s, GR_FLIGHT_GRAVITY, 2, i);
+    else predict(s, GR_FLIGHT_GRAVITY, 3, i);
 }
 #endif

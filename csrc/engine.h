@@ -210,5 +210,13 @@ int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
 int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                             gr_error *err);
 int gr_predict_all_gravity(gr_edmd *s, gr_error *err);
+void gr_predict_one_gravity(gr_edmd *s, int32_t i);
+
+/* The loops of rough particles and of a vibrating wall (edmd.c compiled again as
+ * edmd_extra.c), which gr_edmd_advance calls for such a system without gravity. */
+int gr_edmd_advance_extra(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err);
+/* The list scan's kernel, set once by gr_scan_init (edmd.c): 1 AVX2, 0 plain. */
+extern int gr_scan_avx2;
 
 #endif
