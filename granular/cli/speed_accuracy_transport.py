@@ -64,11 +64,17 @@ def driven_model():
     rate, the number density, the steady temperature T_s (theory), D_E(T_s), gamma_v
     and D = T_s / (m gamma_v) (module docstring)."""
     density = ETA / (4.0 / 3.0 * math.pi * RADIUS**3)
-    kw = dict(density=density, radius=RADIUS, restitution=XI, dim=3)
     a2 = theory.sonine_a2_driven(restitution=XI, dim=3, kick=KICK)
     # the strength whose steady temperature is 1 (reproduce_driven.driven_parameters)
-    strength = float(theory.cooling_rate(temperature=1.0, **kw) * (1 + 3 * a2 / 16))
-    t_s = float(theory.driven_temperature(strength=strength, kick=KICK, **kw))
+    cooling = theory.cooling_rate(
+        temperature=1.0, density=density, radius=RADIUS, restitution=XI, dim=3
+    )
+    strength = float(cooling * (1 + 3 * a2 / 16))
+    t_s = float(
+        theory.driven_temperature(
+            strength=strength, density=density, radius=RADIUS, restitution=XI, dim=3, kick=KICK
+        )
+    )
     d_e = float(theory.enskog_diffusion(ETA, radius=RADIUS, temperature=t_s))
     diffusion = 2.0 * d_e / (1.0 + XI)
     return dict(
@@ -109,7 +115,8 @@ def _edmd_driven(n, span, model, seed):
     sim.run(t_stop=SETTLE / g, store=())
     times = sim.time + np.arange(0.0, 2 * span + 1) / (2 * g)
     tr = sim.run(float(times[-1]), sample_times=times, store=("positions",))
-    x = tr.positions - tr.positions.mean(axis=1, keepdims=True)  # the centre of mass is fixed
+    pos = tr._need("positions")
+    x = pos - pos.mean(axis=1, keepdims=True)  # the centre of mass is fixed
     d = _slope_d(FIT_LAGS / g, _tamsd(x, (2 * FIT_LAGS).astype(int)))
     temp = float(2.0 * tr.kinetic_energy.mean() / (3 * (n - 1)))
     return d, temp, clock() - t0
