@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from granular import Viscoelastic, restitution
-from granular.cli import speed_accuracy
+from granular.cli import speed_accuracy, speed_accuracy_transport
 from granular.simulation import _LIST_SHELL
 
 
@@ -100,7 +100,17 @@ def test_speed_accuracy_cli_quick(tmp_path):
             assert max(em) == 1.9 and em == exact
         else:
             assert max(em) == 1.9 and em < exact and max(exact) > 2
-    for name in ("speed_accuracy.png", "em_stability.png", "collapse_map.png", "dense_cost.png"):
+    # the steady states' transport panels: every method, a cost and an error bar each
+    driven = data["driven_diffusion"]["points"]
+    assert {p["method"] for p in driven} == {"edmd", "exact", "em"}
+    assert all(p["seconds"] > 0 and p["d_error_bar"] > 0 and p["runs"] >= 3 for p in driven)
+    visc = data["shear_viscosity"]["points"]
+    assert {p["route"] for p in visc} == {"green_kubo", "nemd"}
+    for p in visc:
+        assert p["seconds"] > 0 and p["spread"] > 0 and len(p["values"]) == p["runs"] >= 3
+        assert p["spread"] == pytest.approx(np.std(p["values"], ddof=1))
+    names = ("speed_accuracy.png", "em_stability.png", "collapse_map.png", "dense_cost.png")
+    for name in (*names, "speed_accuracy_transport.png"):
         assert (tmp_path / name).stat().st_size > 5000
     dense = data["dense_cost"]
     assert max(r["eta"] for r in dense if r["dim"] == 3) >= 0.55
@@ -186,3 +196,51 @@ def test_matched_viscoelastic_law_has_the_mean_restitution():
     for xi in (0.7, 0.5):  # the series stops at eps = 0.7615: out of reach
         law, info = restitution.matched_viscoelastic(xi, 1.5)
         assert law is None and info["mean_eps"] > 0.76
+
+
+def _em_tamsd(steps, n_steps, dt, gamma, diffusion, v0_sq):
+    """Euler-Maruyama's expected TAMSD (all windows, one component) at lags of ``steps``:
+    v_{i+1} = rho v_i + noise, rho = 1 - gamma dt, is AR(1) with stationary variance
+    s2 = 2 gamma D / (2 - gamma dt) (csrc/sde.c), started at v0_sq; x_{i+1} = x_i + v_i dt,
+    so a window's displacement is dt times a sum of consecutive v, whose variance follows
+    from cov(v_i, v_j) = rho^|i - j| var(v_min(i, j))."""
+    rho = 1.0 - gamma * dt
+    s2 = 2.0 * gamma * diffusion / (2.0 - gamma * dt)
+    i = np.arange(n_steps)
+    var = s2 + (v0_sq - s2) * rho ** (2 * i)
+    cov = rho ** np.abs(i[:, None] - i[None, :]) * var[np.minimum.outer(i, i)]
+    out = []
+    for k in steps:
+        sums = [cov[s : s + k, s : s + k].sum() for s in range(n_steps - k + 1)]
+        out.append(dt * dt * np.mean(sums))
+    return np.array(out)
+
+
+def test_driven_langevin_points_are_what_their_schemes_give():
+    """The driven gas' Langevin points: the exact scheme's D over the fit window is
+    theory's (it integrates the OU process exactly at any step), and Euler-Maruyama near
+    its limit (gamma dt = 1.9) is not -- its velocity is AR(1) with rho = -0.9, whose MSD
+    alternates with the parity of the lag for ~20 steps, so the window's slope is far off;
+    measured against that closed form (``_em_tamsd``), not against a tolerance.  Six
+    independent runs each; 5 standard errors of their mean (t with 5 degrees of freedom:
+    a 0.4 % chance of a false alarm)."""
+    model = speed_accuracy_transport.driven_model()
+    g, d = model["gamma"], model["diffusion"]
+    assert g * d == pytest.approx(model["temperature"])  # D = T / (m gamma_v)
+    assert d == pytest.approx(2 * model["enskog_diffusion"] / 1.8)  # 2 D_E / (1 + xi)
+    span, dt = 60, 1.9 / g
+    n_steps = round(span / g / dt)
+    lags = np.unique(np.round(speed_accuracy_transport.FIT_LAGS / g / dt)).astype(int)
+    em_pred = speed_accuracy_transport._slope_d(
+        lags * dt, 3 * _em_tamsd(lags, n_steps, dt, g, d, g * d)
+    )
+    for scheme, expected_over_theory in (("exact", 1.0), ("em", None)):
+        runs = [
+            speed_accuracy_transport._sde_driven(2000, span, dt, scheme, model, seed=40 + k)
+            for k in range(6)
+        ]
+        ratio = np.array([r[0] / r[1] for r in runs])
+        if expected_over_theory is None:
+            expected_over_theory = em_pred / runs[0][1]
+            assert expected_over_theory < 0.5  # the failure is real, not noise
+        assert abs(ratio.mean() - expected_over_theory) < 5 * ratio.std(ddof=1) / math.sqrt(6)

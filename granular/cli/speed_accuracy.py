@@ -24,6 +24,10 @@ so it is paid once per point, not once per run; the two gases of the same (N, ru
 start from the same state, computed once but charged in full to each point.  The SDE
 runs need no equilibration: they draw the stationary Gaussian velocities directly.
 
+The steady states' transport coefficients (``speed_accuracy_transport``): a white-noise
+driven granular gas' self-diffusion by EDMD against the Langevin model with the matching
+friction and noise, and the elastic fluid's shear viscosity by Green-Kubo against NEMD.
+
 Where methods fail: Euler-Maruyama's MSD error against gamma0*dt up to and past its
 stability limit (refused at gamma0*dt >= 2) beside the exact scheme; inelastic collapse of
 2D disks between walls over restitution and area fraction, with and without the TC
@@ -55,6 +59,7 @@ from .. import (
 )
 from ..restitution import matched_viscoelastic
 from ..simulation import _LIST_SHELL  # the shell of shell="auto": dense_cost measures it
+from . import speed_accuracy_transport
 from .bench_langevin import log_lags
 from .output import write_json
 
@@ -694,6 +699,17 @@ def _charts(out, points, refs, stab, cells, dense):
     plt.close(fig)
 
 
+def _transport_chart(out, driven, model, visc, enskog):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = speed_accuracy_transport.chart(plt, driven, model, visc, enskog)
+    fig.savefig(os.path.join(out, "speed_accuracy_transport.png"), dpi=110)
+    plt.close(fig)
+
+
 def main(out="speed-accuracy", quick=False):
     os.makedirs(out, exist_ok=True)
     started = time.perf_counter()
@@ -704,11 +720,14 @@ def main(out="speed-accuracy", quick=False):
         f"  speed/accuracy points: {len(points)}  ({time.perf_counter() - started:.0f} s)",
         flush=True,
     )
+    driven, driven_model = speed_accuracy_transport.driven_points(quick)
+    visc, enskog_viscosity = speed_accuracy_transport.viscosity_points(quick)
     stab = em_stability(quick)
     cells = collapse_map(quick)
     dense = dense_cost(quick)
     costs = scene_costs(quick)
     _charts(out, points, refs, stab, cells, dense)
+    _transport_chart(out, driven, driven_model, visc, enskog_viscosity)
     write_json(
         os.path.join(out, "speed_accuracy.json"),
         dict(
@@ -719,6 +738,12 @@ def main(out="speed-accuracy", quick=False):
             collapse_map=cells,
             dense_cost=dense,
             scene_costs=costs,
+            driven_diffusion=dict(model=driven_model, points=driven),
+            shear_viscosity=dict(
+                packing=speed_accuracy_transport.VISCOSITY_ETA,
+                enskog=enskog_viscosity,
+                points=visc,
+            ),
         ),
     )
     print(f"{'method':<34} {'CPU s':>8} {'MSD err':>8} {'slope err':>9}")
@@ -727,9 +752,25 @@ def main(out="speed-accuracy", quick=False):
             f"{p['gas'][:4] + ' ' + p['label']:<34} {p['seconds']:>8.2f} {p['msd_error']:>8.3f} "
             f"{p['slope_error']:>9.3f}"
         )
+    for p in driven:
+        print(
+            f"driven {p['method']} {p['label']:<24} {p['seconds']:>8.2f} s  D/theory - 1 = "
+            f"{p['d_error']:+.4f} +- {p['d_error_bar']:.4f}"
+        )
+    for p in visc:
+        print(
+            f"viscosity {p['route']} {p['label']:<16} {p['seconds']:>8.3f} s/run  eta* = "
+            f"{p['mean']:.4f} +- {p['mean_error']:.4f}, one run +- {p['spread']:.4f}"
+        )
     print(f"charts and speed_accuracy.json in {out}/ ({time.perf_counter() - started:.0f} s)")
     return dict(
-        points=points, em_stability=stab, collapse_map=cells, dense_cost=dense, scene_costs=costs
+        points=points,
+        em_stability=stab,
+        collapse_map=cells,
+        dense_cost=dense,
+        scene_costs=costs,
+        driven_diffusion=driven,
+        shear_viscosity=visc,
     )
 
 
