@@ -50,6 +50,11 @@ def _compare(row, key):
     z = _z(row, key)
     if z is None:
         return f"{key} {_num(ref)}"
+    if ref == 0:  # a reference of 0 (e.g. a correlation that should vanish): no relative gap
+        gap = f"{row['ours'] - ref:+.3g}"
+        if abs(z) <= SIGMA:
+            return f"{key} {_num(ref)}: agrees within {max(1, math.ceil(abs(z)))} sigma"
+        return f"{key} {_num(ref)}: differs by {gap} ({z:+.1f} sigma)"
     rel = row["ours"] / ref - 1
     if abs(z) <= SIGMA:
         return f"{key} {_num(ref)}: agrees within {max(1, math.ceil(abs(z)))} sigma ({rel:+.1%})"
@@ -243,6 +248,11 @@ def _gravity_notes(cfg, by_id):
     return reproduce_gravity.notes(by_id)
 
 
+def _no_notes(cfg, by_id):
+    """A section whose rows' sentences say it all."""
+    return []
+
+
 # The sections of the report: (title, row id prefix, notes(cfg, by_id) -> sentences)
 SECTIONS = (
     ("Energy (Fig. 4.2)", "energy.", _energy_notes),
@@ -257,6 +267,8 @@ SECTIONS = (
     ("Gases driven by white noise", "driven.", _driven_notes),
     ("A gas kept hot by a vibrating wall", "vibrated.", _vibrated_notes),
     ("Gravity: the hydrostatic profile", "gravity.", _gravity_notes),
+    ("Forces in the Langevin model: a harmonic trap", "langevin.", _no_notes),
+    ("Rough particles", "rough.", _no_notes),
 )
 
 
