@@ -3,8 +3,8 @@
 
 Registered (``"vibrated"`` in ``reproduce.FIGURES``):
 
-- **A granular gas between a vibrating and a fixed wall**, no gravity.  2D, N = 200 disks of radius
-  0.01 in the unit box (area fraction 0.063), xi = 0.99, elastic walls, the lower wall a
+- **A granular gas between a vibrating and a fixed wall**, no gravity.  2D, N = 200 disks of
+  radius 0.01 in the unit box (area fraction 0.063), xi = 0.99, elastic walls, the lower wall a
   sine of angular frequency ``OMEGA`` = 250 and amplitude A = 0.001, 0.002, 0.004 (peak
   speeds V = 0.25, 0.5, 1; A far below the mean free path, ~0.09).  Each of ``RUNS`` runs
   settles for 300 collisions per particle (quick: 150), then the time-averaged kinetic
@@ -66,7 +66,7 @@ def _balance(peak_velocity):
     )  # fmt: skip
 
 
-def _steady(amplitude, seed, quick, gravity=None):
+def _steady(amplitude, seed, quick):
     """One run: (temperature T = <E>/N, its time average, the wall's mean power over the
     collisions' mean loss) in the steady state."""
     a = amplitude
@@ -77,8 +77,7 @@ def _steady(amplitude, seed, quick, gravity=None):
         N, RADIUS, dim=2, box=((0.0, 2 * a), (1.0, 1.0)), boundary="walls",
         temperature=_balance(a * OMEGA), seed=seed,
     )  # fmt: skip
-    extra = {} if gravity is None else {"gravity": gravity}
-    scene = start.replace(box=1.0, vibrating_wall=wall, restitution=XI, **extra)
+    scene = start.replace(box=1.0, vibrating_wall=wall, restitution=XI)
     sim = Simulation(scene)
     settle, measure = _lengths(quick)
     sim.run(stop_when={"collisions_per_particle": settle}, store=())
