@@ -163,6 +163,22 @@ REPRODUCE_MARGINS = {
     "vibrated.temperature.": 0.12,
     "vibrated.temperature_exponent": 0.02,
     "vibrated.power_balance": 0.02,
+    # the bed on a vibrating floor under gravity (reproduce_vibrated) against the dilute
+    # isothermal barometric balance, an estimate that leaves out the bed's temperature
+    # gradient and anisotropy: measured 5-7% below it: margin 10%.  Its exponent against the
+    # dilute 2: hard disks in the dilute small-amplitude limit make T / V^2 independent of V
+    # (the column holds c sigma = 4 mean free paths at every V, V / sqrt(T) is the same); what
+    # breaks that is the floor's area fraction, 0.035 at the lowest V and 0.009 at the
+    # highest, which warms the bed: T rises with g, measured (10 runs each) by 3.5 +- 1.5% at
+    # V = 1 from g = 1.5 to 6 (floor area fraction 0.009 to 0.034) and 3.3 +- 1% at V = 0.5
+    # (0.035 to 0.14): up to ~3.5% in T between our ends, -0.05 in the exponent; the ceiling,
+    # < 1% in T at the highest V, -0.01.  Margin 3% (0.06).  Measured 1.988 +- 0.020 (full),
+    # 1.996 +- 0.025 (quick).  Its power balance: as the gas's, plus the potential energy,
+    # constant in a steady state; the quick run's 150 collisions a particle leave the taller
+    # bed settling (measured 0.973 +- 0.012; full 0.997 +- 0.003): margin 2%.
+    "vibrated.bed.temperature.": 0.10,
+    "vibrated.temperature_scaling": 0.03,
+    "vibrated.bed.power_balance": 0.02,
     # the hydrostatic profile (reproduce_gravity) is the local-density approximation: its
     # gradient corrections are O((sigma / l)^2) ~ 7e-4 at a scale height of 39 diameters,
     # and the window's edges, 3 diameters from the walls, leave the hard walls' layering
@@ -313,6 +329,7 @@ def test_reproduce_quick(tmp_path):
         + [f"hcs.a2.xi{x}" for x in ("0.9", "0.8", "0.5")]
         + [f"driven.{q}.xi{x}" for q in ("temperature", "a2") for x in ("0.8", "0.5")]
         + ["gravity.profile.elastic"]
+        + ["vibrated.temperature_scaling", "vibrated.bed.power_balance"]
         + list(NEMD)
         + list(SHEAR)
     )

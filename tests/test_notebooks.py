@@ -62,6 +62,7 @@ def test_there_are_four_notebooks():
         "02_thesis_reproduction",
         "03_langevin_vs_edmd",
         "04_viscoelastic_and_clustering",
+        "05_driven_and_forced_gases",
         "06_sheared_gases",
         "07_rough_particles",
     ]

@@ -59,6 +59,32 @@ def test_the_balance_temperature_scales_as_v_squared_and_balances():
         theory.vibrated_temperature(0.3, **{**kw, "restitution": 1.0})
 
 
+@pytest.mark.parametrize("g", [0.5, 4.0])
+def test_the_bed_balance_integrates_the_barometric_column(g):
+    """The bed's temperature balances, for any g, the floor's input at the barometric
+    profile's floor density n0 = c m g / T against Haff's loss d n T / tau0(n) (dilute,
+    eta = 0) integrated by quadrature up the column n0 exp(-z m g / T); and T(2V) = 4 T(V)."""
+    n, area, r, xi, e = 150.0, 0.8, 0.01, 0.9, 0.95
+    kw = dict(n=n, area=area, radius=r, restitution=xi, wall_restitution=e, dim=2)
+    T = theory.vibrated_bed_temperature(0.4, **kw)
+    assert theory.vibrated_bed_temperature(0.8, **kw) / T == pytest.approx(4.0, rel=1e-10)
+    n0 = (n / area) * g / T
+    gain = theory.wall_power(0.4, density=n0, temperature=T, wall_restitution=e)
+
+    def loss_density(z):
+        local = n0 * math.exp(-z * g / T)
+        tau0 = theory.haff_tau0(
+            density=local, radius=r, restitution=xi, temperature0=T, dim=2, eta=0.0
+        )
+        return 2 * local * T / tau0
+
+    # to 60 scale heights: the rest is exp(-120) of the loss
+    loss, _ = integrate.quad(loss_density, 0, 60 * T / g, epsrel=1e-12, limit=200)
+    assert gain == pytest.approx(loss, rel=1e-9)
+    with pytest.raises(ValueError, match="elastic"):
+        theory.vibrated_bed_temperature(0.4, **{**kw, "restitution": 1.0})
+
+
 @pytest.mark.slow
 def test_the_engine_walls_work_is_the_theorys():
     """A near-ideal 2D gas (N = 4000 disks of radius 0.001, elastic) heated by a sine wall of

@@ -308,3 +308,17 @@ def test_a_gas_the_wall_heated_saves_and_loads(tmp_path):
     sneaky = Simulation(s.replace(velocities=2.0 * s.velocities))  # same scene, other energy
     sneaky._initial = s
     assert "wall's work" in checkpoint._fault(sneaky)
+
+
+def test_a_vibrating_floor_keeps_a_bed_from_collapsing_where_a_fixed_one_does_not():
+    """docs/gravity.md's bed map: 200 disks dropped under g = 10, pairs and floor at
+    xi = 0.9, no TC model: the bed on the fixed floor collapses as it settles (t ~ 0.5);
+    on a floor vibrating at A = 0.002, omega = 250 (Gamma = 12.5) it stays fluidised to
+    t = 1 within the map's event budget."""
+    from granular.cli import reproduce_gravity
+
+    kw = dict(xis=(0.9,), contact_durations=(0.0,))
+    fixed = reproduce_gravity.bed_map(**kw)[0]
+    shaken = reproduce_gravity.bed_map(**kw, floor=VibratingWall(1, "lower", 0.002, 250.0))[0]
+    assert fixed["status"] == "collapse" and fixed["time"] < 1.0
+    assert shaken["status"] == "ok" and shaken["time"] == 1.0

@@ -768,7 +768,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
         31.0,
         9.2,
     ),
-    "vibrated": ("gas between a vibrating and a fixed wall: T against V, balance", 25.4, 12.0),
+    "vibrated": ("a gas and a bed under gravity on a vibrating wall: T against V", 35.0, 14.0),
     "gravity": ("elastic disks under gravity: the hydrostatic density profile", 60.0, 25.0),
     "shear": ("uniform shear flow of the inelastic gas: steady state, stresses", 15.0, 5.0),
 }

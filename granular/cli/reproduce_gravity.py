@@ -153,21 +153,33 @@ BED_XIS = (0.9, 0.7, 0.5, 0.3)
 BED_TCS = (0.0, 1e-5, 1e-4, 1e-3)
 
 
-def bed_map(xis=BED_XIS, contact_durations=BED_TCS, t_stop=1.0, events_per_particle=10_000, n=200):
+def bed_map(
+    xis=BED_XIS,
+    contact_durations=BED_TCS,
+    t_stop=1.0,
+    events_per_particle=10_000,
+    n=200,
+    floor=None,
+):
     """Where an inelastic bed resting on its floor collapses: 2D disks (r = 0.01) dropped
     in a walled box 0.3 wide and 1 high under g = 10 (they settle within t ~ 0.5), pairs
     and floor of restitution xi, with the TC model's t_c; each run to ``t_stop`` within a
     budget of ``events_per_particle`` events a particle.  Each cell: 'collapse' (with its
     time), 'budget' (the rattling bed's events ran out first: the time reached), or 'ok';
-    and the events per particle per unit time over the run's last tenth."""
+    and the events per particle per unit time over the run's last tenth.  ``floor``: a
+    ``VibratingWall`` on the lower face of axis 1 (the particles start above its sweep),
+    its restitution xi too; None: a fixed floor."""
     cells = []
     box = (np.zeros(2), np.array([0.3, 1.0]))
+    above = (np.array([0.0, 2 * floor.amplitude]), box[1]) if floor is not None else box
     for tc in contact_durations:
         for xi in xis:
             s = Scene.random(
-                n, 0.01, dim=2, box=box, boundary="walls", restitution=xi,
+                n, 0.01, dim=2, box=above, boundary="walls", restitution=xi,
                 wall_restitution=xi, contact_duration=tc, seed=4,
             ).replace(gravity=(0.0, -10.0))  # fmt: skip
+            if floor is not None:
+                s = s.replace(box=box, vibrating_wall=floor)
             sim = Simulation(s)
             cell = dict(xi=xi, contact_duration=tc)
             budget = events_per_particle * n
@@ -185,8 +197,9 @@ def bed_map(xis=BED_XIS, contact_durations=BED_TCS, t_stop=1.0, events_per_parti
     return cells
 
 
-def bed_map_figure(cells, path):
-    """The map as a grid of coloured cells, xi across, t_c down, each labelled."""
+def bed_map_figure(cells, path, title=None):
+    """The map as a grid of coloured cells, xi across, t_c down, each labelled (``title``:
+    the default names the fixed floor)."""
     import matplotlib.pyplot as plt
 
     xis = sorted({c["xi"] for c in cells}, reverse=True)
@@ -208,6 +221,6 @@ def bed_map_figure(cells, path):
     ax.set_yticks(range(len(tcs)), ["off" if t == 0 else f"{t:g}" for t in tcs])
     ax.set_xlabel("restitution xi (pairs and floor)")
     ax.set_ylabel("TC model t_c")
-    ax.set_title("a bed settling on an inelastic floor (g = 10, N = 200, to t = 1)")
+    ax.set_title(title or "a bed settling on an inelastic floor (g = 10, N = 200, to t = 1)")
     fig.savefig(path, dpi=110)
     plt.close(fig)

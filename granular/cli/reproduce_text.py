@@ -50,6 +50,11 @@ def _compare(row, key):
     z = _z(row, key)
     if z is None:
         return f"{key} {_num(ref)}"
+    if ref == 0:  # a reference of 0 (e.g. a correlation that should vanish): no relative gap
+        gap = f"{row['ours'] - ref:+.3g}"
+        if abs(z) <= SIGMA:
+            return f"{key} {_num(ref)}: agrees within {max(1, math.ceil(abs(z)))} sigma"
+        return f"{key} {_num(ref)}: differs by {gap} ({z:+.1f} sigma)"
     rel = row["ours"] / ref - 1
     if abs(z) <= SIGMA:
         return f"{key} {_num(ref)}: agrees within {max(1, math.ceil(abs(z)))} sigma ({rel:+.1%})"
@@ -243,7 +248,6 @@ def _gravity_notes(cfg, by_id):
     return reproduce_gravity.notes(by_id)
 
 
-# The sections of the report: (title, row id prefix, notes(cfg, by_id) -> sentences)
 def _rough_notes(cfg, by_id):
     return [
         "Theory: the two-temperature cooling of rough spheres and disks (Huthmann & "
@@ -282,6 +286,7 @@ def _shear_notes(cfg, by_id):
     ]
 
 
+# The sections of the report: (title, row id prefix, notes(cfg, by_id) -> sentences)
 SECTIONS = (
     ("Energy (Fig. 4.2)", "energy.", _energy_notes),
     ("Speed distributions (Table 4.1, Figs 4.5-4.7)", "table4.1.", _speed_notes),

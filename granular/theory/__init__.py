@@ -120,6 +120,7 @@ from .udsbm import (
 from .vibrated import (
     DILUTE_EXPONENT,
     WARR_HUNTLEY_JACQUES_EXPONENT,
+    vibrated_bed_temperature,
     vibrated_temperature,
     wall_power,
     wall_power_leading,
@@ -207,6 +208,7 @@ __all__ = [
     "usf_shear_rate",
     "usf_temperature",
     "usf_viscosity",
+    "vibrated_bed_temperature",
     "vibrated_temperature",
     "viscoelastic_cooling_rate",
     "viscoelastic_cooling_time",

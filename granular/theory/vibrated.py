@@ -207,3 +207,82 @@ def vibrated_temperature(
     t_guess = mass * peak_velocity**2
     lo, hi = math.log(t_guess) - 30.0, math.log(t_guess) + 30.0
     return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-14, rtol=1e-13))
+
+
+@keyword_only("peak_velocity")
+def vibrated_bed_temperature(
+    peak_velocity: float,
+    *,
+    n: float,
+    area: float,
+    radius: float,
+    restitution: float,
+    mass: float = 1.0,
+    wall_restitution: float = 1.0,
+    waveform: str = "sine",
+    dim: int = 2,
+) -> float:
+    """The steady temperature of a dilute bed of ``n`` particles on a vibrating floor under
+    gravity, isothermal and barometric: the T at which the floor's input ``wall_power`` at
+    the floor's density n0 equals the pair collisions' loss integrated up the column.
+
+    With the scale height l = T / (m g), n(z) = n0 exp(-z / l) and n0 l = n / area = c (the
+    column's particles per unit floor area).  The loss per unit volume is d n T / tau0(n, T)
+    (Haff, [G20] 2.40-2.41) with 1 / tau0 proportional to n, so up the column it sums to
+    d T n0 c / (2 tau0(n0, T)): the input and the loss are both proportional to n0, and
+    gravity drops out -- at leading order T = k V^2 / c, the dilute exponent
+    ``DILUTE_EXPONENT`` of Kumaran (1998), twice the uniform gas's T at the same c
+    (``vibrated_temperature`` with n H = c: the barometric profile's mean of n^2 is half its
+    n0 c).  Dilute: Haff's rate without the contact value (eta = 0).  What it leaves out:
+    the bed's temperature gradient (it cools upwards), its anisotropy, the floor's excursion,
+    and the dense bottom of a deep bed (there Warr, Huntley & Jacques 1995 measured
+    T ~ V^1.41, ``WARR_HUNTLEY_JACQUES_EXPONENT``).
+
+    Parameters
+    ----------
+    peak_velocity : float
+        V, the floor's peak speed [sqrt(eps/m)].
+    n : float
+        The number of particles in the bed.
+    area : float
+        The floor's area (a length in 2D) [L^(d-1)].
+    radius : float
+        r [L].
+    restitution : float
+        xi of pair collisions, < 1.
+    mass, wall_restitution, waveform
+        As ``wall_power`` (the floor's restitution and motion).
+    dim : int
+        2 or 3.
+    """
+    _check_dim(dim)
+    if not restitution < 1.0:
+        raise ValueError(f"an elastic bed (restitution {restitution}) has no steady temperature")
+    column = n / area
+
+    def excess(log_t: float) -> float:
+        t = math.exp(log_t)
+        gain = wall_power(
+            peak_velocity,
+            density=1.0,
+            temperature=t,
+            mass=mass,
+            wall_restitution=wall_restitution,
+            waveform=waveform,
+        )
+        rate = 1.0 / haff_tau0(
+            density=1.0,
+            radius=radius,
+            restitution=restitution,
+            temperature0=t,
+            mass=mass,
+            dim=dim,
+            eta=0.0,
+        )
+        return math.log(gain) - math.log(dim * t * rate * column / 2.0)
+
+    from scipy import optimize
+
+    t_guess = mass * peak_velocity**2
+    lo, hi = math.log(t_guess) - 30.0, math.log(t_guess) + 30.0
+    return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-14, rtol=1e-13))
