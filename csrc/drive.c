@@ -72,8 +72,16 @@ static int kick(gr_edmd *s, gr_error *err)
     const double mi = s->mass[i], mj = s->mass[j];
     const double before = fl_kinetic(dyn, d, mi, vi) + fl_kinetic(dyn, d, mj, vj);
     const double M = mi + mj, mu = mi * mj / M;
-    double vb[6]; /* the velocities before, for the stress tensor's kinetic part */
+    /* In a sheared box the mean flow at each particle, shear_rate (y - y_c) along x: the
+     * thermostat acts on the velocities less it (a pair far apart in y must not lose its
+     * share of the flow) and the stress tensor keeps the peculiar ones (stress.h). */
+    const double yc = 0.5 * (s->cfg.lo[1] + s->cfg.hi[1]);
+    const double ui = s->le ? s->cfg.shear_rate * (p[1] - yc) : 0.0;
+    const double uj = s->le ? s->cfg.shear_rate * (q[1] - yc) : 0.0;
+    double vb[6]; /* the (peculiar) velocities before, for the stress tensor's kinetic part */
     for (int a = 0; a < d; a++) vb[a] = vi[a], vb[3 + a] = vj[a];
+    vb[0] -= ui;
+    vb[3] -= uj;
     if (s->cfg.drive_kind == GR_DRIVE_WHITE_NOISE) {
         const double amp = 2.0 * mu * sqrt(s->cfg.drive_strength / s->cfg.drive_rate);
         for (int a = 0; a < d; a++) {
@@ -84,9 +92,10 @@ static int kick(gr_edmd *s, gr_error *err)
     } else {
         const double sd = sqrt(s->cfg.drive_strength / mu);
         for (int a = 0; a < d; a++) {
-            const double v = (mi * vi[a] + mj * vj[a]) / M, g = sd * gr_normal(&st);
-            vi[a] = v + (mj / M) * g;
-            vj[a] = v - (mi / M) * g;
+            const double fi = a == 0 ? ui : 0.0, fj = a == 0 ? uj : 0.0;
+            const double v = (mi * (vi[a] - fi) + mj * (vj[a] - fj)) / M, g = sd * gr_normal(&st);
+            vi[a] = v + (mj / M) * g + fi;
+            vj[a] = v - (mi / M) * g + fj;
         }
     }
     for (int a = 0; a < d; a++) {
@@ -103,9 +112,13 @@ static int kick(gr_edmd *s, gr_error *err)
     s->kinetic += gain;
     s->drive_energy += gain;
     if (s->cfg.stress) { /* a kick is an outside force: only the kinetic tensor changes */
+        double V[6] = {0.0};
+        for (int a = 0; a < d; a++) V[a] = vi[a], V[3 + a] = vj[a];
+        V[0] -= ui;
+        V[3] -= uj;
         stress_sync(s, d, t);
-        stress_kick(s, d, mi, vb, vi);
-        stress_kick(s, d, mj, vb + 3, vj);
+        stress_kick(s, d, mi, vb, V);
+        stress_kick(s, d, mj, vb + 3, V + 3);
     }
     /* predictions that others made with i's or j's old velocities become stale */
     s->sched[i].count++;
