@@ -43,7 +43,6 @@ from numpy.typing import ArrayLike, NDArray
 from .._params import keyword_only
 from ._numerics import _check_dim
 
-
 # the equations of state each dimension offers, its default first
 _EQUATIONS = {3: ("carnahan-starling", "kolafa"), 2: ("henderson",)}
 
