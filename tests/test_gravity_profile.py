@@ -165,9 +165,9 @@ def _sphere_column(seed):
     collisions a particle), sampled every 0.2 for 100: its profile in the window with 10
     blocks of 10 (the column's slow breathing, kinetic against potential energy, keeps
     its centre of mass correlated over ~10 time units: blocks of 5 gave a chi^2 of 22 on
-    average over 6 seeds where independent blocks give 15.4, blocks of 10 gave 9.7-15.3
-    over 8 seeds), the run's mean kinetic temperature, the count in the window, the
-    window's edges and its cross-section."""
+    average over 6 seeds where independent blocks give 15.4, blocks of 10 gave 19.5), the
+    run's mean kinetic temperature, the count in the window, the window's edges and its
+    cross-section."""
     box = (np.zeros(3), SPHERE_BOX)
     s = Scene.random(SPHERES, SPHERE_RADIUS, dim=3, box=box, boundary="walls", seed=seed)
     sim = Simulation(s.replace(gravity=(0.0, 0.0, -SPHERE_G)))
@@ -202,12 +202,12 @@ def test_an_elastic_sphere_column_has_the_carnahan_starling_profile():
     bound (it is twice as dense at the bottom: the test resolves the equation of state).
     The temperature per component is uniform along the column (36 values, chi^2 <= 113.5).
     Measured (seed 1): chi^2 10.5 (Kolafa's equation of state 12.4), the barometric 3.0e5,
-    the temperature's 43.4.  Over seeds 1-8 the profile's chi^2 was 9.7-17.1 for six and
-    37 and 43 for two (the mean 19.5 against the 15.4 of independent blocks), the
-    temperature's 35-113: the blocks miss the column's slowest mode, heat conduction along
-    it (seeds 6 and 8 keep a temperature gradient of ~1 % over the 100 time units, after 30
-    or 80 of equilibration alike, and the density follows it), so the tail is heavier than
-    the bound assumes."""
+    the temperature's 43.4.  Over seeds 1-8 (sampled every 0.1) the profile's chi^2 was
+    9.7-17.1 for six and 37 and 43 for two (the mean 19.5 against the 15.4 of independent
+    blocks), the temperature's 35-113: the blocks miss the column's slowest mode, heat
+    conduction along it (seeds 6 and 8 keep a temperature gradient of ~1 % over the 100
+    time units, after 30 or 80 of equilibration alike, and the density follows it), so the
+    tail is heavier than the bound assumes."""
     p, temperature, count, edges, area = _sphere_column(1)
     kw = dict(n=count, area=area, radius=SPHERE_RADIUS, gravity=SPHERE_G,
               temperature=temperature, dim=3)  # fmt: skip
