@@ -222,6 +222,11 @@ def _call(f, **override):
         value = override.get(p.name, VALID[p.name])
         if p.name == "temperature" and "temperature0" in inspect.signature(f).parameters:
             value = override.get(p.name, 0.5)  # a cooled temperature below T0
+        if p.name == "approximation" and f.__name__ in (
+            "hydrostatic_density",
+            "excess_chemical_potential",
+        ):
+            value = override.get(p.name, "carnahan-starling")  # there an equation of state
         if p.kind == p.POSITIONAL_OR_KEYWORD:
             args.append(value)
         else:
