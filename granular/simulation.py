@@ -227,8 +227,9 @@ class Simulation:
         wall_work, the work it did on the particles (the sum over its hits of J U, J the
         normal impulse it gave and U its velocity then), and collision_loss, the kinetic
         energy dissipated by pair and wall collisions (a heated wall's gain counts as a
-        negative loss): the kinetic energy changed by wall_work - collision_loss since the
-        start, up to rounding; its stale_events also count a particle's arrival at the band
+        negative loss): the kinetic energy (plus the potential one under gravity) changed by
+        wall_work - collision_loss (+ drive_energy with a random driving) since the start,
+        up to rounding; its stale_events also count a particle's arrival at the band
         the wall sweeps, where the exact search for its hit starts (docs/vibrated.md).
 
         With ``Simulation(stress=True)`` also: stress_collisional, kinetic_time_tensor,

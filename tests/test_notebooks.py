@@ -56,7 +56,7 @@ def test_notebook_runs(path, tmp_path, monkeypatch):
     assert sum(len(t) for t in text) < TEXT_LIMIT
 
 
-def test_there_are_four_notebooks():
+def test_the_notebooks_are_the_seven_listed():
     assert [p.stem for p in NOTEBOOKS] == [
         "01_quickstart",
         "02_thesis_reproduction",
