@@ -69,9 +69,12 @@ ASAN_PY    := $(ASAN_VENV)/bin/python
 ASAN_CFLAGS := -fsanitize=undefined -fno-sanitize-recover=undefined
 # notebooks run kernels (not the C core); packaging builds an sdist
 ASAN_TESTS ?= $(filter-out test_notebooks.py test_packaging.py,$(notdir $(wildcard tests/test_*.py)))
-# CI's share (.ci/run): the tests that drive the C core hardest
+# CI's share (.ci/run): the tests that drive the C core hardest, and the fast tests of the
+# engine's newer physics (gravity, vibrating wall, driving, shear, stress, rough particles)
 ASAN_CI_TESTS := test_scene.py test_simulation.py test_neighbour_lists.py test_physics_edmd.py \
                  test_langevin.py test_fuzz.py test_checkpoint.py test_restitution.py
+ASAN_CI_PHYSICS := test_gravity.py test_vibrating_wall.py test_driving.py test_shear.py \
+                   test_stress.py test_shear_stress.py test_rough.py
 ASAN_ENV   := LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
               ASAN_OPTIONS=detect_leaks=0:allocator_may_return_null=1 \
               UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 GRANULAR_FUZZ_TIMEOUT=30
@@ -97,6 +100,8 @@ test-asan: $(ASAN_VENV)/.installed
 
 test-asan-ci:
 	$(MAKE) test-asan ASAN_TESTS="$(ASAN_CI_TESTS)"
+	cd $(ASAN_VENV)/tests && $(ASAN_ENV) ../bin/python -m pytest -q -p no:cacheprovider \
+	    -m "not slow" $(ASAN_CI_PHYSICS)
 
 clean:
 	rm -rf build $(VENV) granular/*.so *.egg-info docs/generated
