@@ -265,11 +265,9 @@ class Simulation:
             )
         c["collisions_per_particle"] = (2 * c["pair_collisions"] + c["wall_collisions"]) / s.n
         if s.shear_rate != 0.0:  # the peculiar velocities' (granular/_shear.py)
-            from ._shear import flow_temperature
-
             pos, vel, _ = self._engine.state()
             c["temperature"] = float(
-                flow_temperature(pos, vel, s.masses, s.lower, s.upper, s.shear_rate)
+                _shear.flow_temperature(pos, vel, s.masses, s.lower, s.upper, s.shear_rate)
             )
         else:
             c["temperature"] = 2.0 * c["kinetic_energy"] / (s.dim * s.n)
@@ -277,7 +275,7 @@ class Simulation:
         c["drive_power"] = c["drive_energy"] / c["time"] if c["time"] > 0 else 0.0
         # rough particles (kinetic_energy is the translational part)
         c["rotational_energy"] = rotational_energy(self._spins(), s)
-        c["translational_temperature"] = 2.0 * c["kinetic_energy"] / (s.dim * s.n)
+        c["translational_temperature"] = c["temperature"]  # (the peculiar one when sheared)
         c["rotational_temperature"] = 2.0 * c["rotational_energy"] / (rotational_dim(s.dim) * s.n)
         c["temperature_ratio"] = (
             c["rotational_temperature"] / c["translational_temperature"]
