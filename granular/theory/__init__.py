@@ -80,6 +80,10 @@ from .rough import (
     rough_temperatures,
 )
 from .shear import (
+    USFGrad,
+    USFState,
+    usf_enskog,
+    usf_grad_dilute,
     usf_shear_rate,
     usf_temperature,
     usf_viscosity,
@@ -152,6 +156,8 @@ __all__ = [
     "FloatOrArray",
     "LangevinCoefficients",
     "RoughCoefficients",
+    "USFGrad",
+    "USFState",
     "barometric_density",
     "collision_frequency",
     "collision_time",
@@ -205,6 +211,8 @@ __all__ = [
     "udsbm_ergodicity_breaking",
     "udsbm_increment_msd",
     "udsbm_v0_sq",
+    "usf_enskog",
+    "usf_grad_dilute",
     "usf_shear_rate",
     "usf_temperature",
     "usf_viscosity",
