@@ -103,6 +103,7 @@ from .transport import (
     diffusion_infinite_system,
     enskog_diffusion,
     enskog_viscosity,
+    speedy_diffusion,
 )
 from .trap import (
     barometric_density,
@@ -203,6 +204,7 @@ __all__ = [
     "shear_viscosity",
     "sonine_a2_cooling",
     "sonine_a2_driven",
+    "speedy_diffusion",
     "tracer_contact_value",
     "tracer_friction",
     "tracer_langevin_coefficients",
