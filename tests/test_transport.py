@@ -62,6 +62,27 @@ def _ar1_moments(rng, steps, components, phi, sigma, dt):
     return g, dt * sigma**2 * (1 + phi) / (1 - phi)
 
 
+def test_speedy_diffusion_limits_and_value():
+    """Speedy (1987): D0 / n at low density, which is the Boltzmann first-Sonine D (Enskog's at
+    chi -> 1, to the 2.5 eta of chi - 1); zero at his singular density n sigma^3 = 1.09 and
+    beyond; units through sigma = 2 r and sqrt(T / m); one value by hand at n = 0.5."""
+    r, t, m = 0.3, 2.0, 3.0
+    tiny = 1e-7
+    assert theory.speedy_diffusion(tiny, radius=r, temperature=t, mass=m) == pytest.approx(
+        theory.enskog_diffusion(tiny, radius=r, temperature=t, mass=m), rel=1e-6
+    )
+    eta_max = 1.09 * math.pi / 6
+    assert theory.speedy_diffusion(eta_max, radius=r, temperature=t) == pytest.approx(0, abs=1e-15)
+    assert theory.speedy_diffusion(0.6, radius=r, temperature=t) == 0.0
+    n = 0.5
+    d0 = 3 / 8 * 2 * r * math.sqrt(t / (math.pi * m))
+    want = d0 / n * (1 - n / 1.09) * (1 + n**2 * (0.4 - 0.83 * n**2))
+    got = theory.speedy_diffusion(n * math.pi / 6, radius=r, temperature=t, mass=m)
+    assert got == pytest.approx(want, rel=1e-14)
+    # above Enskog at intermediate packing (correlated collisions), as the MD it fits
+    assert got > theory.enskog_diffusion(n * math.pi / 6, radius=r, temperature=t, mass=m)
+
+
 def test_einstein_helfand_recovers_a_known_integral_and_its_error():
     """Correlated synthetic stresses (AR(1), correlation time ~ 4 steps) whose Green-Kubo
     integral is known exactly: over 40 independent series the estimate's z-scores

@@ -202,14 +202,16 @@ def _fig_transport(cfg, out, *, ensemble, save, fig, row, mean_row):
             )
         )
         d_err = diff.error * red_d
+        speedy = float(theory.speedy_diffusion(eta, radius=r, temperature=temp)) * red_d
         rows.append(
             row(
                 "diffusion.elastic" + suffix,
                 f"self-diffusion D* = D sqrt(m / T) / sigma of elastic hard spheres at packing "
                 f"{eta} (EDMD, N = {n}, MSD slope over {DIFFUSION_FIT[0]:g}-"
                 f"{DIFFUSION_FIT[1]:g} tau, 10 blocks), corrected to infinite N by Yeh & "
-                f"Hummer with the measured viscosity (D_L* = {diff.value * red_d:.4f}); "
-                f"theory: Enskog ({expect})",
+                f"Hummer with the measured viscosity (D_L* = {diff.value * red_d:.4f}; "
+                f"Speedy's 1987 representation of MD at N ~ 500, theory.speedy_diffusion: "
+                f"{speedy:.4f}); theory: Enskog ({expect})",
                 d_inf * red_d,
                 d_err,
                 None,

@@ -80,6 +80,10 @@ from .rough import (
     rough_temperatures,
 )
 from .shear import (
+    USFGrad,
+    USFState,
+    usf_enskog,
+    usf_grad_dilute,
     usf_shear_rate,
     usf_temperature,
     usf_viscosity,
@@ -99,6 +103,7 @@ from .transport import (
     diffusion_infinite_system,
     enskog_diffusion,
     enskog_viscosity,
+    speedy_diffusion,
 )
 from .trap import (
     barometric_density,
@@ -152,6 +157,8 @@ __all__ = [
     "FloatOrArray",
     "LangevinCoefficients",
     "RoughCoefficients",
+    "USFGrad",
+    "USFState",
     "barometric_density",
     "collision_frequency",
     "collision_time",
@@ -197,6 +204,7 @@ __all__ = [
     "shear_viscosity",
     "sonine_a2_cooling",
     "sonine_a2_driven",
+    "speedy_diffusion",
     "tracer_contact_value",
     "tracer_friction",
     "tracer_langevin_coefficients",
@@ -205,6 +213,8 @@ __all__ = [
     "udsbm_ergodicity_breaking",
     "udsbm_increment_msd",
     "udsbm_v0_sq",
+    "usf_enskog",
+    "usf_grad_dilute",
     "usf_shear_rate",
     "usf_temperature",
     "usf_viscosity",

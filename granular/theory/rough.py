@@ -30,9 +30,16 @@ follows from dt = ds / omega(T(s)) (``rough_cooling`` integrates the equations i
 1e-10).  After a few collisions the slower mode dominates: T_rot / T approaches the root of
 ``rough_temperature_ratio`` and both decay as Haff's law with the slower rate.
 
+Beyond the Maxwellian: in 3D spins and velocities become correlated in direction
+(Brilliantov, Poeschel, Kranz & Zippelius, PRL 98, 128001 (2007); Kranz et al., arXiv
+0808.1952) and the joint distribution has cumulants (Santos, Kremer & dos Santos, Phys.
+Fluids 23, 030604 (2011); Megias & Santos, arXiv 2303.00057, disks and spheres with DSMC
+and EDMD), which the root below leaves out (granular's 3D runs lie 2-3 % below it, its 2D
+runs on it); their corrections could not be read for this version (docs/rough.md).
+
 Self-diffusion of rough spheres: the literature gives it for constant xi and beta
-(Bodrova & Brilliantov 2012, Granular Matter, doi:10.1007/s10035-012-0319-2, with a Sonine
-correction); it is not implemented here.
+(Bodrova & Brilliantov, Granular Matter 14, 85 (2012), doi:10.1007/s10035-012-0319-2, with a
+Sonine correction); its result could not be read here, so it is not implemented.
 """
 
 from __future__ import annotations

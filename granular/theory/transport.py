@@ -10,6 +10,9 @@ and by tens of percent near freezing.  The high-precision MD values of Pieprzyk,
 Bannerman, Branka, Chudak & Heyes, Phys. Chem. Chem. Phys. 21, 6886 (2019) measure that
 difference; their tables are not reproduced here (see docs/stress.md: they could not be
 looked up for this version, so granular compares with Enskog and states the deviation).
+``speedy_diffusion`` gives an older empirical representation of MD self-diffusion
+(Speedy 1987), which Sigurgeirsson & Heyes (2003) found to fit their N ~ 500 data: a
+finite-system reference, not an infinite-N one.
 """
 
 from __future__ import annotations
@@ -151,3 +154,55 @@ def diffusion_infinite_system(
     return np.asarray(diffusion) + YEH_HUMMER_XI * np.asarray(temperature) / (
         6.0 * math.pi * np.asarray(viscosity) * np.asarray(box)
     )
+
+
+# Speedy's singular density n sigma^3 at which his D vanishes (Mol. Phys. 62, 509 (1987))
+SPEEDY_DENSITY_MAX = 1.09
+
+
+@keyword_only("eta")
+def speedy_diffusion(
+    eta: FloatOrArray,
+    *,
+    radius: FloatOrArray,
+    temperature: FloatOrArray,
+    mass: FloatOrArray = 1.0,
+) -> FloatOrArray:
+    """Speedy's representation of the hard-sphere fluid's self-diffusion coefficient from
+    computer simulations (R. J. Speedy, Mol. Phys. 62, 509 (1987)), 3D only::
+
+        D / D0 = (1 / n) (1 - n / 1.09) [1 + n^2 (0.4 - 0.83 n^2)],
+        D0 = (3/8) sigma sqrt(T / (pi m)),   n = rho sigma^3
+
+    exact in the ideal-gas limit (D0 / n is the Boltzmann first-Sonine D) and vanishing at
+    n = 1.09, the singular density of the paper's abstract.  The abstract defines D0 and n and
+    states the singularity; the coefficients 0.4, 0.83, 1.09 are the published fit as it is
+    used in public analysis scripts (the body of the paper could not be read here).
+    Sigurgeirsson & Heyes (Mol. Phys. 101, 469 (2003)) report that it fits their N ~ 500
+    data well: compare it with D measured at N ~ 500, not with the infinite-N limit.
+
+    Parameters
+    ----------
+    eta : float or array
+        Packing fraction in [0, 1) (n = 6 eta / pi; the formula is for the fluid, n <= 1.09,
+        eta <= 0.571, and 0 beyond).
+    radius : float or array
+        Particle radius (L), sigma = 2 r.
+    temperature : float or array
+        Temperature T, an energy (k_B = 1).
+    mass : float or array
+        Particle mass (m).
+
+    Returns
+    -------
+    D in L^2 / time, per dimension: <dx^2> = 2 D t.
+    """
+    n = 6.0 * np.asarray(eta, dtype=np.float64) / math.pi
+    sigma = 2.0 * np.asarray(radius)
+    d0 = 3.0 / 8.0 * sigma * np.sqrt(np.asarray(temperature) / (math.pi * np.asarray(mass)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shape = np.clip(1.0 - n / SPEEDY_DENSITY_MAX, 0.0, None) * (
+            1.0 + n**2 * (0.4 - 0.83 * n**2)
+        )
+        d = d0 / n * shape
+    return np.where(n == 0.0, np.inf, d)
