@@ -82,6 +82,8 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
     if (smp->wall) smp->wall[k] = s->wall;
     if (smp->virial) smp->virial[k] = s->virial;
     if (smp->wall_impulse) smp->wall_impulse[k] = s->wall_impulse;
+    if (smp->wall_work) smp->wall_work[k] = s->wall_work;
+    if (smp->collision_loss) smp->collision_loss[k] = s->collision_loss;
     if (s->cfg.stress) stress_sample(s, smp, ts);
     smp->next = k + 1;
 }
