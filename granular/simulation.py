@@ -603,6 +603,14 @@ class Simulation:
         energy never falls without a dissipative channel (inelastic pairs, of which there
         must be two, or absorbing walls)."""
         s = self._initial
+        if s.gravity is not None and s.boundary == "periodic":
+            # the freely falling box: its kinetic energy counts the fall, M g^2 t^2 / 2, which
+            # outgrows any cooling, so an energy target alone may never come
+            raise ValueError(
+                f"stop_when kinetic_energy = {target} alone cannot bound a run in the freely "
+                "falling box (free_fall=True): its kinetic energy counts the fall, which grows "
+                "as M g^2 t^2 / 2; give t_stop, or stop_when collisions_per_particle or events"
+            )
         pairs_lose = (
             _restitution.loses_energy(s.restitution) or not rough_keeps_energy(s)
         ) and s.n >= 2

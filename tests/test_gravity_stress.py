@@ -251,3 +251,16 @@ def test_gravity_in_a_sheared_box_is_refused_and_says_why():
     for g in ((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)):
         with pytest.raises(ValueError, match="only the free-fall frame, the same motion"):
             Simulation(p.replace(gravity=g))
+
+
+def test_an_energy_stop_alone_is_refused_in_the_falling_box():
+    """In the freely falling box the kinetic energy counts the fall (M g^2 t^2 / 2, growing
+    without bound), so a run bounded by an energy target alone may never end: refused before
+    it starts, saying what to give instead (found by the fuzz test: such a run hung).  With
+    a time or an event budget it runs."""
+    s = Scene.random(8, 0.04, dim=2, restitution=0.99, temperature=2.0, seed=1)
+    s = s.replace(gravity=(0.5, -3.0), free_fall=True)
+    sim = Simulation(s)
+    with pytest.raises(ValueError, match="freely falling box"):
+        sim.run(stop_when={"kinetic_energy": 0.1})
+    sim.run(stop_when={"kinetic_energy": 0.1, "events": 1000}, store=())
