@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from granular import Scene, Simulation, VibratingWall, theory
+from granular.cli import reproduce_gravity as rg
 
 from helpers import reference_gravity
 from helpers.scenes import reference_scene
@@ -126,46 +127,10 @@ def test_a_checkpoint_continues_the_tensor_bit_for_bit(tmp_path, boundary):
 
 # The elastic column of reproduce_gravity (docs/gravity.md): N = 400 disks (r = 0.01) in a
 # walled 1 x 2 box, g = 2 down, dropped and settled; T ~ 1.6, a scale height of ~40 diameters,
-# area fraction ~0.13 at the floor, where Henderson's Z = 1.32.
-COLUMN_N, COLUMN_R, COLUMN_G = 400, 0.01, 2.0
-COLUMN_BOX = np.array([1.0, 2.0])
-COLUMN_PAD = 6 * COLUMN_R  # three diameters from every wall: the bulk, as the profile tests
-
-
-def _bulk_mean_pressure(temperature, count):
-    """The mean over the centres' column [r, H - r] of the local pressure n T Z(eta) of the
-    hydrostatic profile (theory.hydrostatic_density, Henderson's Z) whose count in the
-    bulk window (COLUMN_PAD from every wall) is ``count``: the profile is fixed by the bulk,
-    not by all N, because the hard walls adsorb (a wall's contact density is P / T, above the
-    bulk's: ~4 of the 400 disks sit in the walls' layers beyond what the profile puts there),
-    and taking all N over the column overestimates the bulk density by ~1 % and the pair
-    part of the pressure by ~3 % (measured: trace / d 1.8 below, 3.6 block errors)."""
-    lx, lz = COLUMN_BOX
-    r = COLUMN_R
-    z = np.linspace(r, lz - r, 4001)
-    bulk = (z >= COLUMN_PAD) & (z <= lz - COLUMN_PAD)
-
-    def profile(n_total):
-        return np.asarray(
-            theory.hydrostatic_density(
-                z, n=n_total, area=lx - 2 * r, bottom=r, top=lz - r, radius=r,
-                gravity=COLUMN_G, temperature=temperature, dim=2,
-            )
-        )  # fmt: skip
-
-    def excess(n_total):
-        return np.trapezoid(profile(n_total)[bulk], z[bulk]) * (lx - 2 * COLUMN_PAD) - count
-
-    a, b = 0.97 * COLUMN_N, 0.99 * COLUMN_N  # the secant on the count (monotone in it)
-    fa, fb = excess(a), excess(b)
-    for _ in range(30):
-        a, fa, b = b, fb, b - fb * (b - a) / (fb - fa)
-        fb = excess(b)
-        if abs(fb) <= 1e-10 * count:
-            break
-    n = profile(b)
-    p = n * temperature * theory.compressibility_factor(n * math.pi * r**2, dim=2)
-    return float(np.trapezoid(p, z) / (lz - 2 * r))
+# area fraction ~0.13 at the floor, where Henderson's Z = 1.32.  Its bulk window (PAD: three
+# diameters from every wall) and the bulk profile's mean pressure are reproduce_gravity's.
+COLUMN_N, COLUMN_R, COLUMN_G = rg.N, rg.RADIUS, rg.G
+COLUMN_BOX = np.array([rg.WIDTH, rg.HEIGHT])
 
 
 def test_an_elastic_column_has_an_isotropic_stress_and_the_hydrostatic_pressure():
@@ -175,9 +140,11 @@ def test_an_elastic_column_has_an_isotropic_stress_and_the_hydrostatic_pressure(
 
     - isotropic: P_xx - P_yy and P_xy are zero within 3 standard errors of the blocks' mean
       (measured 2.6 +- 1.3 and 0.9 +- 0.6 on a pressure of 393).  The walls' layers make the
-      volume average anisotropic in truth, by their tension over the box: at first order in
-      the density ~T sigma^3 n_w^2 L / 6 per wall over V (n_w the density at the wall), 0.2
-      here, a sixth of the error;
+      volume average anisotropic in truth, by their tension over the box: a uniform walled
+      1 x 2 box at the floor's packing without gravity gives P_xx - P_yy = -2.5 +- 1.2, a
+      tension of ~2.5 per unit length at the floor's density, which the column's floor
+      (length 1) and side walls (2 x 2, at a density falling as exp(-z / l): ~0.8 of the
+      floor's n^2 length) nearly cancel, to ~0.3, a fifth of the error;
     - trace / d is the mean over the column of the local pressure n T Z of the hydrostatic
       profile (at each block's temperature, from the tensor, and its count in the bulk
       window) within 3 standard errors of the blocks' mean difference (measured 0.37 +-
@@ -195,7 +162,7 @@ def test_an_elastic_column_has_an_isotropic_stress_and_the_hydrostatic_pressure(
     times = np.linspace(20.0, 70.0, blocks * per + 1)
     tr = sim.run(t_stop=times[-1], sample_times=times, store=("positions",))
     x = tr.positions
-    pad = COLUMN_PAD
+    pad = rg.PAD
     in_bulk = (x[..., 0] >= pad) & (x[..., 0] <= lx - pad) & (x[..., 1] >= pad)
     in_bulk &= x[..., 1] <= lz - pad
     count = in_bulk.sum(axis=-1)
@@ -210,7 +177,7 @@ def test_an_elastic_column_has_an_isotropic_stress_and_the_hydrostatic_pressure(
         trace.append(np.trace(p) / 2)
         anisotropy.append(p[0, 0] - p[1, 1])
         shear.append(p[0, 1])
-        difference.append(trace[-1] - _bulk_mean_pressure(temperature, count[i : j + 1].mean()))
+        difference.append(trace[-1] - rg.bulk_mean_pressure(temperature, count[i : j + 1].mean()))
     # the block averages are the run's tensor (the windows tile the run)
     np.testing.assert_allclose(np.mean(trace), np.trace(tr.pressure_tensor()) / 2, rtol=1e-12)
 
