@@ -219,7 +219,12 @@ def notes(by_id):
         "with granular's own equation of state; it is measured away from the walls, where "
         "hard walls layer the gas, and normalised to the count there (reproduce_gravity).  "
         "The quantity text gives the barometric profile's value: the ideal gas is far off, "
-        "so the row resolves the hard cores' pressure."
+        "so the row resolves the hard cores' pressure.",
+        "The stress rows are the same columns' volume-averaged stress tensor (kinetic plus "
+        "pair collisions, integrated exactly through the parabolic flights): its trace against "
+        "the bulk's hydrostatic profile's mean pressure (the profile fixed by the count away "
+        "from the walls, which adsorb), and its anisotropy, which the walls' tension moves by "
+        "less than the error (docs/stress.md, 'Under gravity').",
     ]
 
 
