@@ -39,7 +39,7 @@ def test_tensor_under_gravity_agrees_with_slow_reference(dim, boundary, xi, mixt
     same events, rounding amplified by chaos; measured 1e-11 to 1e-14).  Twelve particles
     and g = 3 make flights between collisions of the order of the fall time, so the terms
     (v g + g v) tau^2 / 2 and g g tau^3 / 3 are of the order of the whole integral: the
-    constant-velocity integral misses it by 5 to 100 %.  Periodic: the freely falling
+    constant-velocity integral misses it by 5 to 110 %.  Periodic: the freely falling
     box."""
     s = reference_scene(dim, boundary, xi, mixture)
     s = s.replace(gravity=_gravity(dim), free_fall=boundary == "periodic")
