@@ -479,16 +479,19 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
                             "kinetic_energy", "momentum", "pair_collisions", "wall_collisions",
                             "virial", "wall_impulse",
                             "stress_collisional", "kinetic_time_tensor", "kinetic_tensor", "angular_velocities",
+                            "wall_work", "collision_loss",
                             NULL};
     gr_edmd_stop stop;
     long long max_events, next;
     PyObject *otimes, *opos = Py_None, *ovel = Py_None, *okin = Py_None, *omom = Py_None,
              *opair = Py_None, *owall = Py_None, *ovir = Py_None, *oimp = Py_None,
              *ostc = Py_None, *ostk = Py_None, *okt = Py_None, *ospin = Py_None;
-    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$dddLOLOOOOOOOOOOOO:advance", names, &stop.t_stop,
+    PyObject *owork = Py_None, *oloss = Py_None; /* a vibrating wall's books */
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "|$dddLOLOOOOOOOOOOOOOO:advance", names, &stop.t_stop,
                                      &stop.collisions_per_particle, &stop.kinetic_energy,
                                      &max_events, &otimes, &next, &opos, &ovel, &okin, &omom,
-                                     &opair, &owall, &ovir, &oimp, &ostc, &ostk, &okt, &ospin) ||
+                                     &opair, &owall, &ovir, &oimp, &ostc, &ostk, &okt, &ospin,
+                                     &owork, &oloss) ||
         require_keywords(args, kw, names, 6, "advance") < 0)
         return NULL;
     if (!check_ready(self)) return NULL;
@@ -536,7 +539,9 @@ static PyObject *EDMD_advance(EDMDObject *self, PyObject *args, PyObject *kw)
         !out_buffer(ostc, "stress_collisional", NPY_FLOAT64, tdd, (void **)&smp.stress_collisional) ||
         !out_buffer(ostk, "kinetic_time_tensor", NPY_FLOAT64, tdd, (void **)&smp.kinetic_time_tensor) ||
         !out_buffer(okt, "kinetic_tensor", NPY_FLOAT64, tdd, (void **)&smp.kinetic_tensor) ||
-        !out_buffer(ospin, "angular_velocities", NPY_FLOAT64, nw, (void **)&smp.spin)) {
+        !out_buffer(ospin, "angular_velocities", NPY_FLOAT64, nw, (void **)&smp.spin) ||
+        !out_buffer(owork, "wall_work", NPY_FLOAT64, T, (void **)&smp.wall_work) ||
+        !out_buffer(oloss, "collision_loss", NPY_FLOAT64, T, (void **)&smp.collision_loss)) {
         Py_DECREF(times);
         return NULL;
     }
@@ -664,7 +669,8 @@ static PyMethodDef EDMD_methods[] = {
      " sample_times, next, positions=None, velocities=None, kinetic_energy=None,"
      " momentum=None, pair_collisions=None, wall_collisions=None, virial=None,"
      " wall_impulse=None, stress_collisional=None, kinetic_time_tensor=None,"
-     " kinetic_tensor=None, angular_velocities=None) -> (reason, next).  Process events,"
+     " kinetic_tensor=None, angular_velocities=None, wall_work=None,"
+     " collision_loss=None) -> (reason, next).  Process events,"
      " writing samples into the arrays given (stop_kinetic_energy: the mean translational"
      " kinetic energy to stop at, negative for none)."},
     {"angular_velocities", (PyCFunction)EDMD_angular_velocities, METH_NOARGS,

@@ -126,6 +126,9 @@ typedef struct {
     double *kinetic_tensor;     /* sum m v_a v_b at the sample */
     double *spin;         /* count x n x (1 in 2D, 3 in 3D): angular velocities, or NULL
                            * (always NULL for smooth particles) */
+    /* a vibrating wall (vibwall.h), count each, or NULL: cumulative, as the counters' */
+    double *wall_work;      /* the work it did on the particles */
+    double *collision_loss; /* the kinetic energy pair and wall collisions dissipated */
 } gr_edmd_samples;
 
 typedef struct {

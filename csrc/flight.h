@@ -25,7 +25,10 @@
  *    back through the face below: the face hit is the seam's answer, not the sign of v);
  *  - fl_kinetic_integral: the integral of the total kinetic energy over a flight, for the
  *    pressure.  With constant velocity it changes only at collisions; under gravity it
- *    changes in flight (d/dt = g . total momentum) and the clock integrates that.
+ *    changes in flight (d/dt = g . total momentum) and the clock integrates that;
+ *  - and outside this file, stress.h's flight of the kinetic tensor sum m v_a v_b
+ *    (stress_kinetic_at, stress_sync), for Simulation(stress=True), or a refusal of the
+ *    tensor with the new dynamics in validate.c.
  * The AVX2 scan (scan_avx2.h) is written for straight lines through GR_FL_SEP; a dynamics
  * whose GR_FL_SEP it cannot use runs the plain scan (edmd.c, predict).
  *

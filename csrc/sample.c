@@ -29,10 +29,11 @@ static void stress_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
         for (int c = 0; c < dd; c++) smp->kinetic_tensor[at + c] = ks[c];
         return;
     }
+    double k_now[9], kt[9]; /* under gravity K changes in flight (stress.h) */
+    stress_kinetic_at(s, dim, ts, k_now, kt);
     for (int c = 0; c < dd; c++) {
         if (smp->stress_collisional) smp->stress_collisional[at + c] = s->st_coll[c];
-        if (smp->kinetic_time_tensor)
-            smp->kinetic_time_tensor[at + c] = s->st_kin_time[c] + s->st_kin[c] * (ts - s->stress_t);
+        if (smp->kinetic_time_tensor) smp->kinetic_time_tensor[at + c] = s->st_kin_time[c] + kt[c];
     }
     if (!smp->kinetic_tensor) return;
     double k[9] = {0.0};
@@ -81,6 +82,8 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
     if (smp->wall) smp->wall[k] = s->wall;
     if (smp->virial) smp->virial[k] = s->virial;
     if (smp->wall_impulse) smp->wall_impulse[k] = s->wall_impulse;
+    if (smp->wall_work) smp->wall_work[k] = s->wall_work;
+    if (smp->collision_loss) smp->collision_loss[k] = s->collision_loss;
     if (s->cfg.stress) stress_sample(s, smp, ts);
     smp->next = k + 1;
 }
@@ -175,10 +178,11 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
         c->kinetic_time_tensor[k] = s->st_kin_time[k] + s->st_kin[k] * (s->t - s->stress_t);
         c->kinetic_tensor[k] = s->st_kin[k];
     }
-    if (s->le && s->cfg.stress) { /* the peculiar tensor, polynomial in flight (stress.h) */
+    if ((s->le || dynamics_of(s) == GR_FLIGHT_GRAVITY) && s->cfg.stress) {
+        /* the peculiar tensor, or the one under gravity: polynomial in flight (stress.h) */
         double k[9], kt[9];
         const int dd = s->dim * s->dim;
-        stress_le_at(s->dim, s->cfg.shear_rate, s->st_kin, s->t - s->stress_t, k, kt);
+        stress_kinetic_at(s, s->dim, s->t, k, kt);
         for (int a = 0; a < dd; a++) {
             c->kinetic_time_tensor[a] = s->st_kin_time[a] + kt[a];
             c->kinetic_tensor[a] = k[a];

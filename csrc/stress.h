@@ -19,7 +19,8 @@
  * changes under constant-velocity flight), with its integral brought up to the time of the
  * last change (stress_t): the integral to any later t is st_kin_time + K (t - stress_t),
  * exact up to rounding.  K is summed anew from the velocities whenever s->kinetic is
- * (edmd.c, at fixed collision counts), so checkpoints continue it bit for bit. */
+ * (edmd.c, at fixed collision counts), so checkpoints continue it bit for bit.  Under
+ * gravity K changes in flight too, by a polynomial the sync integrates exactly (below). */
 #ifndef GR_STRESS_H
 #define GR_STRESS_H
 
@@ -85,11 +86,80 @@ static void stress_le_sync(gr_edmd *s, int dim, double t)
     s->stress_t = t;
 }
 
+/* ---- under uniform gravity (flight.h, GR_FLIGHT_GRAVITY) ----
+ * Every velocity is v + g tau after a flight of tau, so between collisions
+ *     K_ab(tau) = sum m (v_a + g_a tau)(v_b + g_b tau)
+ *               = K_ab + (P_a g_b + g_a P_b) tau + M g_a g_b tau^2,
+ * P the total momentum and M the total mass at stress_t, and its integral over the flight
+ * is exact in closed form:
+ *     K_ab tau + (P_a g_b + g_a P_b) tau^2 / 2 + M g_a g_b tau^3 / 3.
+ * The engine keeps the total momentum at its own clock s->t (s->momentum, flight.h's
+ * fl_kinetic_integral), and nothing but gravity changes it between stress_t and s->t: a
+ * wall's impulse syncs the tensor first (stress_wall) and pair collisions and kicks keep
+ * it.  So P(stress_t) = P(s->t) - M g (s->t - stress_t). */
+
+/* Whether the system flies under gravity (engine.h dynamics_of): a test made only where
+ * the tensor is kept, never in the plain loop without it. */
+static inline int stress_gravity(const gr_edmd *s)
+{
+    return dynamics_of(s) == GR_FLIGHT_GRAVITY;
+}
+
+/* K and its integral advanced by tau from st_kin (at stress_t) under gravity. */
+static inline void stress_gravity_at(const gr_edmd *s, int dim, double tau, double *k_out,
+                                     double *int_out)
+{
+    const double *g = s->cfg.gravity, M = s->mass_total, back = s->t - s->stress_t;
+    double P[3];
+    for (int a = 0; a < dim; a++) P[a] = s->momentum[a] - M * g[a] * back;
+    for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++) {
+            const int c = a * dim + b;
+            const double k = s->st_kin[c], k1 = P[a] * g[b] + g[a] * P[b], k2 = M * g[a] * g[b];
+            k_out[c] = k + (k1 + k2 * tau) * tau;
+            int_out[c] = (k + (0.5 * k1 + k2 * tau / 3.0) * tau) * tau;
+        }
+}
+
+/* Bring the kinetic tensor and its integral to time t (>= stress_t) under gravity. */
+static void stress_gravity_sync(gr_edmd *s, int dim, double t)
+{
+    double k[9], kt[9];
+    stress_gravity_at(s, dim, t - s->stress_t, k, kt);
+    for (int c = 0; c < dim * dim; c++) {
+        s->st_kin[c] = k[c];
+        s->st_kin_time[c] += kt[c];
+    }
+    s->stress_t = t;
+}
+
+/* K and its integral from stress_t to t (>= stress_t), whatever the flight: for samples
+ * and counters, which read the tensor between collisions. */
+static inline void stress_kinetic_at(const gr_edmd *s, int dim, double t, double *k_out,
+                                     double *int_out)
+{
+    const double tau = t - s->stress_t;
+    if (s->le) {
+        stress_le_at(dim, s->cfg.shear_rate, s->st_kin, tau, k_out, int_out);
+    } else if (stress_gravity(s)) {
+        stress_gravity_at(s, dim, tau, k_out, int_out);
+    } else {
+        for (int c = 0; c < dim * dim; c++) {
+            k_out[c] = s->st_kin[c];
+            int_out[c] = s->st_kin[c] * tau;
+        }
+    }
+}
+
 /* Bring the kinetic tensor's integral to time t (>= stress_t). */
 static inline void stress_sync(gr_edmd *s, int dim, double t)
 {
     if (s->le) {
         stress_le_sync(s, dim, t);
+        return;
+    }
+    if (stress_gravity(s)) {
+        stress_gravity_sync(s, dim, t);
         return;
     }
     const double dt = t - s->stress_t;
@@ -99,14 +169,20 @@ static inline void stress_sync(gr_edmd *s, int dim, double t)
 
 /* The kinetic tensor summed from the velocities (records hold the velocities at each
  * particle's own clock: right for constant velocity, see kinetic_total; a sheared box's
- * peculiar ones are taken at stress_t). */
+ * peculiar ones, and under gravity the velocities, are taken at stress_t). */
 static inline void stress_resum(gr_edmd *s, int dim)
 {
     double k[9] = {0.0};
+    const int falls = stress_gravity(s);
     for (int32_t i = 0; i < s->n; i++) {
-        double V[3]; /* sheared: the peculiar velocity at stress_t */
-        if (s->le) stress_le_peculiar(s, dim, rec(s, dim, i), s->stress_t, V);
-        const double *v = s->le ? V : VEL(rec(s, dim, i), dim), m = s->mass[i];
+        double V[3] = {0.0, 0.0, 0.0}; /* sheared: peculiar; gravity: v at stress_t */
+        const double *p = rec(s, dim, i);
+        if (s->le) stress_le_peculiar(s, dim, p, s->stress_t, V);
+        if (falls)
+            for (int a = 0; a < dim; a++)
+                V[a] = fl_vel_at(GR_FLIGHT_GRAVITY, VEL(p, dim)[a], s->cfg.gravity[a],
+                                 s->stress_t - TIME(p, dim));
+        const double *v = s->le || falls ? V : VEL(p, dim), m = s->mass[i];
         for (int a = 0; a < dim; a++)
             for (int b = 0; b < dim; b++) k[a * dim + b] += m * v[a] * v[b];
     }

@@ -67,6 +67,8 @@ class EDMD:
         kinetic_time_tensor: NDArray[np.float64] | None = ...,
         kinetic_tensor: NDArray[np.float64] | None = ...,
         angular_velocities: NDArray[np.float64] | None = ...,
+        wall_work: NDArray[np.float64] | None = ...,
+        collision_loss: NDArray[np.float64] | None = ...,
     ) -> tuple[int, int]: ...
     def state(self) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]: ...
     # rough particles' spins now ((N,) in 2D, (N, 3) in 3D); None for smooth ones

@@ -41,7 +41,9 @@ The exact float64 (and int64) values granular reads back live in the log section
   HOOMD's ``md/compute/ThermodynamicQuantities/pressure_tensor`` (xx, xy, xz, yy, yz, zz,
   float64, zeros for z in 2D): the pressure tensor averaged over the window since the
   previous frame (EDMD's collisional stress is impulses: an instant between collisions has
-  only the kinetic part, which is what frame 0, with no window, carries)
+  only the kinetic part, which is what frame 0, with no window, carries); with a vibrating
+  wall also its books ``wall_work`` and ``collision_loss`` (float64, cumulative, as the
+  Trajectory's)
 - frame 0: ``stop_reason`` (UTF-8 bytes), ``format`` (this layout's version), and every
   parameter of the run's scene but the positions and velocities (``_scene_params``'s
   ``RUN_PARAMETERS``), each attribute the Scene keeps it in under its own name: ``lower``,
@@ -108,9 +110,11 @@ _INT_COUNTERS = ("pair_collisions", "wall_collisions")
 # the stress tensor's parts ((d, d) each), present from a Simulation(stress=True) run only
 _TENSORS = ("stress_collisional", "kinetic_time_tensor", "kinetic_tensor")
 _HOOMD_PRESSURE_TENSOR = "md/compute/ThermodynamicQuantities/pressure_tensor"
+# a vibrating wall's books (one number each), present from a run with such a wall only
+_WALL_BOOKS = ("wall_work", "collision_loss")
 LOG_NAMES = (
     "format", "stop_reason", "time", "unwrapped_positions", "velocities",
-    "angular_velocities", "rotational_energy", *_COUNTERS, *_TENSORS
+    "angular_velocities", "rotational_energy", *_COUNTERS, *_TENSORS, *_WALL_BOOKS
 )  # fmt: skip
 
 
@@ -228,6 +232,10 @@ def _frame(hoomd, traj, k, lower, upper):
         for name in _TENSORS:
             log[f"granular/{name}"] = np.ascontiguousarray(getattr(traj, name)[k], np.float64)
         log[_HOOMD_PRESSURE_TENSOR] = _hoomd_pressure_tensor(traj, k)
+    for name in _WALL_BOOKS:
+        books = getattr(traj, name, None)
+        if books is not None:
+            log[f"granular/{name}"] = np.array([books[k]], dtype=np.float64)
     if k == 0:
         log["granular/format"] = np.array([FORMAT], dtype=np.int64)
         log["granular/stop_reason"] = _text(traj.stop_reason)
@@ -539,6 +547,7 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
         counters: dict[str, list] = {name: [] for name in _COUNTERS}
         stress = f.has(0, _log("stress_collisional"))
         tensors: dict[str, list] = {name: [] for name in _TENSORS} if stress else {}
+        books: dict[str, list] = {name: [] for name in _WALL_BOOKS if f.has(0, _log(name))}
         for k in range(f.frames):
             t = f.array(k, _log("time"), (1,))[0]
             if not np.isfinite(t):
@@ -575,10 +584,16 @@ def read(path: str | os.PathLike, make_scene: Any, make_trajectory: Any) -> Any:
                 if not np.all(np.isfinite(tensor)):
                     raise f.error(k, _log(name), "contains NaN or infinity")
                 tensors[name].append(tensor)
+            for name in books:
+                value = f.array(k, _log(name), (1,))[0]
+                if not np.isfinite(value):
+                    raise f.error(k, _log(name), f"is {value}, not finite")
+                books[name].append(value)
     # the counters' keywords: arrays of floats or of counts (Any: mypy would match them
     # against every keyword of Trajectory, its strings too)
     arrays: dict[str, Any] = {name: np.array(values) for name, values in counters.items()}
     arrays.update({name: np.array(values).reshape(-1, d, d) for name, values in tensors.items()})
+    arrays.update({name: np.array(values, dtype=np.float64) for name, values in books.items()})
     return make_trajectory(
         np.array(times),
         np.array(positions).reshape(len(times), n, d),

@@ -46,6 +46,9 @@ _LIST_SHELL = _edmd.LIST_SHELL  # see _edmd
 # The stress tensor's parts a sample records with Simulation(stress=True), each (d, d):
 # the cumulative collisional sum, the cumulative kinetic integral, the kinetic tensor now.
 _TENSORS = ("stress_collisional", "kinetic_time_tensor", "kinetic_tensor")
+# A vibrating wall's energy books a sample records (cumulative, as the counters'), with
+# such a wall only: the work it did and the energy collisions dissipated.
+_WALL_BOOKS = ("wall_work", "collision_loss")
 
 
 class Simulation:
@@ -229,7 +232,8 @@ class Simulation:
         energy dissipated by pair and wall collisions (a heated wall's gain counts as a
         negative loss): the kinetic energy (plus the potential one under gravity) changed by
         wall_work - collision_loss (+ drive_energy with a random driving) since the start,
-        up to rounding; its stale_events also count a particle's arrival at the band
+        up to rounding (per sample: ``Trajectory.wall_work``, ``.collision_loss``); its
+        stale_events also count a particle's arrival at the band
         the wall sweeps, where the exact search for its hit starts (docs/vibrated.md).
 
         With ``Simulation(stress=True)`` also: stress_collisional, kinetic_time_tensor,
@@ -599,6 +603,14 @@ class Simulation:
         energy never falls without a dissipative channel (inelastic pairs, of which there
         must be two, or absorbing walls)."""
         s = self._initial
+        if s.gravity is not None and s.boundary == "periodic":
+            # the freely falling box: its kinetic energy counts the fall, M g^2 t^2 / 2, which
+            # outgrows any cooling, so an energy target alone may never come
+            raise ValueError(
+                f"stop_when kinetic_energy = {target} alone cannot bound a run in the freely "
+                "falling box (free_fall=True): its kinetic energy counts the fall, which grows "
+                "as M g^2 t^2 / 2; give t_stop, or stop_when collisions_per_particle or events"
+            )
         pairs_lose = (
             _restitution.loses_energy(s.restitution) or not rough_keeps_energy(s)
         ) and s.n >= 2
@@ -633,6 +645,9 @@ class Simulation:
         for name in _TENSORS:
             if buf.get(name) is not None:
                 buf[name][k] = np.array(c[name][: vel.shape[1] ** 2]).reshape(vel.shape[1], -1)
+        for name in _WALL_BOOKS:
+            if buf.get(name) is not None:
+                buf[name][k] = c[name]
 
     def _buffers(self, count, store, rough=False):
         n, d = self._initial.n, self._initial.dim
@@ -649,6 +664,10 @@ class Simulation:
             **{
                 name: np.zeros((count, d, d)) if self._knobs.get("stress") else None
                 for name in _TENSORS
+            },
+            **{
+                name: np.zeros(count) if self._initial.vibrating_wall is not None else None
+                for name in _WALL_BOOKS
             },
         )
 

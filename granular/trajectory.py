@@ -47,6 +47,14 @@ class Trajectory:
     kinetic_time_tensor : (T, d, d) cumulative integral over time of sum_i m_i v_a v_b,
         or None (as above)
     kinetic_tensor : (T, d, d) sum_i m_i v_a v_b at each sample, or None (as above)
+    wall_work : (T,) cumulative work a vibrating wall did on the particles since the
+        simulation began (the sum over its hits of J U, J the normal impulse it gave, U its
+        velocity then), or None without a vibrating wall (``stats["wall_work"]`` is the
+        last value of a run that ends with a sample)
+    collision_loss : (T,) cumulative kinetic energy pair and wall collisions dissipated
+        since the simulation began, or None without a vibrating wall; between two samples
+        the kinetic (plus potential, under gravity) energy changed by the differences of
+        ``wall_work`` less those of ``collision_loss`` (``wall_power``)
     stop_reason : why the run ended: "time", "collisions", "kinetic_energy", "events",
         "idle" (no event will ever happen); a run cut short carries the samples so far in
         its exception's ``.trajectory``, with "error" or, after Ctrl-C, "interrupted"
@@ -76,6 +84,8 @@ class Trajectory:
     stress_collisional: NDArray[np.float64] | None
     kinetic_time_tensor: NDArray[np.float64] | None
     kinetic_tensor: NDArray[np.float64] | None
+    wall_work: NDArray[np.float64] | None
+    collision_loss: NDArray[np.float64] | None
     angular_velocities: NDArray[np.float64] | None
     rotational_energy: NDArray[np.float64] | None
     masses: NDArray[np.float64]
@@ -110,6 +120,8 @@ class Trajectory:
         kinetic_tensor: NDArray[np.float64] | None = None,
         angular_velocities: NDArray[np.float64] | None = None,
         rotational_energy: NDArray[np.float64] | None = None,
+        wall_work: NDArray[np.float64] | None = None,
+        collision_loss: NDArray[np.float64] | None = None,
     ) -> None:
         # read-only views: a caller writing into an array the trajectory hands out gets a
         # ValueError instead of changing the trajectory unseen
@@ -128,6 +140,8 @@ class Trajectory:
             kinetic_tensor=kinetic_tensor,
             angular_velocities=angular_velocities,
             rotational_energy=rotational_energy,
+            wall_work=wall_work,
+            collision_loss=collision_loss,
             masses=masses,
             radii=radii,
             lower=lower,
@@ -318,6 +332,36 @@ class Trajectory:
                 "this trajectory has no stress tensor: build the Simulation with stress=True"
             )
         return self.stress_collisional
+
+    def wall_power(self, per_window: bool = False) -> tuple[Any, Any]:
+        """The vibrating wall's mean power input and the mean power collisions dissipate,
+        (input, loss), from ``wall_work`` and ``collision_loss``: over the run between the
+        first and the last sample, or per window between consecutive samples.  Exact (the
+        engine sums both at every hit and collision); their difference is the rate of change
+        of the kinetic (plus potential, under gravity) energy, zero on average in a steady
+        state (docs/vibrated.md).
+
+        Parameters
+        ----------
+        per_window : bool
+            Return two (T - 1,) arrays, one value per window, instead of two floats.
+        """
+        if self.wall_work is None or self.collision_loss is None:
+            raise ValueError(
+                "this trajectory has no vibrating wall's books (wall_work, collision_loss): "
+                "its scene had no vibrating wall"
+            )
+        t = self.times
+        if per_window:
+            if len(t) < 2:
+                raise ValueError("wall_power needs at least two samples")
+            spans = np.diff(t)
+            return np.diff(self.wall_work) / spans, np.diff(self.collision_loss) / spans
+        if len(t) < 2 or t[-1] <= t[0]:
+            raise ValueError("wall_power needs at least two samples spanning some time")
+        span = float(t[-1] - t[0])
+        work = float(self.wall_work[-1] - self.wall_work[0])
+        return work / span, float(self.collision_loss[-1] - self.collision_loss[0]) / span
 
     def wall_pressure(self) -> float:
         """Mechanical pressure on the walls between the first and last sample: the normal

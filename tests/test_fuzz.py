@@ -137,5 +137,6 @@ def test_fuzz_inputs_end_in_a_clear_error_or_a_valid_result():
         "threads",
         "stress",
         "vibrating",
+        "falling",
     ):
         assert tally[kind, "ok"] >= 10 and tally[kind, "error"] >= 10, dict(tally)

@@ -941,6 +941,37 @@ STRESS_KINDS = {"stress": (_stress_params, [*RUN_MUTATIONS, _stress_knob])}
 STRESS_SHARE = 0.04
 
 
+# Runs under gravity keeping the stress tensor (its flight integral under gravity,
+# csrc/stress.h), between walls or in the freely falling periodic box, from a stream of
+# their own (the first stream's cases stay as they were, fewer by this share).
+def _falling_params(rng):
+    p = _stress_params(rng)
+    g = np.zeros(p["scene"]["dim"])
+    g[-1] = -float(rng.choice([0.5, 3.0, 50.0]))
+    g[0] = float(rng.choice([0.0, 0.5]))
+    p["fall"] = dict(gravity=g, free_fall=p["scene"]["boundary"] == "periodic")
+    return p
+
+
+def _fall_strength(rng, p):
+    """Gravity from the representable to the absurd (or NaN) on the falling baseline."""
+    v = float(rng.choice([1e-300, 1e-150, 1e140, 1e279, 1e300, NAN, INF]))
+    p["fall"]["gravity"] = p["fall"]["gravity"] * 0.0 + np.eye(len(p["fall"]["gravity"]))[-1] * v
+    return f"gravity[-1]={v!r}"
+
+
+def _fall_frame(rng, p):
+    """The free-fall frame flipped (a periodic box without it is refused)."""
+    p["fall"]["free_fall"] = not p["fall"]["free_fall"]
+    return f"free_fall={p['fall']['free_fall']}"
+
+
+FALLING_KINDS = {
+    "falling": (_falling_params, [*RUN_MUTATIONS, _stress_knob, _fall_strength, _fall_frame])
+}
+FALLING_SHARE = 0.03
+
+
 def _draw(rng, kinds, count, at_least_one=()):
     cases = []
     for i in range(count):
@@ -967,7 +998,10 @@ def make_cases(seed, count):
     stress = int(STRESS_SHARE * count)
     rough = int(ROUGH_SHARE * count)
     vib = int(VIB_SHARE * count)
-    first = _draw(np.random.default_rng(seed), KINDS, count - later - scales - stress - rough - vib)
+    falling = int(FALLING_SHARE * count)
+    first = _draw(
+        np.random.default_rng(seed), KINDS, count - later - scales - stress - rough - vib - falling
+    )
     return (
         first
         + _draw(np.random.default_rng([seed, 1]), LATER_KINDS, later, ("threads",))
@@ -975,6 +1009,7 @@ def make_cases(seed, count):
         + _draw(np.random.default_rng([seed, 3]), STRESS_KINDS, stress)
         + _draw(np.random.default_rng([seed, 4]), ROUGH_KINDS, rough)
         + _draw(np.random.default_rng([seed, 5]), VIB_KINDS, vib)
+        + _draw(np.random.default_rng([seed, 6]), FALLING_KINDS, falling)
     )
 
 
@@ -1038,6 +1073,8 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
         _check(a is None or np.all(np.isfinite(a)), f"non-finite {name} in the trajectory")
         if a is not None:
             _check(np.all(np.isfinite(sim.stats[name])), f"non-finite stats {name}")
+    if scene.gravity is not None and traj.kinetic_tensor is not None:
+        _check_falling_tensor(scene, traj, sim)
     stats = {
         k: v
         for k, v in sim.stats.items()  # pressure, temperature_ratio: NaN is a documented answer
@@ -1098,6 +1135,26 @@ def _check_trajectory(scene, traj, sim, sample_times=None):
     if len(e) and not heated:
         rise = (np.max(e) - e[0]) / e[0] if e[0] > 0 else np.max(e)
         _check(rise <= ENERGY_RTOL, f"no heated walls, yet the kinetic energy rose by {rise:.3g}")
+
+
+@_verified
+def _check_falling_tensor(scene, traj, sim):
+    """Under gravity with stress=True: trace(pressure_tensor) / d is the scalar pressure (two
+    integrals of the kinetic energy through the parabolic flights, summed apart), and the
+    kinetic tensor kept by differences (stats) is the velocities' own now, both to 1e-9
+    (the kept tensor to 1e-9 of the largest energy the run held: it carries the rounding of
+    the energies it held since it was last summed anew)."""
+    st = sim.stats
+    d = scene.dim
+    if st["time"] > 0 and math.isfinite(st["pressure"]):
+        trace = float(np.trace(np.array(st["pressure_tensor"]))) / d
+        gap = abs(trace - st["pressure"])
+        _check(gap <= 1e-9 * abs(st["pressure"]) + 1e-300, f"trace / d - pressure = {gap:.3g}")
+    v = sim.scene.velocities
+    own = np.einsum("i,ia,ib->ab", scene.masses, v, v)
+    held = max(2 * float(np.max(traj.kinetic_energy, initial=0.0)), float(np.trace(own)))
+    gap = float(np.max(np.abs(np.array(st["kinetic_tensor"]) - own)))
+    _check(gap <= 1e-9 * held + 1e-300, f"the kept kinetic tensor is off by {gap:.3g}")
 
 
 @_verified
@@ -1201,6 +1258,16 @@ def _check_vibrating(scene, traj, sim):
     scale = max(scene.kinetic_energy, abs(st["wall_work"]), abs(st["collision_loss"]))
     miss = abs(change - (st["wall_work"] - st["collision_loss"]))
     _check(miss <= 1e-12 * scale, f"energy: change {change:.6g} vs work - loss, off by {miss:.3g}")
+    # the books per sample: cumulative, the stats' at a last sample taken now, and each
+    # window's energy change to the same rounding
+    work, loss = traj.wall_work, traj.collision_loss
+    _check(work is not None and loss is not None, "a vibrating wall's run without its books")
+    if len(traj.times) and traj.times[-1] == sim.time:
+        _check(work[-1] == st["wall_work"] and loss[-1] == st["collision_loss"],
+               "the last sample's books are not the stats'")  # fmt: skip
+    gap = np.abs(np.diff(traj.kinetic_energy) - (np.diff(work) - np.diff(loss)))
+    scale = max(scale, float(np.max(traj.kinetic_energy, initial=0.0)))
+    _check(np.all(gap <= 1e-12 * scale), "a window's energy change is not its work - loss")
 
 
 def _same_stats(a, b):
@@ -1284,8 +1351,10 @@ def run_case(case):
                 "the radii are not the requested ones, particle by particle",
             )
             _run_scene(s)
-        elif kind in ("run", "stress"):
+        elif kind in ("run", "stress", "falling"):
             scene = Scene.random(**p["scene"])
+            if "fall" in p:  # (Scene.random takes no gravity)
+                scene = scene.replace(**p["fall"])
             sim = Simulation(scene, **p.get("knobs", {}))
             traj = sim.run(**p["run"])
             _check_trajectory(scene, traj, sim, p["run"].get("sample_times"))

@@ -35,9 +35,13 @@ def wall_time(x, v, g, stop, outward):
     return best
 
 
-def run_scene(scene, t_stop, sample_times):
+def run_scene(scene, t_stop, sample_times, tensors=None):
     """Positions (unwrapped) and velocities of a granular.Scene with gravity at
-    sample_times (as reference_edmd.run_scene)."""
+    sample_times (as reference_edmd.run_scene).  A dict ``tensors`` gets the stress
+    tensor's parts at the sample times (as reference_edmd.run's): "collisional", the sum
+    over pair collisions of dr_a dp_b, and "kinetic_time", the integral over time of
+    sum m v_a v_b, by Simpson's rule over each flight between events (exact: v is linear
+    in time in flight, so m v_a v_b is a quadratic), not by the engine's closed form."""
     x = np.array(scene.positions, dtype=float)
     v = np.array(scene.velocities, dtype=float)
     r, m, lo, hi = scene.radii, scene.masses, scene.lower, scene.upper
@@ -50,6 +54,16 @@ def run_scene(scene, t_stop, sample_times):
     t = 0.0
     out_x, out_v = [], []
     samples = list(sample_times)
+    coll, kin_time = np.zeros((d, d)), np.zeros((d, d))
+    coll_out, kin_out = [], []
+
+    def kin_integral(span):
+        def tensor(tau):
+            w = v + g * tau
+            return np.einsum("i,ia,ib->ab", m, w, w)
+
+        return span / 6.0 * (tensor(0.0) + 4.0 * tensor(0.5 * span) + tensor(span))
+
     while True:
         pt = pair_times(x, v, r, L, periodic)
         i, j = np.unravel_index(np.argmin(pt), pt.shape)
@@ -68,8 +82,11 @@ def run_scene(scene, t_stop, sample_times):
             tau = ts - t
             out_x.append(x + v * tau + 0.5 * g * tau**2 + image * L)
             out_v.append(v + g * tau)
+            coll_out.append(coll.copy())
+            kin_out.append(kin_time + kin_integral(tau))
         if t + dt > t_stop:
             break
+        kin_time = kin_time + kin_integral(dt)
         x += v * dt + 0.5 * g * dt**2
         v += g * dt
         t += dt
@@ -86,6 +103,7 @@ def run_scene(scene, t_stop, sample_times):
             f = (1 + eps) * np.dot(dv, dr) / (np.dot(dr, dr) * (m[i] + m[j]))
             v[i] += f * m[j] * dr
             v[j] -= f * m[i] * dr
+            coll += np.outer(dr, -f * m[i] * m[j] * dr)
         else:
             p, a = wall
             e_w = _eps(wall_e, abs(v[p, a]))
@@ -94,4 +112,7 @@ def run_scene(scene, t_stop, sample_times):
             # on the wall exactly, as the engine puts it (else rounding may leave it a hair
             # past, and the next root search starts outside)
             x[p, a] = hi[a] - r[p] if v[p, a] < 0 else lo[a] + r[p]
+    if tensors is not None:
+        tensors["collisional"] = np.array(coll_out)
+        tensors["kinetic_time"] = np.array(kin_out)
     return np.array(out_x), np.array(out_v)
