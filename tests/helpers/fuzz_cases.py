@@ -956,7 +956,9 @@ def _falling_params(rng):
 def _fall_strength(rng, p):
     """Gravity from the representable to the absurd (or NaN) on the falling baseline."""
     v = float(rng.choice([1e-300, 1e-150, 1e140, 1e279, 1e300, NAN, INF]))
-    p["fall"]["gravity"] = p["fall"]["gravity"] * 0.0 + np.eye(len(p["fall"]["gravity"]))[-1] * v
+    g = np.zeros(len(p["fall"]["gravity"]))
+    g[-1] = v  # (eye * v would make 0 * inf = NaN in the other components)
+    p["fall"]["gravity"] = g
     return f"gravity[-1]={v!r}"
 
 
