@@ -75,6 +75,14 @@ static GR_ALWAYS_INLINE void prefetch_ahead(gr_edmd *s, int dim)
 static void set_clock(gr_edmd *s, int dyn, double t);
 static double next_sample(const gr_edmd_samples *smp);
 
+/* Whether this unit compiles the rough rule (rule.h) at all: not the plain unit, whose
+ * do_pair_sheared, a function with a run-time `laws`, would otherwise carry its code. */
+#if defined(GR_EDMD_GRAVITY_UNIT) || defined(GR_EDMD_EXTRA_UNIT)
+#define GR_UNIT_ROUGH 1
+#else
+#define GR_UNIT_ROUGH 0
+#endif
+
 /* The collision count 2 * pair + wall at which s->kinetic is next summed anew: the next
  * multiple of GR_KINETIC_RESUM * n above the present count. */
 #define GR_KINETIC_RESUM 16
@@ -197,9 +205,11 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
                 predict(s, dyn, dim, i);
                 continue;
             }
-            const double k0 = vib ? s->kinetic : 0.0;
+            /* vibwall.h's bookkeeping (the rough rule books its own loss: do_pair) */
+            const int books = vib && !GR_RULE_IS_ROUGH(laws);
+            const double k0 = books ? s->kinetic : 0.0;
             status = do_pair(s, dyn, dim, laws, i, e->partner, te, err);
-            if (vib) s->collision_loss += k0 - s->kinetic; /* vibwall.h's bookkeeping */
+            if (books) s->collision_loss += k0 - s->kinetic;
             check = 1;
         } else if (vib && -2 - e->partner == 2 * s->cfg.vib.axis + s->cfg.vib.side) {
             status = do_vibwall(s, dyn, dim, laws, i, te, err);
@@ -308,10 +318,38 @@ static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
     return advance(s, GR_FLIGHT_GRAVITY, 3, 1, stop, smp, err, 1);
 }
 
+/* rough particles under gravity (rule.h; spins do not change in flight: no torque) */
+static int advance_2d_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop,
+                                    gr_edmd_samples *smp, gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 2, GR_RULE_ROUGH, stop, smp, err, 0);
+}
+
+static int advance_3d_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop,
+                                    gr_edmd_samples *smp, gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 3, GR_RULE_ROUGH, stop, smp, err, 0);
+}
+
+static int advance_2d_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                                gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 2, GR_RULE_ROUGH, stop, smp, err, 1);
+}
+
+static int advance_3d_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                                gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 3, GR_RULE_ROUGH, stop, smp, err, 1);
+}
+
 int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                             gr_error *err)
 {
     if (s->cfg.vib.on) return advance_vib(s, stop, smp, err);
+    if (s->spin)
+        return s->dim == 2 ? advance_2d_gravity_rough(s, stop, smp, err)
+                           : advance_3d_gravity_rough(s, stop, smp, err);
     return s->dim == 2 ? advance_2d_gravity(s, stop, smp, err)
                        : advance_3d_gravity(s, stop, smp, err);
 }
@@ -344,10 +382,23 @@ static int advance_3d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_sample
     return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err, 0);
 }
 
+/* Rough particles beside a vibrating wall (which is smooth for them, as every wall) */
+static int advance_2d_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                                gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 2, GR_RULE_ROUGH, stop, smp, err, 1);
+}
+
+static int advance_3d_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                                gr_error *err)
+{
+    return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err, 1);
+}
+
 int gr_edmd_advance_extra(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    if (s->spin) /* a scene with spins: the rough rule, with or without laws */
+    if (s->spin && !s->cfg.vib.on) /* spins: the rough rule, with or without laws */
         return s->dim == 2 ? advance_2d_rough(s, stop, smp, err)
                            : advance_3d_rough(s, stop, smp, err);
     return advance_vib(s, stop, smp, err);
@@ -369,6 +420,9 @@ static int advance_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
                      "last up to about t = 2^26 / omega");
         return GR_ERR_VALUE;
     }
+    if (s->spin) /* rough particles (rule.h) */
+        return s->dim == 2 ? advance_2d_vib_rough(s, stop, smp, err)
+                           : advance_3d_vib_rough(s, stop, smp, err);
     return s->dim == 2 ? advance_2d_vib(s, stop, smp, err) : advance_3d_vib(s, stop, smp, err);
 }
 #endif
@@ -437,9 +491,13 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
         /* the TC model's elastic collision is smooth too: it keeps the energy */
         const double beta =
             s->elastic_tc != elastic_before ? -1.0 : s->cfg.tangential_restitution;
+        double loss;
         vir = rule_rough_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->spin + (size_t)i * w,
                                s->spin + (size_t)j * w, s->mass[i], s->mass[j], RAD(p, dim),
-                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction);
+                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction,
+                               &loss);
+        /* translation and rotation: kinetic alone cannot tell it (stats' collision_loss) */
+        s->collision_loss += loss;
     } else {
         vir = rule_pair_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
     }
@@ -609,6 +667,7 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
     for (int a = 0; a < dim; a++) vq[a] = VEL(q, dim)[a];
     vq[0] += vx;
     int64_t clamped;
+    const int64_t elastic_before = s->elastic_tc;
     const double xi = rule_pair_eps(&s->cfg, laws, dim, dr, VEL(p, dim), vq, t, &s->sched[i],
                                     &s->sched[j], &clamped, &s->elastic_tc);
     const double before = kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j);
@@ -618,7 +677,22 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
         stress_le_peculiar(s, dim, p, t, Vb);
         stress_le_peculiar(s, dim, q, t, Vb + 3);
     }
-    const double vir = rule_pair_apply(dim, dr, VEL(p, dim), vq, s->mass[i], s->mass[j], xi);
+    double vir;
+    if (GR_UNIT_ROUGH && GR_RULE_IS_ROUGH(laws)) {
+        /* the rough rule (do_pair) on the image's velocity vq; the spins are the same in
+         * every image (the images slide, they do not turn) */
+        const int w = dim == 2 ? 1 : 3;
+        const double beta =
+            s->elastic_tc != elastic_before ? -1.0 : s->cfg.tangential_restitution;
+        double loss;
+        vir = rule_rough_apply(dim, dr, VEL(p, dim), vq, s->spin + (size_t)i * w,
+                               s->spin + (size_t)j * w, s->mass[i], s->mass[j], RAD(p, dim),
+                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction,
+                               &loss);
+        s->collision_loss += loss; /* (as do_pair's: the same in every frame) */
+    } else {
+        vir = rule_pair_apply(dim, dr, VEL(p, dim), vq, s->mass[i], s->mass[j], xi);
+    }
     if (vir < 0.0) { /* grazing (do_pair) */
         s->invalid++;
         predict(s, dyn, dim, i);

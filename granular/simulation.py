@@ -232,6 +232,12 @@ class Simulation:
         up to rounding; its stale_events also count a particle's arrival at the band
         the wall sweeps, where the exact search for its hit starts (docs/vibrated.md).
 
+        Rough particles in a periodic box (sheared or not) also have collision_loss: the
+        energy, translational and rotational, their pair collisions dissipated, summed from
+        the collision rule's formulas (csrc/rule.h); in a sheared box kinetic_energy +
+        rotational_energy changed by shear_work - collision_loss since the start, up to
+        rounding.
+
         With ``Simulation(stress=True)`` also: stress_collisional, kinetic_time_tensor,
         kinetic_tensor (each d rows of d numbers, a tuple of tuples: ``np.array`` makes
         the matrix; see ``Trajectory``) and pressure_tensor, their average since the start
@@ -283,7 +289,10 @@ class Simulation:
             else float("nan")
         )
         if s.vibrating_wall is None:  # kept by the engine only where a wall vibrates
-            del c["wall_work"], c["collision_loss"]
+            del c["wall_work"]
+            # and for rough particles' pair collisions (csrc/rule.h): whole in a periodic box
+            if not (s.boundary == "periodic" and s.tangential_restitution != -1.0):
+                del c["collision_loss"]
         return c
 
     def _spins(self) -> NDArray[np.float64]:

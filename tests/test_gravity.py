@@ -285,13 +285,12 @@ def test_a_checkpoint_continues_bit_for_bit(tmp_path, boundary, shell):
 
 
 def test_what_gravity_is_not_offered_with_is_refused_by_name():
-    """Gravity's loops (csrc/edmd_gravity.c) have no rough rule, no sliding images and no
-    flight integral of the kinetic tensor: each combination is refused, naming it."""
+    """Gravity's loops (csrc/edmd_gravity.c) have no sliding images and no flight
+    integral of the kinetic tensor: each combination is refused, naming it (rough particles
+    are offered: tests/test_rough_combined.py)."""
     s = Scene.random(20, 0.03, dim=2, boundary="walls", seed=1)
     g = np.array([0.0, -1.0])
     Simulation(s.replace(gravity=g))  # alone it runs
-    with pytest.raises(ValueError, match="not offered with rough particles"):
-        Simulation(s.replace(gravity=g, tangential_restitution=0.5))
     with pytest.raises(ValueError, match="not offered with the stress tensor"):
         Simulation(s.replace(gravity=g), stress=True)
     p = Scene.random(20, 0.03, dim=2, seed=1)

@@ -107,7 +107,7 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
     positions, velocities and spins."""
     rough = getattr(scene, "tangential_restitution", -1.0) != -1.0
     if getattr(scene, "shear_rate", 0.0) != 0.0:
-        return run_sheared(
+        out = run_sheared(
             np.array(scene.positions),
             np.array(scene.velocities),
             scene.radii,
@@ -120,7 +120,12 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
             scene.shear_rate,
             scene.shear_offset,
             tensors=tensors,
-        )[:2]
+            spin=np.array(scene.angular_velocities) if rough else None,
+            beta=scene.tangential_restitution,
+            q=scene.inertia_factor,
+            mu=scene.friction,
+        )
+        return out[:2] + out[4:]
     return run(
         np.array(scene.positions),
         np.array(scene.velocities),
@@ -356,7 +361,22 @@ def sheared_images(d, kx_max=2):
 
 
 def run_sheared(
-    x, v, r, m, lo, hi, xi, t_stop, sample_times, shear_rate, shear_offset=0.0, tensors=None
+    x,
+    v,
+    r,
+    m,
+    lo,
+    hi,
+    xi,
+    t_stop,
+    sample_times,
+    shear_rate,
+    shear_offset=0.0,
+    tensors=None,
+    spin=None,
+    beta=-1.0,
+    q=0.4,
+    mu=np.inf,
 ):
     """``run`` in a periodic box with Lees-Edwards images across the y faces (flow along x):
     the image across the upper face is displaced along x by delta(t) = (shear_offset +
@@ -375,8 +395,15 @@ def run_sheared(
     A dict ``tensors`` gets the stress tensor's parts at the sample times, as ``run``'s but
     with the peculiar velocities V = v - shear_rate (y - y_c) e_x: "kinetic_time" integrates
     sum m V_a V_b step by step by Simpson's rule (exact: V is linear in time within a step),
-    "collisional" sums dr_a dp_b with dr through the image that touched."""
+    "collisional" sums dr_a dp_b with dr through the image that touched.
+
+    With ``spin`` (rough particles, ``run``'s), the pair through an image collides by
+    ``rough_collide`` with the image's velocity (v_x + ky u) and the particle's own spin
+    (the images slide, they do not turn); the spins at sample_times are a fifth array
+    returned."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
+    w = None if spin is None else spin.astype(float).copy()
+    out_s = []
     n, d = x.shape
     y_c = 0.5 * (lo[1] + hi[1])
     coll, kin_time = np.zeros((d, d)), np.zeros((d, d))
@@ -426,6 +453,8 @@ def run_sheared(
             out_v.append(v.copy())
             out_k.append(0.5 * (m[:, None] * v * v).sum())
             out_w.append(work)
+            if w is not None:
+                out_s.append(w.copy())
             coll_out.append(coll.copy())
             kin_out.append(kin_time + kin_integral(ts - t))
         if t + dt > t_stop:
@@ -465,6 +494,17 @@ def run_sheared(
         vj[0] += kyy * u
         dv = vj - v[i]
         eps = _eps(xi, -np.dot(dv, dr) / np.sqrt(np.dot(dr, dr)))
+        if w is not None:  # rough: the rule on the image's velocity, the spins as they are
+            vi_before = v[i].copy()
+            v[i], vj_after, w[i], w[j] = rough_collide(
+                dr, v[i], vj, w[i], w[j], r[i], r[j], m[i], m[j], q, eps, beta, mu, d
+            )
+            v[j] = vj_after
+            v[j][0] -= kyy * u
+            dp_i = m[i] * (v[i] - vi_before)
+            work += kyy * u * dp_i[0]
+            coll += np.outer(dr, -dp_i)
+            continue
         f = (1 + eps) * np.dot(dv, dr) / (np.dot(dr, dr) * (m[i] + m[j]))
         v[i] += f * m[j] * dr
         v[j] -= f * m[i] * dr
@@ -474,4 +514,5 @@ def run_sheared(
     if tensors is not None:
         tensors["collisional"] = np.array(coll_out)
         tensors["kinetic_time"] = np.array(kin_out)
-    return np.array(out_x), np.array(out_v), np.array(out_k), np.array(out_w)
+    out = np.array(out_x), np.array(out_v), np.array(out_k), np.array(out_w)
+    return out if w is None else (*out, np.array(out_s))
