@@ -343,3 +343,33 @@ def test_the_sheared_trajectory_has_the_rotational_temperature():
     st = sim.stats
     assert tr.rotational_temperature[-1] == pytest.approx(st["rotational_temperature"], rel=1e-12)
     assert tr.temperature_ratio[-1] == pytest.approx(st["temperature_ratio"], rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    "rough",
+    [
+        dict(tangential_restitution=1.0, restitution=1.0),
+        dict(tangential_restitution=0.5, friction=0.2, restitution=0.9),
+    ],
+)
+def test_the_sheared_stress_tensor_carries_the_tangential_impulse(rough):
+    """Simulation(stress=True) of rough particles in a sheared box: the peculiar
+    translational energy (half the kinetic tensor's trace) plus the rotational energy plus
+    the collisions' loss rose by the viscous heating, -rate (int K_xy dt + W_yx) -- the
+    collisional part W summed with each collision's whole impulse, normal and tangential:
+    to rounding, a few 1e-16 of the energies in play per collision, while the heating is
+    a good part of them."""
+    s = _sheared(3, n=100, **rough)
+    sim = Simulation(s, stress=True)
+    tr = sim.run(stop_when={"collisions_per_particle": 30}, sample_times=[0.0, 1e9])
+    st = sim.stats
+    k = np.array(st["kinetic_tensor"])
+    kt = np.array(st["kinetic_time_tensor"])
+    w = np.array(st["stress_collisional"])
+    k0 = tr.kinetic_tensor[0]
+    gained = 0.5 * (np.trace(k) - np.trace(k0)) + st["rotational_energy"] - s.rotational_energy
+    gained += st["collision_loss"]
+    heated = -s.shear_rate * (kt[0, 1] + w[1, 0])
+    scale = max(np.trace(k), np.trace(k0), s.rotational_energy, abs(heated))
+    assert abs(gained - heated) <= 1e-15 * st["pair_collisions"] * scale
+    assert abs(heated) > 0.03 * scale
