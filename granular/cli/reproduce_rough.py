@@ -32,8 +32,8 @@ Maxwellian at T = 1 (rescaled to exactly 1), spins at rest.
 - ``rough.sheared_ratio.2d.beta=0``: rough disks (xi = 0.99, beta = 0) in a Lees-Edwards box,
   N = 100 at area fraction 0.05, shear rate 0.2, in their steady state: T_rot / T_tr against
   the estimate B / C (``theory.rough_sheared_temperature_ratio``: the rotational equation's
-  fixed point, the images doing work on the translation only; Maxwellian, vanishing shear
-  rate).
+  fixed point, the images doing work on the translation only; an estimate that takes the
+  velocities isotropic, Maxwellian and independent of the spins: docs/rough.md).
 """
 
 from __future__ import annotations
@@ -289,7 +289,7 @@ def _fig_rough(cfg, out, *, ensemble, save, fig, row, mean_row):
             f"shear rate {RATE_SHEAR}), each run's mean over {SHEAR_WINDOWS} samples "
             f"{SHEAR_EVERY:g} collisions per particle apart after {SHEAR_SETTLE:g}; estimate: "
             "the rotational equation's fixed point B / C (theory.rough_sheared_temperature_ratio"
-            "; Maxwellian, vanishing shear rate)",
+            "; an estimate: isotropic Maxwellian velocities independent of the spins)",
             per_run,
             None,
             theory.rough_sheared_temperature_ratio(tangential_restitution=0.0, dim=2),
@@ -298,14 +298,16 @@ def _fig_rough(cfg, out, *, ensemble, save, fig, row, mean_row):
     return names, rows
 
 
-# the sheared row: a nearly elastic gas, whose steady reduced shear rate is small
+# the sheared row: nearly elastic normal impacts (the tangential loss remains at beta = 0)
 N_SHEAR, PHI_SHEAR, XI_SHEAR, RATE_SHEAR = 100, 0.05, 0.99, 0.2
 SHEAR_SETTLE, SHEAR_EVERY, SHEAR_WINDOWS = 400.0, 20.0, 20
 
 
 def _sheared_ratio(seed):
     """One sheared run's mean T_rot / T_tr (the peculiar T_tr) over its samples, after the
-    steady state has set in (~(1 - xi^2) SHEAR_SETTLE = 8 relaxation times)."""
+    steady state has set in (the translational energy relaxes at about k_tr A = 0.15 per
+    collision per particle, the tangential loss's share dominating: SHEAR_SETTLE is many
+    relaxation times)."""
     radius = math.sqrt(PHI_SHEAR / (N_SHEAR * math.pi))
     s = Scene.random(N_SHEAR, radius, dim=2, seed=seed, temperature=1.0)
     s = s.replace(shear_rate=RATE_SHEAR, restitution=XI_SHEAR, tangential_restitution=0.0)

@@ -140,12 +140,13 @@ def rough_sheared_temperature_ratio(
 
     T_tr the temperature of the velocities less the mean flow.  Independent of xi and of
     the shear rate: 1 at beta = 1 (equipartition), 0 at beta = -1; 1/4 for disks and 2/9
-    for solid spheres at beta = 0.  An estimate: besides the Maxwellian average's
-    approximations it leaves out the mean flow's velocity difference across a contact
-    (shear_rate * sigma) and the spins' mean (-shear_rate / 2 about z), both of relative
-    order shear_rate^2 sigma^2 m / T -- so it is the limit of a nearly elastic gas, whose
-    steady reduced shear rate is small.  Simulated (docs/rough.md) the ratio lies a few per
-    cent above it at xi = 0.99."""
+    for solid spheres at beta = 0.  An estimate: the average takes the velocities
+    isotropic and Maxwellian, independent of the spins, where a sheared gas' velocity
+    distribution is anisotropic to order (shear_rate / omega)^2 (omega the collision
+    frequency: small only where collisions lose little, xi near 1 and beta near +-1); and
+    it leaves out the mean flow's velocity difference across a contact and the spins'
+    mean (-shear_rate / 2 about z), of relative order shear_rate^2 sigma^2 m / T.
+    Simulated (docs/rough.md) the ratio lies 3-5 % above it at xi = 0.99."""
     _, beta, q = _checked(1.0, tangential_restitution, inertia_factor, dim)
     return q * (1.0 + beta) / (1.0 + 2.0 * q - beta)
 
