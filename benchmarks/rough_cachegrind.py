@@ -1,9 +1,9 @@
 """Rough particles against smooth ones in each combination, instructions per pair collision
-(run under cachegrind by rough_cachegrind.sh): a sheared box, a vibrating floor, gravity
-between walls, and a vibrated bed under gravity.  The gas: 3D, N = 10^3, packing 0.065,
-equilibrated once (prep; between walls its velocities on the lattice); the rough one the
-same with beta = 1, xi = 1 and thermal spins, so that both keep their temperature (or heat
-alike) as the smooth one does.
+(run under cachegrind by rough_cachegrind.sh): a periodic box, a sheared one, a vibrating
+floor, gravity between walls, and a vibrated bed under gravity.  The gas: 3D, N = 10^3,
+packing 0.065, equilibrated once (prep; between walls its velocities on the lattice); the
+rough one the same with beta = 1, xi = 1 and thermal spins, so that both keep their
+temperature (or heat alike) as the smooth one does.
 
     python rough_cachegrind.py prep DIR
     python rough_cachegrind.py run DIR CASE rough|smooth EVENTS
@@ -34,7 +34,9 @@ def prep(folder):
 def scene(folder, case, rough):
     z = np.load(f"{folder}/rough-base.npz")
     pos, vel, r = z["pos"], z["vel"], float(z["r"][0])
-    if case == "sheared":
+    if case == "periodic":  # the rough loop alone
+        s = Scene(pos, vel, r)
+    elif case == "sheared":
         s = Scene(pos, vel, r, shear_rate=0.5)
     else:
         # walls: the lattice (the floor's sweep and a radius clear), the equilibrated
