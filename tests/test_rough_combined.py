@@ -373,3 +373,27 @@ def test_the_sheared_stress_tensor_carries_the_tangential_impulse(rough):
     scale = max(np.trace(k), np.trace(k0), s.rotational_energy, abs(heated))
     assert abs(gained - heated) <= 1e-15 * st["pair_collisions"] * scale
     assert abs(heated) > 0.03 * scale
+
+
+@pytest.mark.parametrize("case", ["sheared", "vibrated bed"])
+def test_gsd_carries_the_spins_in_each_combination(tmp_path, case):
+    """A sheared rough run and a rough vibrated bed written to GSD: granular.read gives back
+    the spins and rotational energies exactly, Scene.from_gsd the last frame's spins with
+    the scene's rough parameters and its shear or gravity and wall."""
+    pytest.importorskip("gsd.hoomd")
+    from granular import read
+
+    s = _CHECKPOINT_CASES[case]()
+    sim = Simulation(s)
+    store = ("positions", "velocities", "angular_velocities")
+    tr = sim.run(t_stop=0.5, sample_times=[0.0, 0.25, 0.5], store=store)
+    tr.write(tmp_path / "r.gsd")
+    back = read(tmp_path / "r.gsd")
+    assert np.array_equal(back.angular_velocities, tr.angular_velocities)
+    assert np.array_equal(back.rotational_energy, tr.rotational_energy)
+    scene = Scene.from_gsd(tmp_path / "r.gsd")
+    assert np.array_equal(scene.angular_velocities, tr.angular_velocities[-1])
+    assert scene.tangential_restitution == s.tangential_restitution
+    assert scene.shear_rate == s.shear_rate
+    assert (scene.gravity is None) == (s.gravity is None)
+    assert (scene.vibrating_wall is None) == (s.vibrating_wall is None)
