@@ -34,6 +34,15 @@
 #include "stress.h"
 #include "vibwall.h"
 
+/* The rough units are their parents compiled with rough loops (see the units' comment
+ * above advance_2d): edmd_gravity_rough.c gravity's unit, edmd_rough_vib.c the extra one. */
+#ifdef GR_EDMD_GRAVITY_ROUGH_UNIT
+#define GR_EDMD_GRAVITY_UNIT 1
+#endif
+#ifdef GR_EDMD_VIB_ROUGH_UNIT
+#define GR_EDMD_EXTRA_UNIT 1
+#endif
+
 /* Everything an event of particle i is about to read or write, requested at once.  A
  * macro, not a function: GCC takes a function that only prefetches for one without
  * effects and deletes the calls (seen with GCC 12 at -O3: none of these was emitted). */
@@ -81,6 +90,12 @@ static double next_sample(const gr_edmd_samples *smp);
 #define GR_UNIT_ROUGH 1
 #else
 #define GR_UNIT_ROUGH 0
+#endif
+/* The vibrating wall's loops' rule: the law rule, or in the rough units the rough one. */
+#if defined(GR_EDMD_GRAVITY_ROUGH_UNIT) || defined(GR_EDMD_VIB_ROUGH_UNIT)
+#define GR_VIB_LAWS GR_RULE_ROUGH
+#else
+#define GR_VIB_LAWS 1
 #endif
 
 /* The collision count 2 * pair + wall at which s->kinetic is next summed anew: the next
@@ -238,13 +253,16 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
     }
 }
 
-/* This file is compiled three times: as itself, the loops of constant velocity with
+/* This file is compiled five times: as itself, the loops of constant velocity with
  * smooth particles and fixed walls (the plain loop's unit); by edmd_gravity.c
- * (GR_EDMD_GRAVITY_UNIT) for gravity's loops; and by edmd_extra.c (GR_EDMD_EXTRA_UNIT) for
- * the loops of rough particles and of a vibrating wall.  Apart, the compiler's choices of
- * what to inline and clone for the plain loop are those it made before the others came:
- * in one unit, the search functions' clones for every loop outgrew its limits and the plain
- * loop ran 7-13 % more instructions an event. */
+ * (GR_EDMD_GRAVITY_UNIT) for gravity's loops; by edmd_extra.c (GR_EDMD_EXTRA_UNIT) for
+ * the loops of rough particles and of a vibrating wall; and by edmd_gravity_rough.c and
+ * edmd_rough_vib.c for rough particles under gravity and beside a vibrating wall.  Apart,
+ * the compiler's choices of what to inline and clone for the plain loop are those it made
+ * before the others came: in one unit, the search functions' clones for every loop outgrew
+ * its limits and the plain loop ran 7-13 % more instructions an event.  The same held
+ * among the others: the rough loops under gravity and beside the wall in the gravity and
+ * extra units cost the loops there 5-9 % more instructions a pair collision. */
 #if !defined(GR_EDMD_GRAVITY_UNIT) && !defined(GR_EDMD_EXTRA_UNIT)
 static int advance_2d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
@@ -290,6 +308,21 @@ int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
 }
 #elif defined(GR_EDMD_GRAVITY_UNIT)
+/* a vibrating floor under gravity (vibwall.h: its search bounds the gap's curvature by
+ * |g| + A omega^2): advance_vib's loops in this unit */
+static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 2, GR_VIB_LAWS, stop, smp, err, 1);
+}
+
+static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 3, GR_VIB_LAWS, stop, smp, err, 1);
+}
+
+#ifndef GR_EDMD_GRAVITY_ROUGH_UNIT
 /* Gravity (flight.h, GR_FLIGHT_GRAVITY): one loop per dimension, compiled with the laws'
  * code (a constant restitution is then one test of the law's kind per collision). */
 static int advance_2d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
@@ -304,21 +337,17 @@ static int advance_3d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samp
     return advance(s, GR_FLIGHT_GRAVITY, 3, 1, stop, smp, err, 0);
 }
 
-/* a vibrating floor under gravity (vibwall.h: its search bounds the gap's curvature by
- * |g| + A omega^2): advance_vib's loops in this unit */
-static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                          gr_error *err)
+int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                            gr_error *err)
 {
-    return advance(s, GR_FLIGHT_GRAVITY, 2, 1, stop, smp, err, 1);
+    if (s->spin) return gr_edmd_advance_gravity_rough(s, stop, smp, err);
+    if (s->cfg.vib.on) return advance_vib(s, stop, smp, err);
+    return s->dim == 2 ? advance_2d_gravity(s, stop, smp, err)
+                       : advance_3d_gravity(s, stop, smp, err);
 }
-
-static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                          gr_error *err)
-{
-    return advance(s, GR_FLIGHT_GRAVITY, 3, 1, stop, smp, err, 1);
-}
-
-/* rough particles under gravity (rule.h; spins do not change in flight: no torque) */
+#else
+/* Rough particles under gravity (rule.h; spins do not change in flight: no torque), with
+ * or without a vibrating floor (smooth for them, as every wall). */
 static int advance_2d_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop,
                                     gr_edmd_samples *smp, gr_error *err)
 {
@@ -331,44 +360,31 @@ static int advance_3d_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop,
     return advance(s, GR_FLIGHT_GRAVITY, 3, GR_RULE_ROUGH, stop, smp, err, 0);
 }
 
-static int advance_2d_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                                gr_error *err)
-{
-    return advance(s, GR_FLIGHT_GRAVITY, 2, GR_RULE_ROUGH, stop, smp, err, 1);
-}
-
-static int advance_3d_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                                gr_error *err)
-{
-    return advance(s, GR_FLIGHT_GRAVITY, 3, GR_RULE_ROUGH, stop, smp, err, 1);
-}
-
-int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                            gr_error *err)
+int gr_edmd_advance_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                                  gr_error *err)
 {
     if (s->cfg.vib.on) return advance_vib(s, stop, smp, err);
-    if (s->spin)
-        return s->dim == 2 ? advance_2d_gravity_rough(s, stop, smp, err)
-                           : advance_3d_gravity_rough(s, stop, smp, err);
-    return s->dim == 2 ? advance_2d_gravity(s, stop, smp, err)
-                       : advance_3d_gravity(s, stop, smp, err);
+    return s->dim == 2 ? advance_2d_gravity_rough(s, stop, smp, err)
+                       : advance_3d_gravity_rough(s, stop, smp, err);
 }
+#endif
 #else
 /* A vibrating wall's loops (vibwall.h): compiled with the law rule (which takes a
- * constant restitution from the config as well), so two loops, not four. */
+ * constant restitution from the config as well), so two loops, not four; in
+ * edmd_rough_vib.c with the rough rule (beside the wall, which is smooth for them). */
 static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 2, 1, stop, smp, err, 1);
+    return advance(s, GR_FLIGHT_LINEAR, 2, GR_VIB_LAWS, stop, smp, err, 1);
 }
 
 static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err, 1);
+    return advance(s, GR_FLIGHT_LINEAR, 3, GR_VIB_LAWS, stop, smp, err, 1);
 }
 
-
+#ifndef GR_EDMD_VIB_ROUGH_UNIT
 /* Rough particles (rule.h): the law rule's code with the tangential impulse and spins. */
 static int advance_2d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                             gr_error *err)
@@ -382,27 +398,22 @@ static int advance_3d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_sample
     return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err, 0);
 }
 
-/* Rough particles beside a vibrating wall (which is smooth for them, as every wall) */
-static int advance_2d_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                                gr_error *err)
-{
-    return advance(s, GR_FLIGHT_LINEAR, 2, GR_RULE_ROUGH, stop, smp, err, 1);
-}
-
-static int advance_3d_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                                gr_error *err)
-{
-    return advance(s, GR_FLIGHT_LINEAR, 3, GR_RULE_ROUGH, stop, smp, err, 1);
-}
-
 int gr_edmd_advance_extra(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    if (s->spin && !s->cfg.vib.on) /* spins: the rough rule, with or without laws */
+    if (s->spin && s->cfg.vib.on) return gr_edmd_advance_vib_rough(s, stop, smp, err);
+    if (s->spin) /* a scene with spins: the rough rule, with or without laws */
         return s->dim == 2 ? advance_2d_rough(s, stop, smp, err)
                            : advance_3d_rough(s, stop, smp, err);
     return advance_vib(s, stop, smp, err);
 }
+#else
+int gr_edmd_advance_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                              gr_error *err)
+{
+    return advance_vib(s, stop, smp, err);
+}
+#endif
 #endif
 
 #if defined(GR_EDMD_GRAVITY_UNIT) || defined(GR_EDMD_EXTRA_UNIT)
@@ -420,9 +431,6 @@ static int advance_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *sm
                      "last up to about t = 2^26 / omega");
         return GR_ERR_VALUE;
     }
-    if (s->spin) /* rough particles (rule.h) */
-        return s->dim == 2 ? advance_2d_vib_rough(s, stop, smp, err)
-                           : advance_3d_vib_rough(s, stop, smp, err);
     return s->dim == 2 ? advance_2d_vib(s, stop, smp, err) : advance_3d_vib(s, stop, smp, err);
 }
 #endif
@@ -1006,7 +1014,8 @@ static inline void predict_cross(gr_edmd *s, int dyn, int dim, int32_t i)
 
 /* ---- the start ---- */
 
-#ifndef GR_EDMD_EXTRA_UNIT /* (the extra loops start from the plain unit's predictions) */
+/* (the extra and rough loops start from the plain or gravity unit's predictions) */
+#if !defined(GR_EDMD_EXTRA_UNIT) && !defined(GR_EDMD_GRAVITY_ROUGH_UNIT)
 static int start(gr_edmd *s, int dyn, int dim, gr_error *err)
 {
     if (s->nl.shell > 0.0) {
@@ -1038,7 +1047,7 @@ void gr_predict_one(gr_edmd *s, int32_t i)
     else if (s->dim == 2) predict(s, GR_FLIGHT_LINEAR, 2, i); /* the clones the loops use */
     else predict(s, GR_FLIGHT_LINEAR, 3, i);
 }
-#elif defined(GR_EDMD_GRAVITY_UNIT)
+#elif defined(GR_EDMD_GRAVITY_UNIT) && !defined(GR_EDMD_GRAVITY_ROUGH_UNIT)
 int gr_predict_all_gravity(gr_edmd *s, gr_error *err)
 {
     return s->dim == 2 ? start(s, GR_FLIGHT_GRAVITY, 2, err) : start(s, GR_FLIGHT_GRAVITY, 3, err);
