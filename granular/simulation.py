@@ -227,7 +227,8 @@ class Simulation:
         wall_work, the work it did on the particles (the sum over its hits of J U, J the
         normal impulse it gave and U its velocity then), and collision_loss, the kinetic
         energy dissipated by pair and wall collisions (a heated wall's gain counts as a
-        negative loss): the kinetic energy (plus the potential one under gravity) changed by
+        negative loss): the kinetic energy (plus the potential one under gravity, plus the
+        rotational one of rough particles, whose pair losses count both) changed by
         wall_work - collision_loss (+ drive_energy with a random driving) since the start,
         up to rounding; its stale_events also count a particle's arrival at the band
         the wall sweeps, where the exact search for its hit starts (docs/vibrated.md).
