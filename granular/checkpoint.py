@@ -126,8 +126,7 @@ def _fault(sim: _Run) -> str | None:
             e = now.kinetic_energy
         else:
             e0, e = (
-                x.kinetic_energy + x.rotational_energy + potential_energy(x)
-                for x in (start, now)
+                x.kinetic_energy + x.rotational_energy + potential_energy(x) for x in (start, now)
             )
     if start.shear_rate != 0.0:
         return _sheared_fault(sim, start, now)
