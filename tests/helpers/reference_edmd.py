@@ -20,7 +20,12 @@ Walls are smooth.
 A vibrating wall (``vib``, a granular.VibratingWall) is found by brute force
 (helpers/vibwall_reference.py: a fine grid of times up to the next other event, the first
 sign change of the gap bisected) and reflects in its own frame: v_a' = U - e_w (v_a - U), the
-other components scaled by e_w, e_w of the speed relative to the wall."""
+other components scaled by e_w, e_w of the speed relative to the wall.
+
+Gravity (``gravity``, a vector g, between fixed walls): every particle falls on the parabola
+x + v t + g t^2 / 2, so a pair's relative motion stays a straight line (the pair times are
+the same) and a wall is met at the earliest root of the quadratic where the particle moves
+into it.  Not with a vibrating wall or a random driving."""
 
 import itertools
 import math
@@ -145,7 +150,32 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
         q=scene.inertia_factor,
         mu=scene.friction,
         vib=scene.vibrating_wall,
+        gravity=scene.gravity,
     )
+
+
+def _fall_times(x, v, g, stop, side):
+    """Per particle and axis, the earliest tau >= 0 at which x + v tau + g tau^2 / 2 reaches
+    ``stop`` moving into it (side +1: upwards, -1: downwards); inf if never.  A particle on
+    the stop moving out of it (just reflected) meets it again at the other root only."""
+    a, b, c = 0.5 * g[None, :], v, x - stop
+    out = np.full(x.shape, np.inf)
+    for idx in np.ndindex(x.shape):
+        ai, bi, ci = float(a[0, idx[1]]), float(b[idx]), float(c[idx])
+        if ai == 0.0:
+            roots = [-ci / bi] if bi != 0.0 else []
+        else:
+            disc = bi * bi - 4.0 * ai * ci
+            if disc < 0.0:
+                continue
+            q = -0.5 * (bi + math.copysign(math.sqrt(disc), bi))
+            roots = [q / ai, ci / q] if q != 0.0 else [0.0]
+        for tau in sorted(roots):
+            # moving into the stop at tau, and not a root behind us (rounding: 1e-12)
+            if side * (bi + 2.0 * ai * tau) > 0.0 and tau >= -1e-12:
+                out[idx] = max(tau, 0.0)
+                break
+    return out
 
 
 def _eps(restitution, speed):
@@ -206,14 +236,19 @@ def run(
     q=0.4,
     mu=np.inf,
     vib=None,
+    gravity=None,
 ):
     """Positions (unwrapped) and velocities at sample_times.  A dict ``tensors`` gets the
     stress tensor's parts at the sample times: "collisional" (sum over pair collisions of
     dr_a dp_b, dr = x_j - x_i, dp j's momentum change) and "kinetic_time" (the integral of
     sum m v_a v_b over time, summed step by step).  ``driving`` (a granular.WhiteNoise or
     PairThermostat): its kicks, drawn as csrc/drive.c draws them.  With ``spin``, the spins
-    too (a third array returned).  ``vib``: a vibrating wall (module docstring)."""
+    too (a third array returned).  ``vib``: a vibrating wall; ``gravity``: g (module
+    docstring)."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
+    g = None if gravity is None else np.asarray(gravity, float)
+    if g is not None and (vib is not None or driving is not None or periodic):
+        raise NotImplementedError("gravity: between fixed walls only")
     w = None if spin is None else spin.astype(float).copy()
     L = hi - lo
     image = np.zeros_like(x)
@@ -232,7 +267,13 @@ def run(
         i, j = np.unravel_index(np.argmin(pt), pt.shape)
         t_pair = pt[i, j]
         t_wall, wall = np.inf, None
-        if not periodic:
+        if g is not None:
+            up = _fall_times(x, v, g, hi - r[:, None], +1)
+            down = _fall_times(x, v, g, lo + r[:, None], -1)
+            wt = np.minimum(up, down)
+            k = np.unravel_index(np.argmin(wt), wt.shape)
+            t_wall, wall = wt[k], k
+        elif not periodic:
             with np.errstate(divide="ignore", invalid="ignore"):
                 up = np.where(v > 0, (hi - r[:, None] - x) / v, np.inf)
                 down = np.where(v < 0, (lo + r[:, None] - x) / v, np.inf)
@@ -259,15 +300,23 @@ def run(
         dt = min(t_pair, t_wall, t_kick - t)
         while samples and samples[0] <= min(t + dt, t_stop):
             ts = samples.pop(0)
-            out_x.append(x + v * (ts - t) + image * L)
-            out_v.append(v.copy())
+            if g is not None:
+                out_x.append(x + v * (ts - t) + 0.5 * g * (ts - t) ** 2)
+                out_v.append(v + g * (ts - t))
+            else:
+                out_x.append(x + v * (ts - t) + image * L)
+                out_v.append(v.copy())
             if w is not None:
                 out_w.append(w.copy())
             coll_out.append(coll.copy())
             kin_out.append(kin_time + kin * (ts - t))
         if t + dt > t_stop:
             break
-        x += v * dt
+        if g is not None:
+            x += v * dt + 0.5 * g * dt * dt
+            v += g * dt
+        else:
+            x += v * dt
         kin_time = kin_time + kin * dt
         t = t_kick if is_kick else t + dt  # (kick times as the engine sums them)
         if periodic:
@@ -307,6 +356,8 @@ def run(
         else:
             p, a = wall
             e_w = _eps(wall_e, abs(v[p, a]))
+            if g is not None:  # on the wall exactly (the engine places it there too)
+                x[p, a] = hi[a] - r[p] if v[p, a] > 0 else lo[a] + r[p]
             v[p, a] = -v[p, a]
             v[p] *= e_w
     if tensors is not None:
