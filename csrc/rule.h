@@ -178,7 +178,11 @@ static inline double rule_rough_tangential(int dim, const double *dr, double *vi
     /* 1/m_t = (1 + 1/q)(1/m_i + 1/m_j), written without 1/q (q may be tiny) */
     const double m_t = q / ((1.0 + q) * (1.0 / mi + 1.0 / mj));
     double f = (1.0 + beta) * m_t; /* P_t = -f g_t */
-    if (mu < INFINITY && f * sqrt(gt2) > mu * pn) f = mu * pn / sqrt(gt2); /* sliding */
+    double ratio = 1.0 + beta;     /* f / m_t, kept apart: m_t underflows to 0 at tiny q */
+    if (mu < INFINITY && f * sqrt(gt2) > mu * pn) { /* sliding (then m_t > 0) */
+        f = mu * pn / sqrt(gt2);
+        ratio = f / m_t;
+    }
     double P[3] = {-f * g[0], -f * g[1], -f * g[2]};
     for (int a = 0; a < dim; a++) {
         vi[a] -= P[a] / mi;
@@ -198,7 +202,7 @@ static inline double rule_rough_tangential(int dim, const double *dr, double *vi
             wj[a] -= t[a] / mj / q / aj;
         }
     }
-    return f * gt2 * (1.0 - 0.5 * f / m_t);
+    return f * gt2 * (1.0 - 0.5 * ratio);
 }
 
 /* The rough pair collision: the smooth normal impulse (rule_pair_apply, so beta = -1

@@ -423,3 +423,21 @@ def test_gsd_carries_the_spins_in_each_combination(tmp_path, case):
     assert scene.shear_rate == s.shear_rate
     assert (scene.gravity is None) == (s.gravity is None)
     assert (scene.vibrating_wall is None) == (s.vibrating_wall is None)
+
+
+@pytest.mark.parametrize("q", [5e-324, 1e-300])
+def test_the_loss_book_at_a_vanishing_inertia_factor(q):
+    """q at the bottom of float64 (m_t = q m_eff / (1 + q) underflows to 0 at the smallest
+    subnormal): the rule's loss stays finite and the books hold, in a sheared box with
+    Walton's rule (the case the fuzz test found giving NaN)."""
+    s = _sheared(3, n=60, tangential_restitution=0.5, friction=0.3, restitution=0.9)
+    sim = Simulation(s.replace(inertia_factor=q))
+    sim.run(stop_when={"collisions_per_particle": 20}, store=())
+    st = sim.stats
+    assert math.isfinite(st["collision_loss"]) and st["collision_loss"] > 0.0
+    change = st["kinetic_energy"] + st["rotational_energy"] - sim._initial.rotational_energy
+    change -= s.kinetic_energy
+    scale = max(abs(st["shear_work"]), st["collision_loss"], s.kinetic_energy)
+    assert abs(change - (st["shear_work"] - st["collision_loss"])) <= (
+        1e-15 * st["pair_collisions"] * scale
+    )

@@ -856,6 +856,8 @@ def _rough_vib_params(rng):
         g = np.zeros(dim)
         g[w["axis"]] = float(rng.choice([1.0, 10.0])) * (-1.0 if w["side"] == "lower" else 1.0)
         sc["gravity"] = g
+        # a heated wall that gravity brings them back to heats without end (HeatedWallsError)
+        sc["wall_restitution"] = min(sc["wall_restitution"], 1.0)
     return p
 
 
@@ -1243,7 +1245,14 @@ def _check_vibrating(scene, traj, sim):
     change = energy(sim.scene) - energy(scene)
     scale = max(energy(scene), abs(st["wall_work"]), abs(st["collision_loss"]))
     miss = abs(change - (st["wall_work"] - st["collision_loss"]))
-    _check(miss <= 1e-12 * scale, f"energy: change {change:.6g} vs work - loss, off by {miss:.3g}")
+    bound = 1e-12 * scale
+    if scene.gravity is not None:
+        # each event's flight and collision round the mover's kinetic + potential energy by
+        # a few ulp (the position's ulp times m g as well): 8 ulp of the energies in play an
+        # event bounds it (a particle chattering on the floor makes ~1e4 hits), still far
+        # below a lost or doubled hit
+        bound = max(bound, 8 * 2.0**-53 * st["events"] * scale)
+    _check(miss <= bound, f"energy: change {change:.6g} vs work - loss, off by {miss:.3g}")
 
 
 def _same_stats(a, b):
