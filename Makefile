@@ -74,7 +74,7 @@ ASAN_TESTS ?= $(filter-out test_notebooks.py test_packaging.py,$(notdir $(wildca
 ASAN_CI_TESTS := test_scene.py test_simulation.py test_neighbour_lists.py test_physics_edmd.py \
                  test_langevin.py test_fuzz.py test_checkpoint.py test_restitution.py
 ASAN_CI_PHYSICS := test_gravity.py test_vibrating_wall.py test_driving.py test_shear.py \
-                   test_stress.py test_shear_stress.py test_rough.py
+                   test_stress.py test_shear_stress.py test_rough.py test_rough_combined.py
 ASAN_ENV   := LD_PRELOAD="$$(gcc -print-file-name=libasan.so) $$(gcc -print-file-name=libubsan.so)" \
               ASAN_OPTIONS=detect_leaks=0:allocator_may_return_null=1 \
               UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 GRANULAR_FUZZ_TIMEOUT=30

@@ -34,6 +34,15 @@
 #include "stress.h"
 #include "vibwall.h"
 
+/* The rough units are their parents compiled with rough loops (see the units' comment
+ * above advance_2d): edmd_gravity_rough.c gravity's unit, edmd_rough_vib.c the extra one. */
+#ifdef GR_EDMD_GRAVITY_ROUGH_UNIT
+#define GR_EDMD_GRAVITY_UNIT 1
+#endif
+#ifdef GR_EDMD_VIB_ROUGH_UNIT
+#define GR_EDMD_EXTRA_UNIT 1
+#endif
+
 /* Everything an event of particle i is about to read or write, requested at once.  A
  * macro, not a function: GCC takes a function that only prefetches for one without
  * effects and deletes the calls (seen with GCC 12 at -O3: none of these was emitted). */
@@ -74,6 +83,20 @@ static GR_ALWAYS_INLINE void prefetch_ahead(gr_edmd *s, int dim)
 
 static void set_clock(gr_edmd *s, int dyn, double t);
 static double next_sample(const gr_edmd_samples *smp);
+
+/* Whether this unit compiles the rough rule (rule.h) at all: not the plain unit, whose
+ * do_pair_sheared, a function with a run-time `laws`, would otherwise carry its code. */
+#if defined(GR_EDMD_GRAVITY_UNIT) || defined(GR_EDMD_EXTRA_UNIT)
+#define GR_UNIT_ROUGH 1
+#else
+#define GR_UNIT_ROUGH 0
+#endif
+/* The vibrating wall's loops' rule: the law rule, or in the rough units the rough one. */
+#if defined(GR_EDMD_GRAVITY_ROUGH_UNIT) || defined(GR_EDMD_VIB_ROUGH_UNIT)
+#define GR_VIB_LAWS GR_RULE_ROUGH
+#else
+#define GR_VIB_LAWS 1
+#endif
 
 /* The collision count 2 * pair + wall at which s->kinetic is next summed anew: the next
  * multiple of GR_KINETIC_RESUM * n above the present count. */
@@ -197,9 +220,11 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
                 predict(s, dyn, dim, i);
                 continue;
             }
-            const double k0 = vib ? s->kinetic : 0.0;
+            /* vibwall.h's bookkeeping (the rough rule books its own loss: do_pair) */
+            const int books = vib && !GR_RULE_IS_ROUGH(laws);
+            const double k0 = books ? s->kinetic : 0.0;
             status = do_pair(s, dyn, dim, laws, i, e->partner, te, err);
-            if (vib) s->collision_loss += k0 - s->kinetic; /* vibwall.h's bookkeeping */
+            if (books) s->collision_loss += k0 - s->kinetic;
             check = 1;
         } else if (vib && -2 - e->partner == 2 * s->cfg.vib.axis + s->cfg.vib.side) {
             status = do_vibwall(s, dyn, dim, laws, i, te, err);
@@ -228,13 +253,16 @@ static GR_ALWAYS_INLINE int advance(gr_edmd *s, const int dyn, const int dim, co
     }
 }
 
-/* This file is compiled three times: as itself, the loops of constant velocity with
+/* This file is compiled five times: as itself, the loops of constant velocity with
  * smooth particles and fixed walls (the plain loop's unit); by edmd_gravity.c
- * (GR_EDMD_GRAVITY_UNIT) for gravity's loops; and by edmd_extra.c (GR_EDMD_EXTRA_UNIT) for
- * the loops of rough particles and of a vibrating wall.  Apart, the compiler's choices of
- * what to inline and clone for the plain loop are those it made before the others came:
- * in one unit, the search functions' clones for every loop outgrew its limits and the plain
- * loop ran 7-13 % more instructions an event. */
+ * (GR_EDMD_GRAVITY_UNIT) for gravity's loops; by edmd_extra.c (GR_EDMD_EXTRA_UNIT) for
+ * the loops of rough particles and of a vibrating wall; and by edmd_gravity_rough.c and
+ * edmd_rough_vib.c for rough particles under gravity and beside a vibrating wall.  Apart,
+ * the compiler's choices of what to inline and clone for the plain loop are those it made
+ * before the others came: in one unit, the search functions' clones for every loop outgrew
+ * its limits and the plain loop ran 7-13 % more instructions an event.  The same held
+ * among the others: the rough loops under gravity and beside the wall in the gravity and
+ * extra units cost the loops there 5-9 % more instructions a pair collision. */
 #if !defined(GR_EDMD_GRAVITY_UNIT) && !defined(GR_EDMD_EXTRA_UNIT)
 static int advance_2d(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp, gr_error *err)
 {
@@ -280,6 +308,21 @@ int gr_edmd_advance_plain(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples 
     return s->dim == 2 ? advance_2d(s, stop, smp, err) : advance_3d(s, stop, smp, err);
 }
 #elif defined(GR_EDMD_GRAVITY_UNIT)
+/* a vibrating floor under gravity (vibwall.h: its search bounds the gap's curvature by
+ * |g| + A omega^2): advance_vib's loops in this unit */
+static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 2, GR_VIB_LAWS, stop, smp, err, 1);
+}
+
+static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                          gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 3, GR_VIB_LAWS, stop, smp, err, 1);
+}
+
+#ifndef GR_EDMD_GRAVITY_ROUGH_UNIT
 /* Gravity (flight.h, GR_FLIGHT_GRAVITY): one loop per dimension, compiled with the laws'
  * code (a constant restitution is then one test of the law's kind per collision). */
 static int advance_2d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
@@ -294,43 +337,54 @@ static int advance_3d_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samp
     return advance(s, GR_FLIGHT_GRAVITY, 3, 1, stop, smp, err, 0);
 }
 
-/* a vibrating floor under gravity (vibwall.h: its search bounds the gap's curvature by
- * |g| + A omega^2): advance_vib's loops in this unit */
-static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                          gr_error *err)
-{
-    return advance(s, GR_FLIGHT_GRAVITY, 2, 1, stop, smp, err, 1);
-}
-
-static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
-                          gr_error *err)
-{
-    return advance(s, GR_FLIGHT_GRAVITY, 3, 1, stop, smp, err, 1);
-}
-
 int gr_edmd_advance_gravity(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                             gr_error *err)
 {
+    if (s->spin) return gr_edmd_advance_gravity_rough(s, stop, smp, err);
     if (s->cfg.vib.on) return advance_vib(s, stop, smp, err);
     return s->dim == 2 ? advance_2d_gravity(s, stop, smp, err)
                        : advance_3d_gravity(s, stop, smp, err);
 }
 #else
+/* Rough particles under gravity (rule.h; spins do not change in flight: no torque), with
+ * or without a vibrating floor (smooth for them, as every wall). */
+static int advance_2d_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop,
+                                    gr_edmd_samples *smp, gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 2, GR_RULE_ROUGH, stop, smp, err, 0);
+}
+
+static int advance_3d_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop,
+                                    gr_edmd_samples *smp, gr_error *err)
+{
+    return advance(s, GR_FLIGHT_GRAVITY, 3, GR_RULE_ROUGH, stop, smp, err, 0);
+}
+
+int gr_edmd_advance_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                                  gr_error *err)
+{
+    if (s->cfg.vib.on) return advance_vib(s, stop, smp, err);
+    return s->dim == 2 ? advance_2d_gravity_rough(s, stop, smp, err)
+                       : advance_3d_gravity_rough(s, stop, smp, err);
+}
+#endif
+#else
 /* A vibrating wall's loops (vibwall.h): compiled with the law rule (which takes a
- * constant restitution from the config as well), so two loops, not four. */
+ * constant restitution from the config as well), so two loops, not four; in
+ * edmd_rough_vib.c with the rough rule (beside the wall, which is smooth for them). */
 static int advance_2d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 2, 1, stop, smp, err, 1);
+    return advance(s, GR_FLIGHT_LINEAR, 2, GR_VIB_LAWS, stop, smp, err, 1);
 }
 
 static int advance_3d_vib(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
-    return advance(s, GR_FLIGHT_LINEAR, 3, 1, stop, smp, err, 1);
+    return advance(s, GR_FLIGHT_LINEAR, 3, GR_VIB_LAWS, stop, smp, err, 1);
 }
 
-
+#ifndef GR_EDMD_VIB_ROUGH_UNIT
 /* Rough particles (rule.h): the law rule's code with the tangential impulse and spins. */
 static int advance_2d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                             gr_error *err)
@@ -347,11 +401,19 @@ static int advance_3d_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_sample
 int gr_edmd_advance_extra(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err)
 {
+    if (s->spin && s->cfg.vib.on) return gr_edmd_advance_vib_rough(s, stop, smp, err);
     if (s->spin) /* a scene with spins: the rough rule, with or without laws */
         return s->dim == 2 ? advance_2d_rough(s, stop, smp, err)
                            : advance_3d_rough(s, stop, smp, err);
     return advance_vib(s, stop, smp, err);
 }
+#else
+int gr_edmd_advance_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                              gr_error *err)
+{
+    return advance_vib(s, stop, smp, err);
+}
+#endif
 #endif
 
 #if defined(GR_EDMD_GRAVITY_UNIT) || defined(GR_EDMD_EXTRA_UNIT)
@@ -437,9 +499,13 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
         /* the TC model's elastic collision is smooth too: it keeps the energy */
         const double beta =
             s->elastic_tc != elastic_before ? -1.0 : s->cfg.tangential_restitution;
+        double loss;
         vir = rule_rough_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->spin + (size_t)i * w,
                                s->spin + (size_t)j * w, s->mass[i], s->mass[j], RAD(p, dim),
-                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction);
+                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction,
+                               &loss);
+        /* translation and rotation: kinetic alone cannot tell it (stats' collision_loss) */
+        s->collision_loss += loss;
     } else {
         vir = rule_pair_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
     }
@@ -609,6 +675,7 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
     for (int a = 0; a < dim; a++) vq[a] = VEL(q, dim)[a];
     vq[0] += vx;
     int64_t clamped;
+    const int64_t elastic_before = s->elastic_tc;
     const double xi = rule_pair_eps(&s->cfg, laws, dim, dr, VEL(p, dim), vq, t, &s->sched[i],
                                     &s->sched[j], &clamped, &s->elastic_tc);
     const double before = kinetic_of(s, dyn, dim, i) + kinetic_of(s, dyn, dim, j);
@@ -618,7 +685,22 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
         stress_le_peculiar(s, dim, p, t, Vb);
         stress_le_peculiar(s, dim, q, t, Vb + 3);
     }
-    const double vir = rule_pair_apply(dim, dr, VEL(p, dim), vq, s->mass[i], s->mass[j], xi);
+    double vir;
+    if (GR_UNIT_ROUGH && GR_RULE_IS_ROUGH(laws)) {
+        /* the rough rule (do_pair) on the image's velocity vq; the spins are the same in
+         * every image (the images slide, they do not turn) */
+        const int w = dim == 2 ? 1 : 3;
+        const double beta =
+            s->elastic_tc != elastic_before ? -1.0 : s->cfg.tangential_restitution;
+        double loss;
+        vir = rule_rough_apply(dim, dr, VEL(p, dim), vq, s->spin + (size_t)i * w,
+                               s->spin + (size_t)j * w, s->mass[i], s->mass[j], RAD(p, dim),
+                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction,
+                               &loss);
+        s->collision_loss += loss; /* (as do_pair's: the same in every frame) */
+    } else {
+        vir = rule_pair_apply(dim, dr, VEL(p, dim), vq, s->mass[i], s->mass[j], xi);
+    }
     if (vir < 0.0) { /* grazing (do_pair) */
         s->invalid++;
         predict(s, dyn, dim, i);
@@ -932,7 +1014,8 @@ static inline void predict_cross(gr_edmd *s, int dyn, int dim, int32_t i)
 
 /* ---- the start ---- */
 
-#ifndef GR_EDMD_EXTRA_UNIT /* (the extra loops start from the plain unit's predictions) */
+/* (the extra and rough loops start from the plain or gravity unit's predictions) */
+#if !defined(GR_EDMD_EXTRA_UNIT) && !defined(GR_EDMD_GRAVITY_ROUGH_UNIT)
 static int start(gr_edmd *s, int dyn, int dim, gr_error *err)
 {
     if (s->nl.shell > 0.0) {
@@ -964,7 +1047,7 @@ void gr_predict_one(gr_edmd *s, int32_t i)
     else if (s->dim == 2) predict(s, GR_FLIGHT_LINEAR, 2, i); /* the clones the loops use */
     else predict(s, GR_FLIGHT_LINEAR, 3, i);
 }
-#elif defined(GR_EDMD_GRAVITY_UNIT)
+#elif defined(GR_EDMD_GRAVITY_UNIT) && !defined(GR_EDMD_GRAVITY_ROUGH_UNIT)
 int gr_predict_all_gravity(gr_edmd *s, gr_error *err)
 {
     return s->dim == 2 ? start(s, GR_FLIGHT_GRAVITY, 2, err) : start(s, GR_FLIGHT_GRAVITY, 3, err);

@@ -216,6 +216,13 @@ void gr_predict_one_gravity(gr_edmd *s, int32_t i);
  * edmd_extra.c), which gr_edmd_advance calls for such a system without gravity. */
 int gr_edmd_advance_extra(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
                           gr_error *err);
+/* Rough particles beside a vibrating wall (edmd_rough_vib.c) and under gravity, with or
+ * without a vibrating floor (edmd_gravity_rough.c), each edmd.c compiled again: called by
+ * gr_edmd_advance_extra and gr_edmd_advance_gravity for a system with spins. */
+int gr_edmd_advance_vib_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                              gr_error *err);
+int gr_edmd_advance_gravity_rough(gr_edmd *s, const gr_edmd_stop *stop, gr_edmd_samples *smp,
+                                  gr_error *err);
 /* The list scan's kernel, set once by gr_scan_init (edmd.c): 1 AVX2, 0 plain. */
 extern int gr_scan_avx2;
 

@@ -147,8 +147,10 @@ static inline void rule_wall_apply(int dim, double *v, int a, double ew)
 /* The tangential impulse of a pair that has just had its normal impulse of size pn
  * (>= 0): vi, vj, spins wi, wj (1 double in 2D, 3 in 3D) changed in place.  beta the
  * tangential restitution (beta_0 under the Coulomb rule), mu the friction coefficient
- * (+inf: none), q the inertia factor. */
-static inline void rule_rough_tangential(int dim, const double *dr, double *vi, double *vj,
+ * (+inf: none), q the inertia factor.  Returns the energy it dissipated: P_t = -f g_t
+ * turns g_t into (1 - f / m_t) g_t, and the energy changes by P_t . (g_t + g_t') / 2, so
+ * the loss is f |g_t|^2 (1 - f / (2 m_t)) -- (1 - beta^2) m_t |g_t|^2 / 2 when it sticks. */
+static inline double rule_rough_tangential(int dim, const double *dr, double *vi, double *vj,
                                          double *wi, double *wj, double mi, double mj,
                                          double ai, double aj, double q, double beta,
                                          double mu, double pn)
@@ -172,11 +174,15 @@ static inline void rule_rough_tangential(int dim, const double *dr, double *vi, 
     const double gn = g[0] * n[0] + g[1] * n[1] + g[2] * n[2];
     for (int a = 0; a < 3; a++) g[a] -= gn * n[a];
     const double gt2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-    if (!(gt2 > 0.0)) return; /* no tangential motion at the contact: nothing to do */
+    if (!(gt2 > 0.0)) return 0.0; /* no tangential motion at the contact: nothing to do */
     /* 1/m_t = (1 + 1/q)(1/m_i + 1/m_j), written without 1/q (q may be tiny) */
     const double m_t = q / ((1.0 + q) * (1.0 / mi + 1.0 / mj));
     double f = (1.0 + beta) * m_t; /* P_t = -f g_t */
-    if (mu < INFINITY && f * sqrt(gt2) > mu * pn) f = mu * pn / sqrt(gt2); /* sliding */
+    double ratio = 1.0 + beta;     /* f / m_t, kept apart: m_t underflows to 0 at tiny q */
+    if (mu < INFINITY && f * sqrt(gt2) > mu * pn) { /* sliding (then m_t > 0) */
+        f = mu * pn / sqrt(gt2);
+        ratio = f / m_t;
+    }
     double P[3] = {-f * g[0], -f * g[1], -f * g[2]};
     for (int a = 0; a < dim; a++) {
         vi[a] -= P[a] / mi;
@@ -196,24 +202,35 @@ static inline void rule_rough_tangential(int dim, const double *dr, double *vi, 
             wj[a] -= t[a] / mj / q / aj;
         }
     }
+    return f * gt2 * (1.0 - 0.5 * ratio);
 }
 
 /* The rough pair collision: the smooth normal impulse (rule_pair_apply, so beta = -1
  * gives the smooth rule's velocities bit for bit), then the tangential one.  Returns
  * the virial as rule_pair_apply (the normal impulse's: the tangential one is
  * perpendicular to dr), or -1 if the pair does not approach (nothing changed).  beta =
- * -1 (the TC model's elastic collisions: smooth as well) leaves the spins alone. */
+ * -1 (the TC model's elastic collisions: smooth as well) leaves the spins alone.  *loss
+ * gets the energy the collision dissipated, translational and rotational, from the
+ * rule's own formulas (not from energies before and after): the normal part
+ * (1 - xi^2) m_eff (g . n)^2 / 2 plus the tangential one (rule_rough_tangential). */
 static inline double rule_rough_apply(int dim, const double *dr, double *vi, double *vj,
                                       double *wi, double *wj, double mi, double mj,
                                       double ai, double aj, double q, double xi, double beta,
-                                      double mu)
+                                      double mu, double *loss)
 {
+    double b = 0.0, dr2 = 0.0; /* dr . (v_j - v_i), before: the spins add nothing along n */
+    for (int a = 0; a < dim; a++) {
+        b += dr[a] * (vj[a] - vi[a]);
+        dr2 += dr[a] * dr[a];
+    }
     const double vir = gr_pair_collide(dim, dr, vi, vj, mi, mj, xi);
-    if (vir < 0.0 || beta == -1.0) return vir;
-    double dr2 = 0.0;
-    for (int a = 0; a < dim; a++) dr2 += dr[a] * dr[a];
+    *loss = 0.0;
+    if (vir < 0.0) return vir;
+    *loss = 0.5 * (1.0 - xi * xi) * (mi * mj / (mi + mj)) * (b * b / dr2);
+    if (beta == -1.0) return vir;
     /* the virial is |P_n| |dr| */
-    rule_rough_tangential(dim, dr, vi, vj, wi, wj, mi, mj, ai, aj, q, beta, mu, vir / sqrt(dr2));
+    *loss += rule_rough_tangential(dim, dr, vi, vj, wi, wj, mi, mj, ai, aj, q, beta, mu,
+                                   vir / sqrt(dr2));
     return vir;
 }
 

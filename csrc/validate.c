@@ -213,13 +213,6 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
                              "in the initial angular velocities");
                 return GR_ERR_NONFINITE;
             }
-    if (cfg->spin && (cfg->shear_rate != 0.0 || cfg->shear_offset != 0.0)) {
-        /* the sheared pair (edmd.c do_pair_sheared) applies the smooth rule only */
-        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->shear_rate,
-                     "rough particles (a tangential restitution above -1) are not offered in a "
-                     "sheared box yet: its pairs through the sliding images collide smooth");
-        return GR_ERR_VALUE;
-    }
     if (!(cfg->big_ratio >= 1.0)) {
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->big_ratio, "big_ratio must be >= 1 (inf: none)");
         return GR_ERR_VALUE;
@@ -264,16 +257,14 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
                      "pass free_fall=True to simulate that frame, or use walls");
         return GR_ERR_VALUE;
     }
-    /* gravity's loops (edmd_gravity.c) have neither the rough rule nor the sliding images'
-     * slide events.  A sheared box is periodic, where gravity is the free-fall frame only
+    /* gravity's loops (edmd_gravity.c, edmd_gravity_rough.c) have no sliding images' slide
+     * events.  A sheared box is periodic, where gravity is the free-fall frame only
      * (docs/gravity.md, "Gravity and shear"): along x or z that is the sheared gas's own
      * motion plus g t^2 / 2 for everyone, a change of frame that adds no physics; along the
      * gradient y the falling gas would cross the sliding faces, each crossing shifting v_x
      * by the images' speed, which no falling frame undoes */
     const char *unlike =
         !pulls ? NULL
-        : cfg->spin ? "gravity is not offered with rough particles (a tangential "
-                      "restitution above -1) yet"
         : cfg->shear_rate != 0.0 && cfg->gravity[1] != 0.0
             ? "gravity along the shear gradient y is refused in a sheared box: the falling "
               "gas would cross the sliding y faces, each crossing shifting v_x by the images' "
@@ -340,13 +331,6 @@ int gr_validate_config(const gr_edmd_config *cfg, const double *pos, const doubl
                 return GR_ERR_OUTSIDE;
             }
         }
-    }
-    if (cfg->vib.on && cfg->spin) {
-        /* the rough loops (edmd.c) are compiled without the moving wall's events */
-        gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, cfg->tangential_restitution,
-                     "rough particles (a tangential restitution above -1) are not offered with "
-                     "a vibrating wall yet");
-        return GR_ERR_VALUE;
     }
     if (cfg->vib.on) return validate_vibwall(cfg, pos, radius, sigma_max, err);
     return GR_OK;

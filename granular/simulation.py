@@ -230,11 +230,18 @@ class Simulation:
         wall_work, the work it did on the particles (the sum over its hits of J U, J the
         normal impulse it gave and U its velocity then), and collision_loss, the kinetic
         energy dissipated by pair and wall collisions (a heated wall's gain counts as a
-        negative loss): the kinetic energy (plus the potential one under gravity) changed by
+        negative loss): the kinetic energy (plus the potential one under gravity, plus the
+        rotational one of rough particles, whose pair losses count both) changed by
         wall_work - collision_loss (+ drive_energy with a random driving) since the start,
         up to rounding (per sample: ``Trajectory.wall_work``, ``.collision_loss``); its
         stale_events also count a particle's arrival at the band
         the wall sweeps, where the exact search for its hit starts (docs/vibrated.md).
+
+        Rough particles in a periodic box (sheared or not) also have collision_loss: the
+        energy, translational and rotational, their pair collisions dissipated, summed from
+        the collision rule's formulas (csrc/rule.h); in a sheared box kinetic_energy +
+        rotational_energy changed by shear_work - collision_loss since the start, up to
+        rounding.
 
         With ``Simulation(stress=True)`` also: stress_collisional, kinetic_time_tensor,
         kinetic_tensor (each d rows of d numbers, a tuple of tuples: ``np.array`` makes
@@ -287,7 +294,10 @@ class Simulation:
             else float("nan")
         )
         if s.vibrating_wall is None:  # kept by the engine only where a wall vibrates
-            del c["wall_work"], c["collision_loss"]
+            del c["wall_work"]
+            # and for rough particles' pair collisions (csrc/rule.h): whole in a periodic box
+            if not (s.boundary == "periodic" and s.tangential_restitution != -1.0):
+                del c["collision_loss"]
         return c
 
     def _spins(self) -> NDArray[np.float64]:

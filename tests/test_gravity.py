@@ -285,14 +285,14 @@ def test_a_checkpoint_continues_bit_for_bit(tmp_path, boundary, shell):
 
 
 def test_what_gravity_is_not_offered_with_is_refused_by_name():
-    """Gravity's loops (csrc/edmd_gravity.c) have no rough rule and no sliding images: each
-    combination is refused, naming it (the stress tensor under gravity:
-    test_gravity_stress.py)."""
+    """Gravity's loops have no sliding images: gravity in a sheared box is refused, naming
+    why (the stress tensor under gravity: test_gravity_stress.py; rough particles under
+    gravity: test_rough_combined.py)."""
     s = Scene.random(20, 0.03, dim=2, boundary="walls", seed=1)
     g = np.array([0.0, -1.0])
     Simulation(s.replace(gravity=g))  # alone it runs
-    with pytest.raises(ValueError, match="not offered with rough particles"):
-        Simulation(s.replace(gravity=g, tangential_restitution=0.5))
+    Simulation(s.replace(gravity=g), stress=True)  # and with the tensor
+    Simulation(s.replace(gravity=g, tangential_restitution=0.5))  # and rough
     p = Scene.random(20, 0.03, dim=2, seed=1)
     with pytest.raises(ValueError, match="in a sheared box"):
         Simulation(p.replace(gravity=g, free_fall=True, shear_rate=0.5))

@@ -533,26 +533,3 @@ def test_a_hoomd_files_spins_are_read(tmp_path):
     scene = Scene.from_gsd(tmp_path / "h.gsd")
     np.testing.assert_allclose(scene.angular_velocities, w, rtol=1e-5, atol=1e-5)
     assert scene.inertia_factor == pytest.approx(0.4, rel=1e-5)
-
-
-def test_rough_particles_in_a_sheared_box_are_refused_until_its_pairs_are_rough():
-    """A pair through the sliding images (edmd.c, do_pair_sheared) collides by the smooth
-    rule; rather than quietly mix the two, a rough sheared scene is refused by name."""
-    s = Scene.random(20, 0.05, dim=2, seed=1).replace(shear_rate=0.5)
-    Simulation(s)  # smooth and sheared is fine
-    with pytest.raises(ValueError, match="not offered in a sheared box"):
-        Simulation(s.replace(tangential_restitution=0.5))
-
-
-def test_rough_particles_beside_a_vibrating_wall_are_refused():
-    """The rough loops are compiled without the moving wall's events: refused by name."""
-    from granular import VibratingWall
-
-    g = np.linspace(0.2, 0.9, 4)  # a grid clear of the wall's sweep (x < 0.1)
-    pos = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
-    vel = np.random.default_rng(1).normal(size=(16, 2))
-    s = Scene(pos, vel, 0.02, boundary="walls")
-    wall = VibratingWall(0, "lower", 0.05, 3.0)
-    Simulation(s.replace(vibrating_wall=wall))  # smooth beside the wall is fine
-    with pytest.raises(ValueError, match="not offered with a vibrating wall"):
-        Simulation(s.replace(vibrating_wall=wall, tangential_restitution=0.5))

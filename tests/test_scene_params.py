@@ -48,8 +48,8 @@ def _examples():
 _PERIODIC_ONLY = {"shear_rate": 0.3, "shear_offset": 0.25}
 
 
-# parameters that take smooth particles (a vibrating wall, gravity: the rough loops have
-# neither), with
+# parameters whose examples run with smooth particles (a vibrating wall, gravity; rough
+# particles combine with both too: tests/test_rough_combined.py), with
 # their examples; _examples_for gives them the walled examples with smooth particles
 _SMOOTH_ONLY = {
     "vibrating_wall": granular.VibratingWall(1, "lower", 0.2, 3.0, phase=-np.pi / 2),
@@ -70,7 +70,8 @@ def _examples_for(name):
         return {**_examples(), **_SMOOTH, name: _SMOOTH_ONLY[name]}
     if name not in _PERIODIC_ONLY:
         return _examples()
-    # an offset needs a shear rate; a sheared box takes smooth particles only
+    # an offset needs a shear rate (the sheared example with smooth particles; rough ones
+    # are sheared in tests/test_rough_combined.py)
     rate = {"shear_rate": _PERIODIC_ONLY["shear_rate"], "tangential_restitution": -1.0}
     return {**_examples(), "boundary": "periodic", **rate, name: _PERIODIC_ONLY[name]}
 

@@ -124,3 +124,28 @@ def test_a_rough_gas_cools_as_the_coupled_equations():
     tr, rot = np.mean(ratios, axis=0)
     assert tr == pytest.approx(1.0, abs=0.01)
     assert rot == pytest.approx(1.0, abs=0.10)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_the_sheared_ratio_is_the_rotational_balance(dim):
+    """rough_sheared_temperature_ratio is B / C of the coupled equations (the rotational
+    equation's fixed point at a given T): q (1 + beta) / (1 + 2 q - beta), 1 at beta = 1,
+    0 at beta = -1, 1/4 for disks and 2/9 for solid spheres at beta = 0, whatever xi."""
+    for beta in (-1.0, -0.3, 0.0, 0.5, 1.0):
+        for q in (None, 0.25, 1.0):
+            co = theory.rough_coefficients(
+                restitution=0.7, tangential_restitution=beta, inertia_factor=q, dim=dim
+            )
+            r = theory.rough_sheared_temperature_ratio(
+                tangential_restitution=beta, inertia_factor=q, dim=dim
+            )
+            if beta == -1.0:
+                assert r == 0.0
+            else:
+                assert r == pytest.approx(co.B / co.C, rel=1e-13)
+    assert theory.rough_sheared_temperature_ratio(tangential_restitution=1.0, dim=dim) == 1.0
+    expected = 0.25 if dim == 2 else 2 / 9
+    r = theory.rough_sheared_temperature_ratio(tangential_restitution=0.0, dim=dim)
+    assert r == pytest.approx(expected, rel=1e-15)
+    with pytest.raises(ValueError, match="tangential_restitution"):
+        theory.rough_sheared_temperature_ratio(tangential_restitution=1.5, dim=dim)

@@ -29,6 +29,11 @@ Maxwellian at T = 1 (rescaled to exactly 1), spins at rest.
   (With their cellulose-acetate values, xi = 0.87, mu = 0.25, beta_0 = 0.43, some runs leave
   the mean field's fixed point after ~70 collisions per particle: T_rot stays while T_tr
   falls, the regime Herbst et al. 2000 describe for small xi and mu, so no late ratio exists.)
+- ``rough.sheared_ratio.2d.beta=0``: rough disks (xi = 0.99, beta = 0) in a Lees-Edwards box,
+  N = 100 at area fraction 0.05, shear rate 0.2, in their steady state: T_rot / T_tr against
+  the estimate B / C (``theory.rough_sheared_temperature_ratio``: the rotational equation's
+  fixed point, the images doing work on the translation only; an estimate that takes the
+  velocities isotropic, Maxwellian and independent of the spins: docs/rough.md).
 """
 
 from __future__ import annotations
@@ -273,4 +278,43 @@ def _fig_rough(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax.set_ylabel("T_rot / T_tr (late)")
     ax.legend(fontsize=8)
     names.append(save(figure, out, "rough_cooling.png"))
+
+    # the steadily sheared rough gas (Lees-Edwards), nearly elastic
+    per_run = [_sheared_ratio(8000 + i) for i in range(runs)]
+    rows.append(
+        mean_row(
+            "rough.sheared_ratio.2d.beta=0",
+            f"steady T_rot / T_tr of rough disks in uniform shear flow (EDMD, Lees-Edwards, "
+            f"N = {N_SHEAR}, area fraction {PHI_SHEAR}, q = 1/2, xi = {XI_SHEAR}, beta = 0, "
+            f"shear rate {RATE_SHEAR}), each run's mean over {SHEAR_WINDOWS} samples "
+            f"{SHEAR_EVERY:g} collisions per particle apart after {SHEAR_SETTLE:g}; estimate: "
+            "the rotational equation's fixed point B / C (theory.rough_sheared_temperature_ratio"
+            "; an estimate: isotropic Maxwellian velocities independent of the spins)",
+            per_run,
+            None,
+            theory.rough_sheared_temperature_ratio(tangential_restitution=0.0, dim=2),
+        )
+    )
     return names, rows
+
+
+# the sheared row: nearly elastic normal impacts (the tangential loss remains at beta = 0)
+N_SHEAR, PHI_SHEAR, XI_SHEAR, RATE_SHEAR = 100, 0.05, 0.99, 0.2
+SHEAR_SETTLE, SHEAR_EVERY, SHEAR_WINDOWS = 400.0, 20.0, 20
+
+
+def _sheared_ratio(seed):
+    """One sheared run's mean T_rot / T_tr (the peculiar T_tr) over its samples, after the
+    steady state has set in (the translational energy relaxes at about k_tr A = 0.15 per
+    collision per particle, the tangential loss's share dominating: SHEAR_SETTLE is many
+    relaxation times)."""
+    radius = math.sqrt(PHI_SHEAR / (N_SHEAR * math.pi))
+    s = Scene.random(N_SHEAR, radius, dim=2, seed=seed, temperature=1.0)
+    s = s.replace(shear_rate=RATE_SHEAR, restitution=XI_SHEAR, tangential_restitution=0.0)
+    sim = Simulation(s)
+    out = []
+    for k in range(SHEAR_WINDOWS + 1):
+        sim.run(stop_when={"collisions_per_particle": SHEAR_SETTLE + k * SHEAR_EVERY}, store=())
+        if k:
+            out.append(sim.stats["temperature_ratio"])
+    return float(np.mean(out))

@@ -76,6 +76,7 @@ from .rough import (
     RoughCoefficients,
     rough_coefficients,
     rough_cooling,
+    rough_sheared_temperature_ratio,
     rough_temperature_ratio,
     rough_temperatures,
 )
@@ -197,6 +198,7 @@ __all__ = [
     "powerlaw_udsbm_moments",
     "rough_coefficients",
     "rough_cooling",
+    "rough_sheared_temperature_ratio",
     "rough_temperature_ratio",
     "rough_temperatures",
     "shear_mode_growth",

@@ -130,6 +130,34 @@ def rough_temperature_ratio(
     return -2.0 * a0 / (a1 + disc) if a1 > 0 else (-a1 + disc) / (2.0 * a2)
 
 
+@keyword_only("tangential_restitution", "inertia_factor", "dim")
+def rough_sheared_temperature_ratio(
+    *,
+    tangential_restitution: float,
+    inertia_factor: float | None = None,
+    dim: int = 3,
+) -> float:
+    """T_rot / T_tr of rough particles in a steadily sheared gas (uniform shear flow, a
+    Lees-Edwards box), estimated from the rotational equation alone: the sliding images do
+    work on the translation only (they shift velocities, not spins), so in the steady state
+    the spins gain from the translation what they lose in collisions, dT_rot/ds = k_rot (B
+    T - C T_rot) = 0 (module docstring; Huthmann & Zippelius 1997), and
+
+        T_rot / T_tr = B / C = eta_t / (1 - eta_t / q) = q (1 + beta) / (1 + 2 q - beta),
+
+    T_tr the temperature of the velocities less the mean flow.  Independent of xi and of
+    the shear rate: 1 at beta = 1 (equipartition), 0 at beta = -1; 1/4 for disks and 2/9
+    for solid spheres at beta = 0.  An estimate: the average takes the velocities
+    isotropic and Maxwellian, independent of the spins, where a sheared gas' velocity
+    distribution is anisotropic to order (shear_rate / omega)^2 (omega the collision
+    frequency: small only where collisions lose little, xi near 1 and beta near +-1); and
+    it leaves out the mean flow's velocity difference across a contact and the spins'
+    mean (-shear_rate / 2 about z), of relative order shear_rate^2 sigma^2 m / T.
+    Simulated (docs/rough.md) the ratio lies 3-5 % above it at xi = 0.99."""
+    _, beta, q = _checked(1.0, tangential_restitution, inertia_factor, dim)
+    return q * (1.0 + beta) / (1.0 + 2.0 * q - beta)
+
+
 @keyword_only(
     "collisions",
     "temperature0",

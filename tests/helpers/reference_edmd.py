@@ -20,7 +20,12 @@ Walls are smooth.
 A vibrating wall (``vib``, a granular.VibratingWall) is found by brute force
 (helpers/vibwall_reference.py: a fine grid of times up to the next other event, the first
 sign change of the gap bisected) and reflects in its own frame: v_a' = U - e_w (v_a - U), the
-other components scaled by e_w, e_w of the speed relative to the wall."""
+other components scaled by e_w, e_w of the speed relative to the wall.
+
+Gravity (``gravity``, a vector g, between fixed walls): every particle falls on the parabola
+x + v t + g t^2 / 2, so a pair's relative motion stays a straight line (the pair times are
+the same) and a wall is met at the earliest root of the quadratic where the particle moves
+into it.  Not with a vibrating wall or a random driving."""
 
 import itertools
 import math
@@ -107,7 +112,7 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
     positions, velocities and spins."""
     rough = getattr(scene, "tangential_restitution", -1.0) != -1.0
     if getattr(scene, "shear_rate", 0.0) != 0.0:
-        return run_sheared(
+        out = run_sheared(
             np.array(scene.positions),
             np.array(scene.velocities),
             scene.radii,
@@ -120,7 +125,12 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
             scene.shear_rate,
             scene.shear_offset,
             tensors=tensors,
-        )[:2]
+            spin=np.array(scene.angular_velocities) if rough else None,
+            beta=scene.tangential_restitution,
+            q=scene.inertia_factor,
+            mu=scene.friction,
+        )
+        return out[:2] + out[4:]
     return run(
         np.array(scene.positions),
         np.array(scene.velocities),
@@ -140,7 +150,32 @@ def run_scene(scene, t_stop, sample_times, tensors=None):
         q=scene.inertia_factor,
         mu=scene.friction,
         vib=scene.vibrating_wall,
+        gravity=scene.gravity,
     )
+
+
+def _fall_times(x, v, g, stop, side):
+    """Per particle and axis, the earliest tau >= 0 at which x + v tau + g tau^2 / 2 reaches
+    ``stop`` moving into it (side +1: upwards, -1: downwards); inf if never.  A particle on
+    the stop moving out of it (just reflected) meets it again at the other root only."""
+    a, b, c = 0.5 * g[None, :], v, x - stop
+    out = np.full(x.shape, np.inf)
+    for idx in np.ndindex(x.shape):
+        ai, bi, ci = float(a[0, idx[1]]), float(b[idx]), float(c[idx])
+        if ai == 0.0:
+            roots = [-ci / bi] if bi != 0.0 else []
+        else:
+            disc = bi * bi - 4.0 * ai * ci
+            if disc < 0.0:
+                continue
+            q = -0.5 * (bi + math.copysign(math.sqrt(disc), bi))
+            roots = [q / ai, ci / q] if q != 0.0 else [0.0]
+        for tau in sorted(roots):
+            # moving into the stop at tau, and not a root behind us (rounding: 1e-12)
+            if side * (bi + 2.0 * ai * tau) > 0.0 and tau >= -1e-12:
+                out[idx] = max(tau, 0.0)
+                break
+    return out
 
 
 def _eps(restitution, speed):
@@ -201,14 +236,19 @@ def run(
     q=0.4,
     mu=np.inf,
     vib=None,
+    gravity=None,
 ):
     """Positions (unwrapped) and velocities at sample_times.  A dict ``tensors`` gets the
     stress tensor's parts at the sample times: "collisional" (sum over pair collisions of
     dr_a dp_b, dr = x_j - x_i, dp j's momentum change) and "kinetic_time" (the integral of
     sum m v_a v_b over time, summed step by step).  ``driving`` (a granular.WhiteNoise or
     PairThermostat): its kicks, drawn as csrc/drive.c draws them.  With ``spin``, the spins
-    too (a third array returned).  ``vib``: a vibrating wall (module docstring)."""
+    too (a third array returned).  ``vib``: a vibrating wall; ``gravity``: g (module
+    docstring)."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
+    g = None if gravity is None else np.asarray(gravity, float)
+    if g is not None and (vib is not None or driving is not None or periodic):
+        raise NotImplementedError("gravity: between fixed walls only")
     w = None if spin is None else spin.astype(float).copy()
     L = hi - lo
     image = np.zeros_like(x)
@@ -227,7 +267,13 @@ def run(
         i, j = np.unravel_index(np.argmin(pt), pt.shape)
         t_pair = pt[i, j]
         t_wall, wall = np.inf, None
-        if not periodic:
+        if g is not None:
+            up = _fall_times(x, v, g, hi - r[:, None], +1)
+            down = _fall_times(x, v, g, lo + r[:, None], -1)
+            wt = np.minimum(up, down)
+            k = np.unravel_index(np.argmin(wt), wt.shape)
+            t_wall, wall = wt[k], k
+        elif not periodic:
             with np.errstate(divide="ignore", invalid="ignore"):
                 up = np.where(v > 0, (hi - r[:, None] - x) / v, np.inf)
                 down = np.where(v < 0, (lo + r[:, None] - x) / v, np.inf)
@@ -254,15 +300,23 @@ def run(
         dt = min(t_pair, t_wall, t_kick - t)
         while samples and samples[0] <= min(t + dt, t_stop):
             ts = samples.pop(0)
-            out_x.append(x + v * (ts - t) + image * L)
-            out_v.append(v.copy())
+            if g is not None:
+                out_x.append(x + v * (ts - t) + 0.5 * g * (ts - t) ** 2)
+                out_v.append(v + g * (ts - t))
+            else:
+                out_x.append(x + v * (ts - t) + image * L)
+                out_v.append(v.copy())
             if w is not None:
                 out_w.append(w.copy())
             coll_out.append(coll.copy())
             kin_out.append(kin_time + kin * (ts - t))
         if t + dt > t_stop:
             break
-        x += v * dt
+        if g is not None:
+            x += v * dt + 0.5 * g * dt * dt
+            v += g * dt
+        else:
+            x += v * dt
         kin_time = kin_time + kin * dt
         t = t_kick if is_kick else t + dt  # (kick times as the engine sums them)
         if periodic:
@@ -302,6 +356,8 @@ def run(
         else:
             p, a = wall
             e_w = _eps(wall_e, abs(v[p, a]))
+            if g is not None:  # on the wall exactly (the engine places it there too)
+                x[p, a] = hi[a] - r[p] if v[p, a] > 0 else lo[a] + r[p]
             v[p, a] = -v[p, a]
             v[p] *= e_w
     if tensors is not None:
@@ -356,7 +412,22 @@ def sheared_images(d, kx_max=2):
 
 
 def run_sheared(
-    x, v, r, m, lo, hi, xi, t_stop, sample_times, shear_rate, shear_offset=0.0, tensors=None
+    x,
+    v,
+    r,
+    m,
+    lo,
+    hi,
+    xi,
+    t_stop,
+    sample_times,
+    shear_rate,
+    shear_offset=0.0,
+    tensors=None,
+    spin=None,
+    beta=-1.0,
+    q=0.4,
+    mu=np.inf,
 ):
     """``run`` in a periodic box with Lees-Edwards images across the y faces (flow along x):
     the image across the upper face is displaced along x by delta(t) = (shear_offset +
@@ -375,8 +446,15 @@ def run_sheared(
     A dict ``tensors`` gets the stress tensor's parts at the sample times, as ``run``'s but
     with the peculiar velocities V = v - shear_rate (y - y_c) e_x: "kinetic_time" integrates
     sum m V_a V_b step by step by Simpson's rule (exact: V is linear in time within a step),
-    "collisional" sums dr_a dp_b with dr through the image that touched."""
+    "collisional" sums dr_a dp_b with dr through the image that touched.
+
+    With ``spin`` (rough particles, ``run``'s), the pair through an image collides by
+    ``rough_collide`` with the image's velocity (v_x + ky u) and the particle's own spin
+    (the images slide, they do not turn); the spins at sample_times are a fifth array
+    returned."""
     x, v = x.astype(float).copy(), v.astype(float).copy()
+    w = None if spin is None else spin.astype(float).copy()
+    out_s = []
     n, d = x.shape
     y_c = 0.5 * (lo[1] + hi[1])
     coll, kin_time = np.zeros((d, d)), np.zeros((d, d))
@@ -426,6 +504,8 @@ def run_sheared(
             out_v.append(v.copy())
             out_k.append(0.5 * (m[:, None] * v * v).sum())
             out_w.append(work)
+            if w is not None:
+                out_s.append(w.copy())
             coll_out.append(coll.copy())
             kin_out.append(kin_time + kin_integral(ts - t))
         if t + dt > t_stop:
@@ -465,6 +545,17 @@ def run_sheared(
         vj[0] += kyy * u
         dv = vj - v[i]
         eps = _eps(xi, -np.dot(dv, dr) / np.sqrt(np.dot(dr, dr)))
+        if w is not None:  # rough: the rule on the image's velocity, the spins as they are
+            vi_before = v[i].copy()
+            v[i], vj_after, w[i], w[j] = rough_collide(
+                dr, v[i], vj, w[i], w[j], r[i], r[j], m[i], m[j], q, eps, beta, mu, d
+            )
+            v[j] = vj_after
+            v[j][0] -= kyy * u
+            dp_i = m[i] * (v[i] - vi_before)
+            work += kyy * u * dp_i[0]
+            coll += np.outer(dr, -dp_i)
+            continue
         f = (1 + eps) * np.dot(dv, dr) / (np.dot(dr, dr) * (m[i] + m[j]))
         v[i] += f * m[j] * dr
         v[j] -= f * m[i] * dr
@@ -474,4 +565,5 @@ def run_sheared(
     if tensors is not None:
         tensors["collisional"] = np.array(coll_out)
         tensors["kinetic_time"] = np.array(kin_out)
-    return np.array(out_x), np.array(out_v), np.array(out_k), np.array(out_w)
+    out = np.array(out_x), np.array(out_v), np.array(out_k), np.array(out_w)
+    return out if w is None else (*out, np.array(out_s))
