@@ -165,6 +165,23 @@ void gr_edmd_spin(const gr_edmd *s, double *spin)
             spin[(size_t)s->order.id_of[i] * w + a] = s->spin[(size_t)i * w + a];
 }
 
+/* The counters of a sheared box with lists: a particle strayed beyond a y face (its
+ * record in the frame of the box it left, le_frame_velocity) counts with the box's
+ * velocity, and the work its re-entry will book (edmd.c le_face_moves) is counted now,
+ * so that the kinetic energy is the box velocities' total and still rises by the work. */
+static void le_counters_in_box(const gr_edmd *s, double *kinetic, double *work)
+{
+    const int dim = s->dim, dyn = dynamics_of(s);
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *p = rec(s, dim, i), dt = s->t - TIME(p, dim);
+        const double du = le_frame_velocity(s, dyn, p, dt);
+        if (du == 0.0) continue;
+        const double v0 = fl_vel_at(dyn, VEL(p, dim)[0], s->cfg.gravity[0], dt), v1 = v0 + du;
+        *kinetic += 0.5 * s->mass[i] * (v1 * v1 - v0 * v0);
+        *work += du * s->mass[i] * 0.5 * (v0 + v1); /* as le_face_moves: sign u = du */
+    }
+}
+
 void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
 {
     c->t = s->t;
@@ -198,6 +215,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
             c->kinetic_tensor[a] = k[a];
         }
     }
+    if (s->le && s->nl.shell > 0.0) le_counters_in_box(s, &c->kinetic, &c->shear_work);
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;
     c->kicks = s->kicks;
     c->drive_energy = s->drive_energy;
