@@ -281,7 +281,8 @@ static GR_NOINLINE double fl_shrink_exit_time(int dyn, int dim, const double *x,
     }
     const double disc = B * B - A * C, q = sqrt(disc > 0.0 ? disc : 0.0);
     if (B > 0.0) return -C / (B + q);
-    return A > 0.0 ? (q - B) / A : 0.0; /* A <= 0 here only by rounding: leave now */
+    if (A > 0.0) return (q - B) / A;
+    return h > 0.0 ? 0.0 : INFINITY; /* by rounding: leave now; h = 0 and at rest: never */
 }
 
 /* The kinetic energy of one particle of mass m, velocity v (at the particle's clock). */
