@@ -392,6 +392,32 @@ def test_lists_report_the_box_velocities_energy():
         assert abs(st["kinetic_energy"] - s.kinetic_energy - st["shear_work"]) < 1e-12 * kinetic
 
 
+def test_a_sheared_list_that_misses_a_pair_is_refused():
+    """The engine's check of a restored state through a sliding face (csrc/checkpoint.c,
+    check_sheared_lists): two spheres within reach only through the lower y face (centres
+    0.12 apart, reach 0.1 + 2 x 0.025) list each other through the image of y shift -L
+    and no x image (code 1 + 3 * 0 + 9 * 1 = 10, its opposite 16); listed as if in the
+    box instead (13 both ways: symmetric) the pair is missing and the state is refused.
+    A build time in the future is refused too.  The state ends with the rows (one entry
+    each, j << 5 | code) and the build times (two doubles)."""
+    pos = [[0.5, 0.04, 0.5], [0.5, 0.92, 0.5]]
+    s = Scene(pos, [[0.0, 0.1, 0.0], [0.0, -0.1, 0.0]], 0.05, shear_rate=0.1)
+    sim = Simulation(s, shell=0.25)
+    state = bytearray(sim._engine.save_state())
+    rows = np.frombuffer(bytes(state[-24:-16]), np.int32)
+    assert sorted(rows >> 5) == [0, 1] and sorted(rows & 31) == [10, 16]
+    assert list(np.frombuffer(bytes(state[-16:]), np.float64)) == [0.0, 0.0]
+    sim._engine.restore_state(bytes(state))  # as saved: fine
+    inside = bytearray(state)
+    inside[-24:-16] = ((rows & ~31) | 13).astype(np.int32).tobytes()
+    with pytest.raises(ValueError, match="within reach through a sliding face"):
+        sim._engine.restore_state(bytes(inside))
+    future = bytearray(state)
+    future[-16:-8] = np.float64(1.0).tobytes()
+    with pytest.raises(ValueError, match="build time is out of range"):
+        sim._engine.restore_state(bytes(future))
+
+
 def test_auto_uses_lists_for_a_dense_sheared_gas():
     """shell='auto' picks neighbour lists for a dense 3D gas, sheared or not."""
     n = 500
