@@ -838,8 +838,13 @@ static void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i);
 static void predict(gr_edmd *s, int dyn, int dim, int32_t i)
 {
     predict_wall(s, dyn, dim, i);
-    if (s->nl.shell > 0.0 && s->le) {
-        le_predict_list(s, dyn, dim, i); /* the sliding images (le_nlist.h) */
+    if (s->nl.shell > 0.0 && s->le) { /* the sliding images (le_nlist.h) */
+        le_shell_exit(s, dyn, dim, i);
+#ifdef GR_SCAN_X86
+        if (dim == 3 && dyn == GR_FLIGHT_LINEAR && scan_avx2) scan_list_avx2_sheared(s, i);
+        else
+#endif
+            le_scan_list(s, dyn, dim, i);
     } else if (s->nl.shell > 0.0) {
         const double *p = rec(s, dim, i);
         s->sched[i].t_cross = TIME(p, dim) + fl_exit_time(dyn, dim, p, VEL(p, dim),

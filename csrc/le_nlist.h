@@ -3,8 +3,8 @@
  * these keep the lists exact is in nlist.h.
  *
  * Static functions included by search.h (so by edmd.c only), reached only when the box
- * is sheared (s->le): the plain loop never runs them.  The scan is scalar in every
- * dimension (the AVX2 lanes of scan_avx2.h know fixed image shifts only). */
+ * is sheared (s->le): the plain loop never runs them.  In 3D on AVX2 CPUs the scan runs
+ * in four lanes instead (scan_avx2.h scan_list_avx2_sheared, the same bits). */
 #ifndef GR_LE_NLIST_H
 #define GR_LE_NLIST_H
 
@@ -121,8 +121,9 @@ static inline double le_shell_radius(const gr_edmd *s, double tb, double t)
 }
 
 /* List mode in a sheared box, i's clock at the present: its shell exit (shrinking next to
- * a y face, nlist.h), then its pair collisions. */
-static void le_predict_list(gr_edmd *s, int dyn, int dim, int32_t i)
+ * a y face, nlist.h); edmd.c predict then scans its list (le_scan_list, or in 3D on AVX2
+ * CPUs scan_list_avx2_sheared: the same bits). */
+static void le_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i)
 {
     const double *p = rec(s, dim, i), *centre = s->nl.centre + (size_t)i * (dim + 1);
     const double tb = s->nl.built[i], t = TIME(p, dim);
@@ -132,7 +133,6 @@ static void le_predict_list(gr_edmd *s, int dyn, int dim, int32_t i)
                       : fl_exit_time(dyn, dim, p, VEL(p, dim), s->cfg.gravity, centre,
                                      s->nl.exit2);
     s->sched[i].t_cross = t + exit;
-    le_scan_list(s, dyn, dim, i);
 }
 
 #endif

@@ -202,7 +202,8 @@ def test_same_result_bit_for_bit_and_continued_runs():
 
 # Dense 3D list-mode runs whose bits must not depend on how the list scan is compiled:
 # periodic and walled, elastic and inelastic, a mixture (contact distances differ per
-# pair; rows grow), lists of every length mod 4 (the AVX2 scan takes four at a time).
+# pair; rows grow), a sheared box (entries through the sliding faces), lists of every
+# length mod 4 (the AVX2 scan takes four at a time).
 _KERNEL_SCENES = textwrap.dedent(
     """
     import hashlib, math
@@ -224,6 +225,7 @@ _KERNEL_SCENES = textwrap.dedent(
             ("periodic", dense(800, 0.45, seed=1)),
             ("walls-inelastic", dense(800, 0.42, seed=2, boundary="walls", restitution=0.8)),
             ("mixture", mixture()),
+            ("sheared", dense(800, 0.45, seed=5, restitution=0.9).replace(shear_rate=3.0)),
         ):
             sim = Simulation(scene, shell=0.25)
             assert sim.stats["shell"] == 0.25  # lists, not declined for a small box
