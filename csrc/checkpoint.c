@@ -585,6 +585,11 @@ static const char *check_sheared_lists(const gr_edmd *t)
     const int d = t->dim;
     const gr_cells *g = &t->cells;
     const int32_t nx = g->nc[0];
+    for (int32_t i = 0; i < t->n; i++) { /* shrinking exactly next to a sliding face */
+        const int32_t c1 = t->sched[i].c[1];
+        if ((t->nl.built[i] < INFINITY) != (c1 == 0 || c1 == g->nc[1] - 1))
+            return "a neighbour list's shell shrinks away from a sliding face, or not next to one";
+    }
     for (int32_t i = 0; i < t->n; i++) {
         const double tbi = t->nl.built[i];
         if (!(tbi < INFINITY)) continue;

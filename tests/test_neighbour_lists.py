@@ -131,15 +131,20 @@ def test_unwrapped_positions_through_rebuilds():
     assert crossed.sum() >= 10  # some particles did cross the periodic boundary
 
 
-@pytest.mark.parametrize("boundary", ["periodic", "walls"])
+@pytest.mark.parametrize("boundary", ["periodic", "walls", "sheared"])
 def test_lists_mended_at_shell_exits_stay_complete(boundary):
     """A shell exit rebuilds one list and changes only the rows of the neighbours that
     leave or join it (unless the particle was wrapped back into the box, when its image
     codes change and it is linked anew).  After thousands of such exits, in a dense gas
     whose particles also get renumbered (N = 5000), the engine's own check on loading a
     state (csrc/checkpoint.c, check_lists) must find every listed pair listed back the
-    other way and every pair of centres within r_i + r_j + 2 delta listed."""
-    s = _dense(5000, 0.4 if boundary == "walls" else 0.45, boundary=boundary, seed=8)
+    other way and every pair of centres within r_i + r_j + 2 delta listed (in a sheared
+    box, through a sliding face, at the later of the two builds; the shrinking shells'
+    build times renumbered with the particles)."""
+    walls = boundary == "walls"
+    s = _dense(5000, 0.4 if walls else 0.45, boundary="walls" if walls else "periodic", seed=8)
+    if boundary == "sheared":  # reduced shear rate ~0.5 in a box ~24 diameters high
+        s = s.replace(shear_rate=0.5 * math.sqrt(s.temperature) / (2 * s.radii[0]))
     sim = _lists(s)
     sim.run(stop_when={"collisions_per_particle": 30.0}, store=())
     assert sim.stats["shell_exits"] > 2 * s.n
