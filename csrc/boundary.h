@@ -26,7 +26,9 @@
  *  - a pair whose y separation goes through an image sees the partner's x displaced by
  *    -+delta and its v_x by -+u (bd_le_image);
  *  - the cells across a y face slide: lees_edwards.h scans them and bounds how long a
- *    prediction there may live (a "slide" event each time the images pass one cell). */
+ *    prediction there may live (a "slide" event each time the images pass one cell);
+ *    neighbour lists through a y face take the nearest x image at each scan and the
+ *    shells next to it shrink (le_nlist.h; nlist.h has why no pair is missed). */
 #ifndef GR_BOUNDARY_H
 #define GR_BOUNDARY_H
 

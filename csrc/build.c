@@ -109,8 +109,9 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         else status = GR_ERR_NOMEM;
     }
     for (int a = 0; a < 3; a++) s->L[a] = a < d ? cfg->hi[a] - cfg->lo[a] : 1.0;
-    /* Lees-Edwards (boundary.h): cells only, every particle in them (the neighbour lists'
-     * and the big particles' image tables are fixed, the sliding images are not) */
+    /* Lees-Edwards (boundary.h): every particle in the cells or the lists (the big
+     * particles' image tables are fixed, the sliding images are not); the lists follow
+     * the sliding images with shrinking shells (nlist.h) */
     s->le = cfg->periodic && cfg->shear_rate != 0.0;
     const int sheared = s->le;
     s->le_u = cfg->shear_rate * s->L[1];
@@ -132,9 +133,10 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     double shell = cfg->shell * sigma_max;
     for (int a = 0; a < d; a++)
         if (cfg->periodic && !(s->L[a] > 2.0 * (sigma_max + 4.0 * shell))) shell = 0.0;
-    if (n >= GR_NL_MAX_N || s->le) shell = 0.0;
+    if (n >= GR_NL_MAX_N) shell = 0.0;
     if (status == GR_OK && shell > 0.0) {
         status = gr_nlist_init(&s->nl, d, n, shell, s->L);
+        if (status == GR_OK && sheared) status = gr_nlist_shear(&s->nl, n, s->le_u);
         s->big.r_small = 0.5 * sigma_max; /* no big particles */
     } else if (status == GR_OK) {
         status = gr_big_choose(&s->big, d, n, radius, s->L, sheared ? INFINITY : cfg->big_ratio,

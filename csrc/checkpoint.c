@@ -274,6 +274,7 @@ static void transfer(cursor *c, gr_edmd *s)
             }
             io(c, nl_row(&s->nl, i), (size_t)nn * sizeof(int32_t));
         }
+        if (s->nl.built) io(c, s->nl.built, (size_t)n * sizeof *s->nl.built); /* sheared */
     }
 }
 
@@ -333,6 +334,7 @@ static void free_state(gr_edmd *t)
     free(t->cells.occ);
     free(t->nl.centre);
     free(t->nl.rows);
+    free(t->nl.built);
 }
 
 /* t: a copy of s whose replaceable arrays are fresh, sized as s's (neighbour rows with
@@ -360,7 +362,8 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     t->nl.centre = lists ? gr_big_alloc(n * (d + 1) * sizeof(double)) : NULL;
     t->nl.rows = lists ? gr_big_alloc(n * (size_t)cap * sizeof(int32_t)) : NULL;
     t->nl.cap = cap;
-    if (!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
+    t->nl.built = s->nl.built ? malloc(n * sizeof(double)) : NULL;
+    if ((s->nl.built && !t->nl.built) ||!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
         !t->order.id_of || !t->big.is_big || !t->queue.item || !t->queue.head || !t->queue.near || !t->cells.head ||
         !t->cells.next || !t->cells.prev || !t->cells.occ ||
         (lists && (!t->nl.centre || !t->nl.rows))) {
@@ -497,6 +500,9 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         }
         if (s->nl.shell > 0.0 && !same_double(t->nl.centre[(size_t)i * (d + 1) + d], RAD(p, d)))
             return "a neighbour list's centre is corrupt";
+        if (t->nl.built && !(t->nl.built[i] == INFINITY ||
+                             (t->nl.built[i] >= 0.0 && t->nl.built[i] <= t->t)))
+            return "a neighbour list's build time is out of range";
         if (t->spin)
             for (int k = 0; k < GR_SPIN_DIM(d); k++)
                 if (!(fabs(t->spin[(size_t)i * GR_SPIN_DIM(d) + k]) <= 1e140))
@@ -569,6 +575,63 @@ static int listed(const gr_edmd *t, int32_t i, int32_t e)
     return 0;
 }
 
+/* check_lists' pairs through a sliding y face (nlist.h): each pair of shrinking shells
+ * whose centres were within reach at the later of their builds is listed, through its y
+ * and z image with no x image.  From i's window at its own build (le_nlist.h: five
+ * columns about the image of its centre): at j's later build the image has slid by less
+ * than 2 delta since (i's shell was alive), still within the window. */
+static const char *check_sheared_lists(const gr_edmd *t)
+{
+    const int d = t->dim;
+    const gr_cells *g = &t->cells;
+    const int32_t nx = g->nc[0];
+    for (int32_t i = 0; i < t->n; i++) { /* shrinking exactly next to a sliding face */
+        const int32_t c1 = t->sched[i].c[1];
+        if ((t->nl.built[i] < INFINITY) != (c1 == 0 || c1 == g->nc[1] - 1))
+            return "a neighbour list's shell shrinks away from a sliding face, or not next to one";
+    }
+    for (int32_t i = 0; i < t->n; i++) {
+        const double tbi = t->nl.built[i];
+        if (!(tbi < INFINITY)) continue;
+        const double *ci = t->nl.centre + (size_t)i * (d + 1);
+        const int32_t *c = t->sched[i].c;
+        const double delta_i = bd_le_offset(t->cfg.shear_offset, t->le_u, tbi, t->L[0]);
+        for (int ky = -1; ky <= 1; ky += 2) {
+            const int32_t r = c[1] + ky;
+            if (r >= 0 && r < g->nc[1]) continue; /* not across the face */
+            const int32_t q1 = r - ky * g->nc[1];
+            for (int kz = 0; kz < (d == 3 ? 3 : 1); kz++) {
+                const int32_t q2 = d == 3 ? g->nb_cell[2][3 * c[2] + kz] : 0;
+                const double sh[3] = {0.0, (double)ky * t->L[1],
+                                      d == 3 ? g->nb_shift[2][3 * c[2] + kz] : 0.0};
+                const int32_t code = nl_code(d, sh);
+                const int32_t K0 = (int32_t)floor((ci[0] - g->lo[0] - ky * delta_i) / g->w[0]) - 2;
+                for (int32_t K = K0; K < K0 + 5; K++) {
+                    const int32_t cell = (q2 * g->nc[1] + q1) * nx + bd_cell_wrap(K, nx);
+                    for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
+                        const double tbj = t->nl.built[j];
+                        if (j == i || !(tbj < INFINITY)) continue;
+                        const double tb = tbi > tbj ? tbi : tbj;
+                        const double *cj = t->nl.centre + (size_t)j * (d + 1);
+                        const double delta = bd_le_offset(t->cfg.shear_offset, t->le_u, tb, t->L[0]);
+                        double d2 = 0.0;
+                        for (int a = 0; a < d; a++) {
+                            double x = cj[a] + sh[a] - ci[a];
+                            if (a == 0) x = bd_nearest(x + ky * delta, t->L[0]);
+                            d2 += x * x;
+                        }
+                        const double cut = (ci[d] + cj[d] + 2.0 * t->nl.shell) * (1.0 - 1e-9);
+                        if (d2 < cut * cut && !listed(t, i, (j << GR_NL_BITS) | code))
+                            return "a neighbour list misses a particle within reach through "
+                                   "a sliding face";
+                    }
+                }
+            }
+        }
+    }
+    return NULL;
+}
+
 /* List mode, on a state whose numbers, cells and occupancy bits are right: whether its
  * neighbour lists are what the engine keeps (nlist.h) -- every entry listed back the
  * other way through the opposite image, and every pair whose centres lie within
@@ -592,6 +655,7 @@ static const char *check_lists(const gr_edmd *t)
         gr_nbr nb[27];
         const int count = cell_neighbours(&t->cells, d, t->sched[i].c, -1, 0, nb);
         for (int k = 0; k < count; k++) {
+            if (t->le && nb[k].shift[1] != 0.0) continue; /* sliding: check_sheared_lists */
             const int32_t code = nl_code(d, nb[k].shift);
             for (int32_t j = t->cells.head[nb[k].cell]; j >= 0; j = t->cells.next[j]) {
                 const double *cj = t->nl.centre + (size_t)j * (d + 1);
@@ -606,7 +670,7 @@ static const char *check_lists(const gr_edmd *t)
             }
         }
     }
-    return NULL;
+    return t->le ? check_sheared_lists(t) : NULL;
 }
 
 int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error *err)

@@ -126,6 +126,8 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
                            double t, gr_error *err);
 static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up,
                             int32_t old);
+static void le_face_moves(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up);
+static int le_list_reenter(gr_edmd *s, int dyn, int dim, int32_t i, double t);
 static GR_ALWAYS_INLINE int do_vibwall(gr_edmd *s, int dyn, int dim, int laws, int32_t i,
                                        double t, gr_error *err);
 
@@ -747,6 +749,23 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
 static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up,
                             int32_t old)
 {
+    double *p = rec(s, dim, i);
+    le_face_moves(s, dyn, dim, i, t, up);
+    gr_sched *e = &s->sched[i];
+    e->c[1] = up ? 0 : s->cells.nc[1] - 1;
+    cell_coords(&s->cells, 1, p, e->c); /* x only */
+    cell_remove(&s->cells, i, old);
+    cell_insert(&s->cells, i, cell_of(&s->cells, dim, e->c));
+    s->crossings++;
+    predict(s, dyn, dim, i);
+}
+
+/* What a re-entry through a sheared face does to particle i (clock at t, its y and img_y
+ * already moved by bd_through_face, x in the box): x by -+delta and v_x by -+u, img_x
+ * the whole box lengths of D(t) that delta dropped, the work and the energy (do_face_sheared,
+ * and a sheared box's shell exit). */
+static void le_face_moves(gr_edmd *s, int dyn, int dim, int32_t i, double t, int up)
+{
     double *p = rec(s, dim, i), *v = VEL(p, dim);
     int64_t *img = &s->image[(size_t)i * dim];
     const double D = bd_le_total(s->cfg.shear_offset, s->le_u, t);
@@ -760,13 +779,23 @@ static void do_face_sheared(gr_edmd *s, int dyn, int dim, int32_t i, double t, i
     bd_reenter(&p[0], s->cfg.lo[0], s->cfg.hi[0], s->L[0], &img[0]);
     s->shear_work += sign * s->le_u * s->mass[i] * 0.5 * (v0 + v[0]);
     s->kinetic += kinetic_of(s, dyn, dim, i) - before;
-    gr_sched *e = &s->sched[i];
-    e->c[1] = up ? 0 : s->cells.nc[1] - 1;
-    cell_coords(&s->cells, 1, p, e->c); /* x only */
-    cell_remove(&s->cells, i, old);
-    cell_insert(&s->cells, i, cell_of(&s->cells, dim, e->c));
-    s->crossings++;
-    predict(s, dyn, dim, i);
+}
+
+/* A sheared box's shell exit brings i (clock at t) back into the box: x first, then
+ * through a y face with le_face_moves (which leaves x in the box again), then z.
+ * Returns 1 if it moved. */
+static int le_list_reenter(gr_edmd *s, int dyn, int dim, int32_t i, double t)
+{
+    double *p = rec(s, dim, i);
+    int64_t *img = &s->image[(size_t)i * dim];
+    int moved = bd_reenter(&p[0], s->cfg.lo[0], s->cfg.hi[0], s->L[0], &img[0]);
+    const int up = p[1] >= s->cfg.hi[1];
+    if (bd_reenter(&p[1], s->cfg.lo[1], s->cfg.hi[1], s->L[1], &img[1])) {
+        le_face_moves(s, dyn, dim, i, t, up);
+        moved = 1;
+    }
+    if (dim == 3 && bd_reenter(&p[2], s->cfg.lo[2], s->cfg.hi[2], s->L[2], &img[2])) moved = 1;
+    return moved;
 }
 
 /* Cell mode: i moves into the next cell, wrapping around a periodic box. */
@@ -822,7 +851,9 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
     gr_sched *e = &s->sched[i];
     move(s, dyn, dim, p, t);
     int wrapped = 0;
-    if (s->cfg.periodic) {
+    if (s->le) {
+        wrapped = le_list_reenter(s, dyn, dim, i, t); /* through a sliding face too */
+    } else if (s->cfg.periodic) {
         for (int a = 0; a < dim; a++) /* not wrapped |= ...: that costs the cell-crossing
                                         * loop 5 instructions an event (cachegrind) */
             if (bd_reenter(&p[a], s->cfg.lo[a], s->cfg.hi[a], s->L[a],
@@ -889,7 +920,14 @@ static void predict_wall(gr_edmd *s, int dyn, int dim, int32_t i);
 static void predict(gr_edmd *s, int dyn, int dim, int32_t i)
 {
     predict_wall(s, dyn, dim, i);
-    if (s->nl.shell > 0.0) {
+    if (s->nl.shell > 0.0 && s->le) { /* the sliding images (le_nlist.h) */
+        le_shell_exit(s, dyn, dim, i);
+#ifdef GR_SCAN_X86
+        if (dim == 3 && dyn == GR_FLIGHT_LINEAR && scan_avx2) scan_list_avx2_sheared(s, i);
+        else
+#endif
+            le_scan_list(s, dyn, dim, i);
+    } else if (s->nl.shell > 0.0) {
         const double *p = rec(s, dim, i);
         s->sched[i].t_cross = TIME(p, dim) + fl_exit_time(dyn, dim, p, VEL(p, dim),
                                                        s->cfg.gravity, s->nl.centre + (size_t)i * (dim + 1),

@@ -1,6 +1,7 @@
 /* nlist.c -- allocation and growth of the neighbour lists (nlist.h). */
 #define _DEFAULT_SOURCE         /* madvise (hugemem.h) */
 #define _POSIX_C_SOURCE 200112L /* posix_memalign */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -25,8 +26,18 @@ int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *
     return nl->centre && nl->rows && nl->near && nl->mark ? GR_OK : GR_ERR_NOMEM;
 }
 
+int gr_nlist_shear(gr_nlist *nl, int32_t n, double u)
+{
+    nl->shrink = 0.5 * fabs(u);
+    nl->built = malloc((size_t)n * sizeof *nl->built);
+    if (!nl->built) return GR_ERR_NOMEM;
+    for (int32_t i = 0; i < n; i++) nl->built[i] = INFINITY;
+    return GR_OK;
+}
+
 void gr_nlist_free(gr_nlist *nl)
 {
+    free(nl->built);
     free(nl->centre);
     free(nl->rows);
     free(nl->near);

@@ -16,7 +16,38 @@
  * in 2D; a wide particle among small ones has more).  An entry is (j << GR_NL_BITS) |
  * image code: the shift that brings j next to i stays the same until one of them
  * rebuilds, so scans need no nearest-image arithmetic.  List lengths live in the
- * scheduling state (schedstate.h, `nn`), on the line an event loads anyway. */
+ * scheduling state (schedstate.h, `nn`), on the line an event loads anyway.
+ *
+ * In a sheared box (Lees-Edwards, boundary.h) the images across the y faces slide along
+ * x at u = (shear rate) L_y, so a list built through such a face goes stale with no
+ * event of either particle.  The lists stay exact so (lees_edwards.h has the code):
+ *  - An entry through a y face stores its y (and z) image only; its x image is the
+ *    nearest one at each use, displaced by s_y delta(t) (bd_le_image, as the pair
+ *    collision finds it), and the pair's relative velocity gains s_y u.  No stored image
+ *    has to follow delta's wraps at L_x, and delta comes from the absolute time as
+ *    everywhere (no offset per build accumulating rounding over a long run).
+ *  - Each particle whose centre lies in a cell next to a y face when its list is built
+ *    (the only ones whose reach, r_i + r_j + 2 delta <= a cell's width, can cross that
+ *    face) gets a shell that shrinks: it leaves when |r_i(t) - c_i| + (|u|/2)(t - t_b,i)
+ *    reaches delta (flight.h fl_shrink_exit_time; t_b,i its build time, in `built`, +inf
+ *    for the plain shell of the others).
+ *  - Why no pair is missed.  Whether i and j are listed was decided at the later of
+ *    their builds, t_b = max(t_b,i, t_b,j), with the centres' distance through every
+ *    image then.  An unlisted pair through a y face had it >= r_i + r_j + 2 delta; since
+ *    then that image drifted by |u| (t - t_b) along x, so
+ *      |r_j + S(t) - r_i| >= sigma + 2 delta - |r_i - c_i| - |r_j - c_j| - |u| (t - t_b)
+ *    and with both shells alive |r_i - c_i| + |r_j - c_j| + (|u|/2)(2t - t_b,i - t_b,j)
+ *    <= 2 delta, where (|u|/2)(2t - t_b,i - t_b,j) >= |u| (t - t_b): no contact.  If
+ *    either centre is not in an edge row it lies a cell width (>= sigma + 2 delta) from
+ *    the face, and the y separation alone keeps them apart, as without shear.
+ *  - Why the nearest x image at a scan is the one that touches: a scan at t_s predicts a
+ *    contact at t_c with no event of i or j between (else that event scans again), so
+ *    both shells live over [t_s, t_c] and |dr_i| + |dr_j| + |u| (t_c - t_s) <= 4 delta
+ *    (each particle moves at most 2 delta less its shrink); the touching image is then
+ *    within sigma + 4 delta < L_x / 2 along x at t_s (build.c: L > 2 (sigma + 4 delta)),
+ *    nearer than any other.
+ * Rounding: delta(t) carries the time's rounding times u (boundary.h); the shrinking
+ * shells start 2^-48 (|D(t_b)| + L_x) early besides the plain shell's hair (nlist.c). */
 #ifndef GR_NLIST_H
 #define GR_NLIST_H
 
@@ -42,6 +73,9 @@ typedef struct {
     int32_t *near;    /* n: room for a rebuild's new neighbours */
     uint8_t *mark;    /* n, all 0 but during a shell exit's relinking (search.h) */
     int broken;       /* a list could not grow: lists are incomplete, no more events */
+    double *built;    /* n, sheared boxes only (else NULL): a shrinking shell's build time,
+                       * +inf for a plain shell */
+    double shrink;    /* the shrinking shells' rate |u| / 2 (sheared boxes) */
     double img[32][4];/* image code -> shift, code = sum over axes of (s_a + 1) 3^a; the
                        * fourth column 0, for loads of four (scan_avx2.h) */
 } gr_nlist;
@@ -61,6 +95,9 @@ static inline int32_t nl_code(int dim, const double *shift)
  * GR_ERR_NOMEM. */
 int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *L);
 void gr_nlist_free(gr_nlist *nl);
+/* A sheared box's lists (images sliding at speed u): the shrinking shells' build times.
+ * GR_OK or GR_ERR_NOMEM. */
+int gr_nlist_shear(gr_nlist *nl, int32_t n, double u);
 /* Double the rows' capacity; on failure the lists are marked broken.  GR_OK or
  * GR_ERR_NOMEM. */
 int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *sched);

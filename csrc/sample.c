@@ -47,6 +47,16 @@ static void stress_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
     for (int c = 0; c < dd; c++) smp->kinetic_tensor[at + c] = k[c];
 }
 
+/* A sheared box's lists let a particle stray a shell beyond a y face before its shell
+ * exit brings it back (edmd.c le_list_reenter): its record's v_x is that of the box it
+ * left, and the box's own is v_x -+ u (as state_sheared reports it).  0 in the box. */
+static double le_frame_velocity(const gr_edmd *s, int dyn, const double *p, double dt)
+{
+    const int dim = s->dim;
+    const double y = fl_at(dyn, p[1], VEL(p, dim)[1], s->cfg.gravity[1], dt);
+    return y >= s->cfg.hi[1] ? -s->le_u : y < s->cfg.lo[1] ? s->le_u : 0.0;
+}
+
 void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
 {
     const int dim = s->dim, dyn = dynamics_of(s);
@@ -60,6 +70,7 @@ void gr_write_sample(const gr_edmd *s, gr_edmd_samples *smp, double ts)
         for (int a = 0; a < dim; a++) {
             const double g = s->cfg.gravity[a];
             double v = fl_vel_at(dyn, VEL(p, dim)[a], g, dt);
+            if (s->le && a == 0) v += le_frame_velocity(s, dyn, p, dt);
             if (smp->pos)
                 smp->pos[out + a] = bd_unwrap(fl_at(dyn, p[a], VEL(p, dim)[a], g, dt),
                                               s->image[(size_t)i * dim + a], s->L[a]);
@@ -103,6 +114,9 @@ static void state_sheared(const gr_edmd *s, int32_t i, double *pos, double *vel,
         img[a] = s->image[(size_t)i * d + a];
     }
     const int64_t img_y = img[1];
+    /* x in the box first (lists let it stray a shell beyond), so that the shift by delta
+     * leaves it at most one box length out */
+    bd_reenter(&x[0], s->cfg.lo[0], s->cfg.hi[0], s->L[0], &img[0]);
     if (bd_reenter(&x[1], s->cfg.lo[1], s->cfg.hi[1], s->L[1], &img[1])) {
         const double sign = img[1] > img_y ? -1.0 : 1.0;
         const double D = bd_le_total(s->cfg.shear_offset, s->le_u, s->t);
@@ -154,6 +168,23 @@ void gr_edmd_spin(const gr_edmd *s, double *spin)
             spin[(size_t)s->order.id_of[i] * w + a] = s->spin[(size_t)i * w + a];
 }
 
+/* The counters of a sheared box with lists: a particle strayed beyond a y face (its
+ * record in the frame of the box it left, le_frame_velocity) counts with the box's
+ * velocity, and the work its re-entry will book (edmd.c le_face_moves) is counted now,
+ * so that the kinetic energy is the box velocities' total and still rises by the work. */
+static void le_counters_in_box(const gr_edmd *s, double *kinetic, double *work)
+{
+    const int dim = s->dim, dyn = dynamics_of(s);
+    for (int32_t i = 0; i < s->n; i++) {
+        const double *p = rec(s, dim, i), dt = s->t - TIME(p, dim);
+        const double du = le_frame_velocity(s, dyn, p, dt);
+        if (du == 0.0) continue;
+        const double v0 = fl_vel_at(dyn, VEL(p, dim)[0], s->cfg.gravity[0], dt), v1 = v0 + du;
+        *kinetic += 0.5 * s->mass[i] * (v1 * v1 - v0 * v0);
+        *work += du * s->mass[i] * 0.5 * (v0 + v1); /* as le_face_moves: sign u = du */
+    }
+}
+
 void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
 {
     c->t = s->t;
@@ -188,6 +219,7 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
             c->kinetic_tensor[a] = k[a];
         }
     }
+    if (s->le && s->nl.shell > 0.0) le_counters_in_box(s, &c->kinetic, &c->shear_work);
     c->shell = s->nl.shell > 0.0 ? s->cfg.shell : 0.0;
     c->kicks = s->kicks;
     c->drive_energy = s->drive_energy;

@@ -50,7 +50,21 @@ static GR_AVX2 inline __m256d dot4(__m256d a0, __m256d a1, __m256d a2, __m256d b
                          _mm256_mul_pd(a2, b2));
 }
 
-static GR_AVX2 void scan_list_avx2(gr_edmd *s, int32_t i)
+/* bd_nearest (boundary.h) in four lanes, the same bits: d - L above L/2, d + L below -L/2 */
+static GR_AVX2 inline __m256d nearest4(__m256d d, __m256d L, __m256d half)
+{
+    const __m256d up = _mm256_cmp_pd(d, half, _CMP_GT_OQ);
+    const __m256d down = _mm256_cmp_pd(d, _mm256_xor_pd(half, _mm256_set1_pd(-0.0)), _CMP_LT_OQ);
+    return _mm256_blendv_pd(_mm256_blendv_pd(d, _mm256_sub_pd(d, L), up), _mm256_add_pd(d, L),
+                            down);
+}
+
+/* The loop, for a box with fixed images (sheared = 0: scan_list_avx2) or a sheared box's
+ * lists (sheared = 1: scan_list_avx2_sheared, le_nlist.h), whose entries through a y face
+ * (a lane whose y shift is not 0) take x as le_try_listed does -- the nearest image of
+ * the separation, displaced by ky delta, nearest again -- and v_x + ky u; the other lanes
+ * as the plain loop, chosen per lane by a blend (exact: no arithmetic on the kept value). */
+static GR_AVX2 GR_ALWAYS_INLINE void scan_list_avx2_in(gr_edmd *s, int32_t i, const int sheared)
 {
     const int dim = 3;
     const double *p = rec(s, dim, i);
@@ -64,6 +78,13 @@ static GR_AVX2 void scan_list_avx2(gr_edmd *s, int32_t i)
                   pt = _mm256_set1_pd(TIME(p, dim)), pr = _mm256_set1_pd(RAD(p, dim));
     const __m256d zero = _mm256_setzero_pd(), m2 = _mm256_set1_pd(-2.0),
                   sign = _mm256_set1_pd(-0.0);
+    /* a sheared box: +-delta now, +-u, L_x and L_x / 2 (unused otherwise) */
+    const double delta =
+        sheared ? bd_le_offset(s->cfg.shear_offset, s->le_u, TIME(p, dim), s->L[0]) : 0.0;
+    const __m256d le_d = _mm256_set1_pd(delta), le_md = _mm256_set1_pd(-delta),
+                  le_u = _mm256_set1_pd(s->le_u), le_mu = _mm256_set1_pd(-s->le_u),
+                  lx = _mm256_set1_pd(s->L[0]), hx = _mm256_set1_pd(0.5 * s->L[0]);
+    (void)le_d, (void)le_md, (void)le_u, (void)le_mu, (void)lx, (void)hx;
     /* a short group is filled with i itself, which never passes (b = 0) */
     const int32_t self = (i << GR_NL_BITS) | GR_NL_CODE_NONE(dim);
     const int nn = e->nn;
@@ -85,10 +106,20 @@ static GR_AVX2 void scan_list_avx2(gr_edmd *s, int32_t i)
                       _mm256_loadu_pd(sh[3]), SX, SY, SZ, S3);
         (void)S3;
         const __m256d dtj = _mm256_sub_pd(pt, T);
-        const __m256d dx = sep4(X, VX, dtj, px, SX), dy = sep4(Y, VY, dtj, py, SY),
-                      dz = sep4(Z, VZ, dtj, pz, SZ);
-        const __m256d ux = _mm256_sub_pd(VX, pvx), uy = _mm256_sub_pd(VY, pvy),
-                      uz = _mm256_sub_pd(VZ, pvz);
+        __m256d dx = sep4(X, VX, dtj, px, SX);
+        const __m256d dy = sep4(Y, VY, dtj, py, SY), dz = sep4(Z, VZ, dtj, pz, SZ);
+        __m256d ux = _mm256_sub_pd(VX, pvx);
+        const __m256d uy = _mm256_sub_pd(VY, pvy), uz = _mm256_sub_pd(VZ, pvz);
+        if (sheared) { /* lanes through a y face: the sliding image (le_try_listed) */
+            const __m256d pos = _mm256_cmp_pd(SY, zero, _CMP_GT_OQ),
+                          neg = _mm256_cmp_pd(SY, zero, _CMP_LT_OQ), face = _mm256_or_pd(pos, neg);
+            const __m256d kd = _mm256_or_pd(_mm256_and_pd(pos, le_d), _mm256_and_pd(neg, le_md));
+            const __m256d ku = _mm256_or_pd(_mm256_and_pd(pos, le_u), _mm256_and_pd(neg, le_mu));
+            const __m256d raw = GR_FL_SEP(_mm256_add_pd, _mm256_sub_pd, _mm256_mul_pd, X, VX, dtj, px);
+            const __m256d fx = nearest4(_mm256_add_pd(nearest4(raw, lx, hx), kd), lx, hx);
+            dx = _mm256_blendv_pd(dx, fx, face);
+            ux = _mm256_blendv_pd(ux, _mm256_add_pd(ux, ku), face);
+        }
         const __m256d b = dot4(dx, dy, dz, ux, uy, uz), dr2 = dot4(dx, dy, dz, dx, dy, dz),
                       dv2 = dot4(ux, uy, uz, ux, uy, uz);
         const __m256d sigma = _mm256_add_pd(pr, R);
@@ -124,6 +155,11 @@ static GR_AVX2 void scan_list_avx2(gr_edmd *s, int32_t i)
     }
     keep_pair(s, dim, i, best, partner);
 }
+
+static GR_AVX2 void scan_list_avx2(gr_edmd *s, int32_t i) { scan_list_avx2_in(s, i, 0); }
+
+/* a sheared box's lists (le_nlist.h), the same bits as le_scan_list */
+static GR_AVX2 void scan_list_avx2_sheared(gr_edmd *s, int32_t i) { scan_list_avx2_in(s, i, 1); }
 #endif
 
 #endif

@@ -248,6 +248,8 @@ static inline void set_centre(gr_edmd *s, int dim, int32_t i)
     centre[dim] = RAD(p, dim);
     for (int a = 0; a < dim; a++) centre[a] = p[a];
     cell_coords(&s->cells, dim, p, s->sched[i].c);
+    if (s->nl.built) /* sheared: next to a y face its shell shrinks from now (nlist.h) */
+        s->nl.built[i] = le_edge_row(&s->cells, s->sched[i].c[1]) ? TIME(p, dim) : INFINITY;
 }
 
 /* List mode, for find_near: append to s->nl.near (m entries so far) every particle j of
@@ -275,6 +277,8 @@ static GR_ALWAYS_INLINE int32_t near_in_cell(const gr_edmd *s, int dim, int32_t 
     return m;
 }
 
+static int32_t le_find_near(gr_edmd *s, int dim, int32_t i, int above);
+
 /* List mode: every particle whose centre is within r_i + r_j + 2 delta of i's (only those
  * numbered above i if `above`: building all lists at once), as list entries in s->nl.near;
  * returns how many. */
@@ -295,6 +299,7 @@ static int32_t find_near(gr_edmd *s, int dim, int32_t i, int above)
         }
         return m;
     }
+    if (s->le && le_edge_row(g, s->sched[i].c[1])) return le_find_near(s, dim, i, above);
     gr_nbr nb[27];
     const int count = cell_neighbours(g, dim, s->sched[i].c, -1, 0, nb);
     for (int k = 0; k < count; k++) {
@@ -367,5 +372,8 @@ static int relink(gr_edmd *s, int dim, int32_t i, int32_t m, gr_error *err)
     }
     return GR_OK;
 }
+
+/* the neighbour lists of a sheared box */
+#include "le_nlist.h"
 
 #endif

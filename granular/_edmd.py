@@ -74,15 +74,8 @@ def build(
     """A new engine (_core.EDMD) at a Scene's state; see Simulation for the knobs."""
     big = bool(np.max(scene.radii) > _core.big_cut(scene.radii, big_ratio))
     if scene.shear_rate != 0.0:
-        # Lees-Edwards: the lists' and the big particles' image tables are fixed, the
-        # sliding images are not (csrc/boundary.h); the engine uses cells, all in them
-        number = isinstance(shell, (int, float, np.number)) and not isinstance(shell, bool)
-        if number and shell > 0:
-            raise ValueError(
-                f"neighbour lists (shell = {shell}) do not follow the sliding images of a "
-                "sheared box: use shell=0 or 'auto' (cells) with shear_rate != 0"
-            )
-        shell = 0.0 if number or shell == "auto" else shell
+        # Lees-Edwards: the big particles' image tables are fixed, the sliding images are
+        # not (csrc/boundary.h): every particle in the cells or the lists
         big = False
     if isinstance(shell, str) and shell == "auto":
         dense = scene.dim == 3 and scene.packing_fraction >= LIST_MIN_PACKING

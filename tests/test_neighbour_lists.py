@@ -131,15 +131,20 @@ def test_unwrapped_positions_through_rebuilds():
     assert crossed.sum() >= 10  # some particles did cross the periodic boundary
 
 
-@pytest.mark.parametrize("boundary", ["periodic", "walls"])
+@pytest.mark.parametrize("boundary", ["periodic", "walls", "sheared"])
 def test_lists_mended_at_shell_exits_stay_complete(boundary):
     """A shell exit rebuilds one list and changes only the rows of the neighbours that
     leave or join it (unless the particle was wrapped back into the box, when its image
     codes change and it is linked anew).  After thousands of such exits, in a dense gas
     whose particles also get renumbered (N = 5000), the engine's own check on loading a
     state (csrc/checkpoint.c, check_lists) must find every listed pair listed back the
-    other way and every pair of centres within r_i + r_j + 2 delta listed."""
-    s = _dense(5000, 0.4 if boundary == "walls" else 0.45, boundary=boundary, seed=8)
+    other way and every pair of centres within r_i + r_j + 2 delta listed (in a sheared
+    box, through a sliding face, at the later of the two builds; the shrinking shells'
+    build times renumbered with the particles)."""
+    walls = boundary == "walls"
+    s = _dense(5000, 0.4 if walls else 0.45, boundary="walls" if walls else "periodic", seed=8)
+    if boundary == "sheared":  # reduced shear rate ~0.5 in a box ~24 diameters high
+        s = s.replace(shear_rate=0.5 * math.sqrt(s.temperature) / (2 * s.radii[0]))
     sim = _lists(s)
     sim.run(stop_when={"collisions_per_particle": 30.0}, store=())
     assert sim.stats["shell_exits"] > 2 * s.n
@@ -202,7 +207,8 @@ def test_same_result_bit_for_bit_and_continued_runs():
 
 # Dense 3D list-mode runs whose bits must not depend on how the list scan is compiled:
 # periodic and walled, elastic and inelastic, a mixture (contact distances differ per
-# pair; rows grow), lists of every length mod 4 (the AVX2 scan takes four at a time).
+# pair; rows grow), a sheared box (entries through the sliding faces), lists of every
+# length mod 4 (the AVX2 scan takes four at a time).
 _KERNEL_SCENES = textwrap.dedent(
     """
     import hashlib, math
@@ -224,6 +230,7 @@ _KERNEL_SCENES = textwrap.dedent(
             ("periodic", dense(800, 0.45, seed=1)),
             ("walls-inelastic", dense(800, 0.42, seed=2, boundary="walls", restitution=0.8)),
             ("mixture", mixture()),
+            ("sheared", dense(800, 0.45, seed=5, restitution=0.9).replace(shear_rate=3.0)),
         ):
             sim = Simulation(scene, shell=0.25)
             assert sim.stats["shell"] == 0.25  # lists, not declined for a small box

@@ -30,6 +30,8 @@ def scenes():
         {},
     )
     yield Scene.random(60, 0.1, dim=3, seed=3), {"shell": 0.25}  # neighbour lists
+    sheared = Scene.random(60, 0.1, dim=3, seed=5).replace(shear_rate=2.0)
+    yield sheared, {"shell": 0.25}  # lists through sliding faces, shrinking shells
     pos = np.array([[0.5, 0.5], [0.1, 0.1], [0.9, 0.1], [0.1, 0.9], [0.9, 0.9], [0.2, 0.5]])
     radii = np.array([0.15, 0.02, 0.02, 0.02, 0.02, 0.02])  # one big particle
     vel = np.random.default_rng(4).normal(size=pos.shape)

@@ -1263,7 +1263,9 @@ def _run_scene(scene):
     speed = math.sqrt(2 * scene.kinetic_energy / np.sum(scene.masses)) if scene.n else 0.0
     length = float(np.min(scene.upper - scene.lower))
     t_stop = length / speed if speed > 0 and math.isfinite(length / speed) else 1.0
-    sim = Simulation(scene)
+    # half the sheared scenes with neighbour lists (where the box is wide enough for them)
+    lists = scene.shear_rate != 0.0 and scene.n % 2 == 0
+    sim = Simulation(scene, shell=0.25) if lists else Simulation(scene)
     traj = sim.run(t_stop, sample_times=np.linspace(0, t_stop, 5), stop_when={"events": EVENTS})
     _check_trajectory(scene, traj, sim)
 
