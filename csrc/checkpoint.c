@@ -41,7 +41,7 @@ uint64_t gr_checkpoint_layout(void)
         offsetof(gr_sched, partner), offsetof(gr_sched, last), offsetof(gr_sched, c),
         offsetof(gr_sched, cross), offsetof(gr_sched, streak), offsetof(gr_sched, nn),
         sizeof(gr_cq_item), offsetof(gr_cq_item, t), offsetof(gr_cq_item, next),
-        offsetof(gr_cq_item, prev), offsetof(gr_cq_item, where),
+        offsetof(gr_cq_item, prev),
     };
     uint64_t h = 0xcbf29ce484222325ULL;
     for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++) h = mix(h, parts[k]);
@@ -248,7 +248,6 @@ static void transfer(cursor *c, gr_edmd *s)
         IO(c, q->item[id].t);
         IO(c, q->item[id].next);
         IO(c, q->item[id].prev);
-        IO(c, q->item[id].where);
     }
     io(c, q->head, (size_t)q->nb * sizeof *q->head);
     if (q->n_near < 0 || q->n_near > n) { /* read: not to size the loop below */
