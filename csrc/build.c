@@ -66,7 +66,7 @@ size_t gr_edmd_bytes_per_particle(int dim, int lists)
                    + sizeof(double)                       /* mass */
                    + (size_t)dim * sizeof(int64_t)        /* image */
                    + sizeof(gr_sched)
-                   + 2 * sizeof(int32_t)                  /* cell links */
+                   + sizeof(int32_t)                      /* cell link */
                    + sizeof(int32_t) + sizeof(uint8_t)    /* id_of, is_big */
                    + scratch_per_particle(dim)
                    + sizeof(gr_cq_item) + sizeof(int32_t) /* queue entry, a bucket's share */
