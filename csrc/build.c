@@ -35,7 +35,7 @@ void gr_edmd_free(gr_edmd *s)
  * state, whichever is larger. */
 static size_t scratch_per_particle(int dim)
 {
-    const size_t record = (size_t)(2 * dim + 2) * sizeof(double);
+    const size_t record = (size_t)GR_STRIDE(dim) * sizeof(double);
     return record > sizeof(gr_sched) ? record : sizeof(gr_sched);
 }
 
@@ -62,11 +62,11 @@ static int copy_law(gr_law *law)
 
 size_t gr_edmd_bytes_per_particle(int dim, int lists)
 {
-    size_t bytes = (size_t)(2 * dim + 2) * sizeof(double) /* record */
+    size_t bytes = (size_t)GR_STRIDE(dim) * sizeof(double) /* record */
                    + sizeof(double)                       /* mass */
                    + (size_t)dim * sizeof(int64_t)        /* image */
                    + sizeof(gr_sched)
-                   + 2 * sizeof(int32_t)                  /* cell links */
+                   + sizeof(int32_t)                      /* cell link */
                    + sizeof(int32_t) + sizeof(uint8_t)    /* id_of, is_big */
                    + scratch_per_particle(dim)
                    + sizeof(gr_cq_item) + sizeof(int32_t) /* queue entry, a bucket's share */
@@ -116,7 +116,8 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     const int sheared = s->le;
     s->le_u = cfg->shear_rate * s->L[1];
     size_t bytes = ((size_t)n * GR_STRIDE(d) * sizeof(double) + 63) / 64 * 64;
-    s->P = gr_big_alloc(bytes); /* records on cache-line boundaries: a 3D record is one line */
+    s->P = gr_big_alloc(bytes); /* records on cache-line boundaries: a record is one line */
+    if (s->P) memset(s->P, 0, bytes); /* the 2D records' padding too (checkpoints hold it) */
     s->mass = gr_big_alloc((size_t)n * sizeof *s->mass);
     s->image = calloc((size_t)n * d, sizeof *s->image);
     s->sched = gr_big_alloc((size_t)n * sizeof *s->sched);

@@ -9,7 +9,8 @@
 #include "common.h"
 #include "hugemem.h"
 
-enum { GR_CQ_LIST = -1, GR_CQ_OVER = -2, GR_CQ_NONE = -3 };
+/* an item's prev: the head of a list, in the near heap, in no structure (calendar.h) */
+enum { GR_CQ_HEAD = -1, GR_CQ_NEAR = -2, GR_CQ_NONE = -3 };
 
 /* Keys per bucket the width aims at: the near heap then stays a few entries deep, and
  * few buckets are stepped over empty.  Measured best among 1, 2, 4, 8 (edmd_perf.py). */
@@ -38,12 +39,13 @@ static inline int64_t bucket_of(const gr_cq *q, double t)
     return (int64_t)x;
 }
 
-/* ---- the near heap: a binary min-heap of (key, id), item[id].where = its slot ---- */
+/* ---- the near heap: a binary min-heap of (key, id), item[id].next = its slot (and
+ * item[id].prev = GR_CQ_NEAR, set where an id enters the heap) ---- */
 
 static inline void near_place(gr_cq *q, int32_t k, gr_cq_near e)
 {
     q->near[k] = e;
-    q->item[e.id].where = k;
+    q->item[e.id].next = k;
 }
 
 static void near_sift_up(gr_cq *q, int32_t k, gr_cq_near e)
@@ -81,11 +83,10 @@ static void near_remove(gr_cq *q, int32_t k)
 
 /* ---- lists ---- */
 
-static inline void list_push(gr_cq *q, int32_t *head, int32_t id, int32_t where)
+static inline void list_push(gr_cq *q, int32_t *head, int32_t id)
 {
     gr_cq_item *it = &q->item[id];
-    it->where = where;
-    it->prev = -1;
+    it->prev = GR_CQ_HEAD;
     it->next = *head;
     if (*head >= 0) q->item[*head].prev = id;
     *head = id;
@@ -106,12 +107,13 @@ static inline void place(gr_cq *q, int32_t id)
     int64_t b = bucket_of(q, t);
     if (b <= q->cur) {
         gr_cq_near e = {t, id};
+        q->item[id].prev = GR_CQ_NEAR;
         near_sift_up(q, q->n_near++, e);
     } else if (b < q->over_from) {
-        list_push(q, &q->head[b & (q->nb - 1)], id, GR_CQ_LIST);
+        list_push(q, &q->head[b & (q->nb - 1)], id);
         q->n_list++;
     } else {
-        list_push(q, &q->over, id, GR_CQ_OVER);
+        list_push(q, &q->over, id);
         q->n_over++;
     }
 }
@@ -119,18 +121,21 @@ static inline void place(gr_cq *q, int32_t id)
 static inline void take_out(gr_cq *q, int32_t id)
 {
     gr_cq_item *it = &q->item[id];
-    if (it->where >= 0) {
-        near_remove(q, it->where);
-    } else if (it->where == GR_CQ_LIST) {
-        list_unlink(q, &q->head[bucket_of(q, it->t) & (q->nb - 1)], id);
-        q->n_list--;
-    } else if (it->where == GR_CQ_OVER) {
-        list_unlink(q, &q->over, id);
-        q->n_over--;
+    if (it->prev == GR_CQ_NEAR) {
+        near_remove(q, it->next);
+    } else if (it->prev != GR_CQ_NONE) { /* a list: which one, its key says */
+        const int64_t b = bucket_of(q, it->t);
+        if (b < q->over_from) {
+            list_unlink(q, &q->head[b & (q->nb - 1)], id);
+            q->n_list--;
+        } else {
+            list_unlink(q, &q->over, id);
+            q->n_over--;
+        }
     } else if (q->nan_id == id) {
         q->nan_id = -1;
     }
-    it->where = GR_CQ_NONE;
+    it->prev = GR_CQ_NONE;
 }
 
 /* Move the overflow keys that now fall before over_from into the calendar. */
@@ -212,7 +217,7 @@ static void rebuild(gr_cq *q)
     q->over_from = q->nb;
     for (int32_t id = 0; id < n; id++) {
         double t = q->item[id].t;
-        q->item[id].where = GR_CQ_NONE;
+        q->item[id].prev = GR_CQ_NONE;
         if (t != t) q->nan_id = id;
         else if (t != INFINITY) place(q, id);
     }
@@ -328,6 +333,7 @@ int32_t gr_cq_top_slow(gr_cq *q, double *t)
             *head = q->item[id].next;
             q->n_list--;
             gr_cq_near e = {q->item[id].t, id};
+            q->item[id].prev = GR_CQ_NEAR;
             near_sift_up(q, q->n_near++, e);
         }
     }
@@ -337,19 +343,19 @@ int32_t gr_cq_top_slow(gr_cq *q, double *t)
 
 void gr_cq_renumber(gr_cq *q, const int32_t *newpos)
 {
-    /* permute the keys in place, cycle by cycle, with `where` marking the ids done
-     * (rebuild() sets every `where` afresh); no allocation, so nothing can fail */
+    /* permute the keys in place, cycle by cycle, with `prev` marking the ids done
+     * (rebuild() sets every `prev` afresh); no allocation, so nothing can fail */
     gr_cq_item *it = q->item;
-    for (int32_t id = 0; id < q->n; id++) it[id].where = 0;
+    for (int32_t id = 0; id < q->n; id++) it[id].prev = 0;
     for (int32_t start = 0; start < q->n; start++) {
-        if (it[start].where) continue;
+        if (it[start].prev) continue;
         double carry = it[start].t;
         int32_t j = start;
         do {
             int32_t k = newpos[j];
             double t = it[k].t;
             it[k].t = carry;
-            it[k].where = 1;
+            it[k].prev = 1;
             carry = t;
             j = k;
         } while (j != start);
@@ -357,19 +363,19 @@ void gr_cq_renumber(gr_cq *q, const int32_t *newpos)
     rebuild(q);
 }
 
-/* Walk the list from head (ids where == `where`, buckets in [blo, bhi) and, for a
- * bucket slot >= 0, in that slot), marking ids seen.  Adds the ids walked to *count;
- * returns NULL or the fault. */
-static const char *check_list(const gr_cq *q, int32_t head, int32_t where, int64_t blo,
-                              int64_t bhi, int64_t slot, uint8_t *seen, int64_t *count)
+/* Walk the list from head (ids with keys in buckets [blo, bhi) and, for a bucket slot
+ * >= 0, in that slot), marking ids seen.  Adds the ids walked to *count; returns NULL or
+ * the fault. */
+static const char *check_list(const gr_cq *q, int32_t head, int64_t blo, int64_t bhi,
+                              int64_t slot, uint8_t *seen, int64_t *count)
 {
-    int32_t prev = -1;
+    int32_t prev = GR_CQ_HEAD;
     for (int32_t id = head; id != -1; id = q->item[id].next) {
         if (id < 0 || id >= q->n) return "a queue list links to an id out of range";
         if (seen[id]) return "a queue id is in two places, or a list has a cycle";
         seen[id] = 1;
         const gr_cq_item *it = &q->item[id];
-        if (it->where != where || it->prev != prev) return "a queue list's links are inconsistent";
+        if (it->prev != prev) return "a queue list's links are inconsistent";
         if (!(it->t == it->t) || it->t == INFINITY) return "a queue list holds a key of +inf or NaN";
         const int64_t b = bucket_of(q, it->t);
         if (b < blo || b >= bhi || (slot >= 0 && (b & (q->nb - 1)) != slot))
@@ -402,7 +408,7 @@ const char *gr_cq_check(const gr_cq *q, uint8_t *seen)
         if (seen[e.id]) return "a queue id is twice in the near heap";
         seen[e.id] = 1;
         const gr_cq_item *it = &q->item[e.id];
-        if (it->where != k || memcmp(&it->t, &e.t, sizeof e.t) != 0)
+        if (it->prev != GR_CQ_NEAR || it->next != k || memcmp(&it->t, &e.t, sizeof e.t) != 0)
             return "the queue's near heap disagrees with its items";
         if (!(e.t == e.t) || e.t == INFINITY || bucket_of(q, e.t) > q->cur)
             return "the queue's near heap holds a key that belongs elsewhere";
@@ -410,18 +416,18 @@ const char *gr_cq_check(const gr_cq *q, uint8_t *seen)
     }
     int64_t listed = 0, over = 0;
     for (int32_t slot = 0; slot < q->nb; slot++) {
-        const char *fault = check_list(q, q->head[slot], GR_CQ_LIST, q->cur + 1, q->over_from,
-                                       slot, seen, &listed);
+        const char *fault =
+            check_list(q, q->head[slot], q->cur + 1, q->over_from, slot, seen, &listed);
         if (fault) return fault;
     }
     if (listed != q->n_list) return "the queue's bucket lists do not hold n_list ids";
-    const char *fault = check_list(q, q->over, GR_CQ_OVER, q->over_from, INT64_MAX, -1, seen, &over);
+    const char *fault = check_list(q, q->over, q->over_from, INT64_MAX, -1, seen, &over);
     if (fault) return fault;
     if (over != q->n_over) return "the queue's overflow list does not hold n_over ids";
     for (int32_t id = 0; id < n; id++) {
         if (seen[id]) continue;
         const gr_cq_item *it = &q->item[id];
-        if (it->where != GR_CQ_NONE) return "a queue id is marked as placed but is in no list";
+        if (it->prev != GR_CQ_NONE) return "a queue id is marked as placed but is in no list";
         if (it->t != INFINITY && !(it->t != it->t && id == q->nan_id))
             return "a queue id with an event time is in no list";
     }

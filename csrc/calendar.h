@@ -30,13 +30,16 @@
  * overflow; saturation keeps bucket() monotonic and avoids an overflowing conversion). */
 #define GR_CQ_FAR 4611686018427387904.0 /* 2^62 */
 
+/* 16 bytes, so that no item straddles two cache lines (at 24 bytes one in four did, and
+ * an update then missed twice on it at large N).  Where an id is follows from prev and
+ * its key: in the near heap (next is its slot there), nowhere, or in a list -- a bucket's
+ * if bucket(key) < over_from, else the overflow (the invariants below). */
 typedef struct {
     double t;       /* key */
-    int32_t next;   /* links in a bucket or overflow list, -1 at the ends */
-    int32_t prev;
-    int32_t where;  /* >= 0: slot in the near heap; or GR_CQ_LIST / GR_CQ_OVER / GR_CQ_NONE */
-    int32_t pad;
+    int32_t next;   /* in a list: the next id, -1 at the end; in the near heap: its slot */
+    int32_t prev;   /* in a list: the previous id, -1 at its head; or GR_CQ_NEAR, GR_CQ_NONE */
 } gr_cq_item;
+typedef char gr_cq_item_is_16_bytes[sizeof(gr_cq_item) == 16 ? 1 : -1];
 
 typedef struct {
     double t;

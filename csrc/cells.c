@@ -60,8 +60,7 @@ int gr_cells_build(gr_cells *g, int dim, int32_t n, const double *lo, const doub
     g->prefetch_heads = (size_t)g->ncells * sizeof *g->head > GR_HEADS_CACHED;
     g->occ = calloc(cell_occ_words(g->ncells), sizeof *g->occ);
     g->next = gr_big_alloc((size_t)n * sizeof *g->next);
-    g->prev = gr_big_alloc((size_t)n * sizeof *g->prev);
-    if (!g->head || !g->occ || !g->next || !g->prev) return GR_ERR_NOMEM;
+    if (!g->head || !g->occ || !g->next) return GR_ERR_NOMEM;
     for (int32_t c = 0; c < g->ncells; c++) g->head[c] = -1;
     int k_all = 0, k_layer[6] = {0, 0, 0, 0, 0, 0};
     int r_all = 0, r_layer[6] = {0, 0, 0, 0, 0, 0};
@@ -107,7 +106,6 @@ void gr_cells_free(gr_cells *g)
     free(g->head);
     free(g->occ);
     free(g->next);
-    free(g->prev);
     for (int a = 0; a < 3; a++) {
         free(g->nb_cell[a]);
         free(g->nb_shift[a]);

@@ -1,5 +1,5 @@
 /* cells.h -- the cell grid: the box cut into cells at least one contact distance wide,
- * each with a doubly linked list of its particles and one occupancy bit.
+ * each with a singly linked list of its particles and one occupancy bit.
  *
  * A particle looks for partners in its own and the adjacent cells only.  One bit per
  * cell says whether the cell holds anyone: most cells of a dilute gas are empty (cells
@@ -31,7 +31,7 @@ typedef struct {
     int periodic;
     int32_t ncells;
     int32_t *head;        /* ncells: first particle of each cell, -1 none */
-    int32_t *next, *prev; /* n: the cell lists' links */
+    int32_t *next;        /* n: the cell lists' links */
     uint64_t *occ;        /* one bit per cell, set iff it holds a particle */
     int prefetch_heads;   /* the heads take more than GR_HEADS_CACHED bytes */
     int32_t *nb_cell[3];  /* [axis][3*c + d+1]: neighbouring coordinate or -1 */
@@ -102,20 +102,26 @@ static inline unsigned cell_row(const gr_cells *g, int32_t mid)
     return (unsigned)(((lo >> sh) | (hi << (63 - sh) << 1)) & 7);
 }
 
+/* i becomes the first of cell c's list (a scan meets the cell's particles in the order
+ * they were filed, latest first). */
 static inline void cell_insert(gr_cells *g, int32_t i, int32_t c)
 {
-    g->prev[i] = -1;
-    g->next[i] = g->head[c];
-    if (g->head[c] >= 0) g->prev[g->head[c]] = i;
-    else g->occ[c >> 6] |= (uint64_t)1 << (c & 63);
+    const int32_t first = g->head[c];
+    g->next[i] = first;
+    if (first < 0) g->occ[c >> 6] |= (uint64_t)1 << (c & 63);
     g->head[c] = i;
 }
 
+/* i leaves cell c's list, the others keeping their order.  Singly linked: the walk from
+ * the head to i reads the links a scan of the cell reads anyway (a cell holds a particle
+ * or two), where back links cost a random access to the neighbours' links at every
+ * crossing (counted in docs/performance.md). */
 static inline void cell_remove(gr_cells *g, int32_t i, int32_t c)
 {
-    if (g->prev[i] >= 0) g->next[g->prev[i]] = g->next[i];
-    else if ((g->head[c] = g->next[i]) < 0) g->occ[c >> 6] &= ~((uint64_t)1 << (c & 63));
-    if (g->next[i] >= 0) g->prev[g->next[i]] = g->prev[i];
+    int32_t *link = &g->head[c];
+    while (*link != i) link = &g->next[*link];
+    *link = g->next[i];
+    if (g->head[c] < 0) g->occ[c >> 6] &= ~((uint64_t)1 << (c & 63));
 }
 
 /* The coordinates c of the cell holding position x (clamped: rounding may leave a

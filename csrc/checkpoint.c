@@ -41,7 +41,7 @@ uint64_t gr_checkpoint_layout(void)
         offsetof(gr_sched, partner), offsetof(gr_sched, last), offsetof(gr_sched, c),
         offsetof(gr_sched, cross), offsetof(gr_sched, streak), offsetof(gr_sched, nn),
         sizeof(gr_cq_item), offsetof(gr_cq_item, t), offsetof(gr_cq_item, next),
-        offsetof(gr_cq_item, prev), offsetof(gr_cq_item, where),
+        offsetof(gr_cq_item, prev),
     };
     uint64_t h = 0xcbf29ce484222325ULL;
     for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++) h = mix(h, parts[k]);
@@ -248,7 +248,6 @@ static void transfer(cursor *c, gr_edmd *s)
         IO(c, q->item[id].t);
         IO(c, q->item[id].next);
         IO(c, q->item[id].prev);
-        IO(c, q->item[id].where);
     }
     io(c, q->head, (size_t)q->nb * sizeof *q->head);
     if (q->n_near < 0 || q->n_near > n) { /* read: not to size the loop below */
@@ -262,7 +261,6 @@ static void transfer(cursor *c, gr_edmd *s)
 
     io(c, s->cells.head, (size_t)s->cells.ncells * sizeof *s->cells.head);
     io(c, s->cells.next, (size_t)n * sizeof *s->cells.next);
-    io(c, s->cells.prev, (size_t)n * sizeof *s->cells.prev);
 
     if (s->nl.shell > 0.0) {
         io(c, s->nl.centre, (size_t)n * (d + 1) * sizeof *s->nl.centre);
@@ -330,7 +328,6 @@ static void free_state(gr_edmd *t)
     free(t->queue.near);
     free(t->cells.head);
     free(t->cells.next);
-    free(t->cells.prev);
     free(t->cells.occ);
     free(t->nl.centre);
     free(t->nl.rows);
@@ -356,7 +353,6 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     t->queue.near = malloc(n * sizeof(gr_cq_near));
     t->cells.head = gr_big_alloc((size_t)s->cells.ncells * sizeof(int32_t));
     t->cells.next = gr_big_alloc(n * sizeof(int32_t));
-    t->cells.prev = gr_big_alloc(n * sizeof(int32_t));
     t->cells.occ = calloc(cell_occ_words(s->cells.ncells), sizeof(uint64_t));
     const int lists = s->nl.shell > 0.0;
     t->nl.centre = lists ? gr_big_alloc(n * (d + 1) * sizeof(double)) : NULL;
@@ -365,7 +361,7 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     t->nl.built = s->nl.built ? malloc(n * sizeof(double)) : NULL;
     if ((s->nl.built && !t->nl.built) ||!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
         !t->order.id_of || !t->big.is_big || !t->queue.item || !t->queue.head || !t->queue.near || !t->cells.head ||
-        !t->cells.next || !t->cells.prev || !t->cells.occ ||
+        !t->cells.next || !t->cells.occ ||
         (lists && (!t->nl.centre || !t->nl.rows))) {
         free_state(t);
         return GR_ERR_NOMEM;
@@ -544,7 +540,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
     }
 
     /* the queue (its own invariants), then the cell lists: each particle that is not
-     * big in exactly the list of its cell, back links right */
+     * big in exactly the list of its cell */
     memset(seen, 0, (size_t)n);
     const char *fault = gr_cq_check(&t->queue, seen);
     if (fault) return fault;
@@ -552,14 +548,12 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
     const gr_cells *g = &t->cells;
     int32_t filed = 0;
     for (int32_t cell = 0; cell < g->ncells; cell++) {
-        int32_t prev = -1;
         for (int32_t i = g->head[cell]; i != -1; i = g->next[i]) {
-            if (i < 0 || i >= n || seen[i] || t->big.is_big[i] || g->prev[i] != prev ||
+            if (i < 0 || i >= n || seen[i] || t->big.is_big[i] ||
                 cell_of(g, d, t->sched[i].c) != cell)
                 return "the cell lists are corrupt";
             seen[i] = 1;
             filed++;
-            prev = i;
         }
     }
     if (filed != n - t->big.n) return "the cell lists do not hold every particle";

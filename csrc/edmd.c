@@ -51,7 +51,6 @@
         GR_PREFETCH(rec((s), (dim), (i)));                                              \
         GR_PREFETCH(&(s)->sched[(i)]);                                                  \
         GR_PREFETCH(&(s)->cells.next[(i)]);                                             \
-        GR_PREFETCH(&(s)->cells.prev[(i)]);                                             \
         GR_CQ_PREFETCH(&(s)->queue, (i));                                               \
         if ((s)->nl.shell > 0.0) GR_PREFETCH(nl_row(&(s)->nl, (i)));                    \
     } while (0)

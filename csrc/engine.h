@@ -110,8 +110,9 @@ struct gr_edmd {
 #define TIME(p, dim) ((p)[2 * (dim)])
 #define RAD(p, dim) ((p)[2 * (dim) + 1])
 
-/* doubles per particle record: x[dim] v[dim] t r */
-#define GR_STRIDE(dim) (2 * (dim) + 2)
+/* doubles per particle record: x[dim] v[dim] t r, padded to 8 (64 bytes, one cache line:
+ * a 2D record of 6 doubles would straddle two lines every other time) */
+#define GR_STRIDE(dim) ((2 * (dim) + 2 + 7) / 8 * 8)
 
 /* Particle i's record.  With dim a constant of the loop the stride is too: the address
  * is a shift, not a multiplication waiting on a load of the stride (in the scans, that

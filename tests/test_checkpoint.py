@@ -795,15 +795,16 @@ def _small(boundary="periodic", restitution=1.0, **kw):
 
 def _edit_records(data, scene, change):
     """The checkpoint with change(P, image) applied to the engine state's particle records
-    (n x stride doubles: x, v, clock, radius) and image counters (n x d int64), which lie
-    either side of the masses; no renumbering below 4096 particles: scene order."""
+    (n x 8 doubles: x, v, clock, radius, padded to one cache line) and image counters
+    (n x d int64), which lie either side of the masses; no renumbering below 4096
+    particles: scene order."""
 
     def edit(state):
         at = bytes(state).find(scene.masses.tobytes())
         assert at > 0 and bytes(state).count(scene.masses.tobytes()) == 1
         n, d = scene.n, scene.dim
-        p0, i0 = at - 8 * n * (2 * d + 2), at + 8 * n
-        records = np.frombuffer(state[p0:at], np.float64).reshape(n, 2 * d + 2).copy()
+        p0, i0 = at - 8 * n * 8, at + 8 * n
+        records = np.frombuffer(state[p0:at], np.float64).reshape(n, 8).copy()
         image = np.frombuffer(state[i0 : i0 + 8 * n * d], np.int64).reshape(n, d).copy()
         change(records, image)
         state[p0:at] = records.tobytes()

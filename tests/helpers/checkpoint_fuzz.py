@@ -145,13 +145,14 @@ def _with_state(members, state):
 
 def _records_at(state, velocities):
     """Offsets of the particle records, masses and image counters in an engine state: the
-    records (x, v, clock, radius each) start d doubles before particle 0's velocity (no
-    renumbering below 4096 particles: scene order), then come n masses, then n x d images."""
+    records (x, v, clock, radius each, padded to 8 doubles) start d doubles before particle
+    0's velocity (no renumbering below 4096 particles: scene order), then come n masses,
+    then n x d images."""
     n, d = velocities.shape
     at = state.find(velocities[0].tobytes()) - 8 * d
     if at < 0:
         return None
-    masses = at + 8 * n * (2 * d + 2)
+    masses = at + 8 * n * 8
     return at, masses, masses + 8 * n
 
 
@@ -177,7 +178,7 @@ def _edit_state(state, edit, velocities):
         _, i, field, value = edit
         i %= n
         if kind == "record":  # field: 0..d-1 position, d..2d-1 velocity, 2d clock, 2d+1 radius
-            k = records + 8 * (i * (2 * d + 2) + field % (2 * d + 2))
+            k = records + 8 * (i * 8 + field % (2 * d + 2))
             state[k : k + 8] = np.float64(value).tobytes()
         else:
             k = images + 8 * (i * d + field % d)
