@@ -7,6 +7,9 @@ temperature (or heat alike) as the smooth one does.
 
     python rough_cachegrind.py prep DIR
     python rough_cachegrind.py run DIR CASE rough|smooth EVENTS
+
+`--tiny` runs prep and every case, rough and smooth, for a few hundred events in a temporary
+folder (that it works, not a measurement).
 """
 
 import sys
@@ -21,12 +24,15 @@ from edmd_perf import lattice, radius_for
 N, ETA = 1000, 0.065
 
 
-def prep(folder):
+CASES = ("periodic", "sheared", "vibrating wall", "gravity", "vibrated bed")
+
+
+def prep(folder, tiny=False):
     rng = np.random.default_rng(1)
     vel = rng.normal(size=(N, 3))
     vel -= vel.mean(0)
     sim = Simulation(Scene(lattice(N, 3), vel, radius_for(N, 3, ETA)))
-    sim.run(stop_when={"collisions_per_particle": 5.0}, store=())
+    sim.run(stop_when={"collisions_per_particle": 0.5 if tiny else 5.0}, store=())
     sc = sim.scene
     np.savez(f"{folder}/rough-base.npz", pos=sc.positions, vel=sc.velocities, r=sc.radii)
 
@@ -56,12 +62,23 @@ def scene(folder, case, rough):
     return s
 
 
+def run(folder, case, kind, events):
+    sim = Simulation(scene(folder, case, kind == "rough"))
+    if events:
+        sim.run(stop_when={"events": events}, store=())
+    print("pairs", sim.stats["pair_collisions"], "events", sim.stats["events"], case, kind)
+
+
 if __name__ == "__main__":
-    if sys.argv[1] == "prep":
+    if sys.argv[1] == "--tiny":
+        import tempfile
+
+        with tempfile.TemporaryDirectory() as tmp:
+            prep(tmp, tiny=True)
+            for case in CASES:
+                for kind in ("smooth", "rough"):
+                    run(tmp, case, kind, 300)
+    elif sys.argv[1] == "prep":
         prep(sys.argv[2])
     else:
-        folder, case, kind, events = sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5])
-        sim = Simulation(scene(folder, case, kind == "rough"))
-        if events:
-            sim.run(stop_when={"events": events}, store=())
-        print("pairs", sim.stats["pair_collisions"], "events", sim.stats["events"])
+        run(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5]))
