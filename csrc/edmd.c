@@ -473,6 +473,30 @@ static inline int streak(gr_edmd *s, int32_t i, double t)
     return e->streak > GR_COLLAPSE_STREAK;
 }
 
+/* The collision rule on the pair (i, j) at separation dr, velocities vp, vq (vq an image's
+ * in a sheared box): the rough rule (rule.h) in the units that compile it, with the spins
+ * as they are (the images slide, they do not turn) and its loss booked (translation and
+ * rotation: the kinetic energy alone cannot tell it; stats' collision_loss), else the smooth
+ * one.  tc_elastic: the TC model made this collision elastic, and so smooth (it keeps the
+ * energy).  Returns the virial (rule_pair_apply). */
+static GR_ALWAYS_INLINE double pair_rule(gr_edmd *s, int dim, int laws, int32_t i, int32_t j,
+                                         const double *dr, double *vp, double *vq,
+                                         double ri, double rj, double xi, int tc_elastic)
+{
+    if (GR_UNIT_ROUGH && GR_RULE_IS_ROUGH(laws)) {
+        const int w = dim == 2 ? 1 : 3; /* spin components */
+        const double beta = tc_elastic ? -1.0 : s->cfg.tangential_restitution;
+        double loss;
+        const double vir = rule_rough_apply(dim, dr, vp, vq, s->spin + (size_t)i * w,
+                                            s->spin + (size_t)j * w, s->mass[i], s->mass[j],
+                                            ri, rj, s->cfg.inertia_factor, xi, beta,
+                                            s->cfg.friction, &loss);
+        s->collision_loss += loss;
+        return vir;
+    }
+    return rule_pair_apply(dim, dr, vp, vq, s->mass[i], s->mass[j], xi);
+}
+
 static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int32_t i, int32_t j,
                                     double t, gr_error *err)
 {
@@ -494,22 +518,8 @@ static GR_ALWAYS_INLINE int do_pair(gr_edmd *s, int dyn, int dim, int laws, int3
     double vb[6]; /* the velocities before, for the stress tensor */
     if (s->cfg.stress)
         for (int a = 0; a < dim; a++) vb[a] = VEL(p, dim)[a], vb[3 + a] = VEL(q, dim)[a];
-    double vir;
-    if (GR_RULE_IS_ROUGH(laws)) { /* compiled into the rough loops only */
-        const int w = dim == 2 ? 1 : 3; /* spin components */
-        /* the TC model's elastic collision is smooth too: it keeps the energy */
-        const double beta =
-            s->elastic_tc != elastic_before ? -1.0 : s->cfg.tangential_restitution;
-        double loss;
-        vir = rule_rough_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->spin + (size_t)i * w,
-                               s->spin + (size_t)j * w, s->mass[i], s->mass[j], RAD(p, dim),
-                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction,
-                               &loss);
-        /* translation and rotation: kinetic alone cannot tell it (stats' collision_loss) */
-        s->collision_loss += loss;
-    } else {
-        vir = rule_pair_apply(dim, dr, VEL(p, dim), VEL(q, dim), s->mass[i], s->mass[j], xi);
-    }
+    const double vir = pair_rule(s, dim, laws, i, j, dr, VEL(p, dim), VEL(q, dim), RAD(p, dim),
+                                 RAD(q, dim), xi, s->elastic_tc != elastic_before);
     if (vir < 0.0) { /* grazing: no longer approaching at contact after rounding */
         s->invalid++;
         predict(s, dyn, dim, i);
@@ -686,22 +696,9 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
         stress_le_peculiar(s, dim, p, t, Vb);
         stress_le_peculiar(s, dim, q, t, Vb + 3);
     }
-    double vir;
-    if (GR_UNIT_ROUGH && GR_RULE_IS_ROUGH(laws)) {
-        /* the rough rule (do_pair) on the image's velocity vq; the spins are the same in
-         * every image (the images slide, they do not turn) */
-        const int w = dim == 2 ? 1 : 3;
-        const double beta =
-            s->elastic_tc != elastic_before ? -1.0 : s->cfg.tangential_restitution;
-        double loss;
-        vir = rule_rough_apply(dim, dr, VEL(p, dim), vq, s->spin + (size_t)i * w,
-                               s->spin + (size_t)j * w, s->mass[i], s->mass[j], RAD(p, dim),
-                               RAD(q, dim), s->cfg.inertia_factor, xi, beta, s->cfg.friction,
-                               &loss);
-        s->collision_loss += loss; /* (as do_pair's: the same in every frame) */
-    } else {
-        vir = rule_pair_apply(dim, dr, VEL(p, dim), vq, s->mass[i], s->mass[j], xi);
-    }
+    /* on the image's velocity vq (the loss is the same in every frame) */
+    const double vir = pair_rule(s, dim, laws, i, j, dr, VEL(p, dim), vq, RAD(p, dim),
+                                 RAD(q, dim), xi, s->elastic_tc != elastic_before);
     if (vir < 0.0) { /* grazing (do_pair) */
         s->invalid++;
         predict(s, dyn, dim, i);
