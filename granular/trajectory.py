@@ -53,8 +53,9 @@ class Trajectory:
         last value of a run that ends with a sample)
     collision_loss : (T,) cumulative kinetic energy pair and wall collisions dissipated
         since the simulation began, or None without a vibrating wall; between two samples
-        the kinetic (plus potential, under gravity) energy changed by the differences of
-        ``wall_work`` less those of ``collision_loss`` (``wall_power``)
+        the kinetic (plus potential, under gravity; plus rotational, for rough particles)
+        energy changed by the differences of ``wall_work`` less those of ``collision_loss``
+        (``wall_power``)
     stop_reason : why the run ended: "time", "collisions", "kinetic_energy", "events",
         "idle" (no event will ever happen); a run cut short carries the samples so far in
         its exception's ``.trajectory``, with "error" or, after Ctrl-C, "interrupted"
@@ -338,7 +339,8 @@ class Trajectory:
         (input, loss), from ``wall_work`` and ``collision_loss``: over the run between the
         first and the last sample, or per window between consecutive samples.  Exact (the
         engine sums both at every hit and collision); their difference is the rate of change
-        of the kinetic (plus potential, under gravity) energy, zero on average in a steady
+        of the kinetic (plus potential, under gravity; plus rotational, for rough particles)
+        energy, zero on average in a steady
         state (docs/vibrated.md).
 
         Parameters
