@@ -340,8 +340,7 @@ class Trajectory:
         first and the last sample, or per window between consecutive samples.  Exact (the
         engine sums both at every hit and collision); their difference is the rate of change
         of the kinetic (plus potential, under gravity; plus rotational, for rough particles)
-        energy, zero on average in a steady
-        state (docs/vibrated.md).
+        energy, zero on average in a steady state (docs/vibrated.md).
 
         Parameters
         ----------
