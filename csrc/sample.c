@@ -206,16 +206,14 @@ void gr_edmd_get_counters(const gr_edmd *s, gr_edmd_counters *c)
     for (int a = 0; a < 3; a++) c->ncell[a] = s->cells.nc[a];
     for (int k = 0; k < 9; k++) { /* zeros without cfg.stress (calloc) */
         c->stress_collisional[k] = s->st_coll[k];
-        c->kinetic_time_tensor[k] = s->st_kin_time[k] + s->st_kin[k] * (s->t - s->stress_t);
+        c->kinetic_time_tensor[k] = s->st_kin_time[k];
         c->kinetic_tensor[k] = s->st_kin[k];
     }
-    if ((s->le || dynamics_of(s) == GR_FLIGHT_GRAVITY) && s->cfg.stress) {
-        /* the peculiar tensor, or the one under gravity: polynomial in flight (stress.h) */
+    if (s->cfg.stress) { /* K and its integral brought from stress_t to t (stress.h) */
         double k[9], kt[9];
-        const int dd = s->dim * s->dim;
         stress_kinetic_at(s, s->dim, s->t, k, kt);
-        for (int a = 0; a < dd; a++) {
-            c->kinetic_time_tensor[a] = s->st_kin_time[a] + kt[a];
+        for (int a = 0; a < s->dim * s->dim; a++) {
+            c->kinetic_time_tensor[a] += kt[a];
             c->kinetic_tensor[a] = k[a];
         }
     }
