@@ -34,8 +34,9 @@ Beyond the Maxwellian: in 3D spins and velocities become correlated in direction
 (Brilliantov, Poeschel, Kranz & Zippelius, PRL 98, 128001 (2007); Kranz et al., arXiv
 0808.1952) and the joint distribution has cumulants (Santos, Kremer & dos Santos, Phys.
 Fluids 23, 030604 (2011); Megias & Santos, arXiv 2303.00057, disks and spheres with DSMC
-and EDMD), which the root below leaves out (granular's 3D runs lie 2-3 % below it, its 2D
-runs on it); their corrections could not be read for this version (docs/rough.md).
+and EDMD), which the root below leaves out (granular's 3D runs lie 1-3 % below it, its 2D
+runs on it; tools/rough_spin_balance.py measures the correlation and finds it carries the
+3D deficit); their corrections could not be read for this version (docs/rough.md).
 
 Self-diffusion of rough spheres: the literature gives it for constant xi and beta
 (Bodrova & Brilliantov, Granular Matter 14, 85 (2012), doi:10.1007/s10035-012-0319-2, with a
