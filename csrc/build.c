@@ -135,9 +135,12 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     for (int a = 0; a < d; a++)
         if (cfg->periodic && !(s->L[a] > 2.0 * (sigma_max + 4.0 * shell))) shell = 0.0;
     if (n >= GR_NL_MAX_N) shell = 0.0;
+    /* under shear a list's life is bounded by a strain that the box must leave room for */
+    if (sheared && shell > 0.0 && !(gr_nlist_shear_strain(d, s->L, sigma_max, shell) >= 0.1))
+        shell = 0.0;
     if (status == GR_OK && shell > 0.0) {
         status = gr_nlist_init(&s->nl, d, n, shell, s->L);
-        if (status == GR_OK && sheared) status = gr_nlist_shear(&s->nl, n, s->le_u);
+        if (status == GR_OK && sheared) status = gr_nlist_shear(&s->nl, d, n, cfg->shear_rate, cfg->lo, s->L, sigma_max);
         s->big.r_small = 0.5 * sigma_max; /* no big particles */
     } else if (status == GR_OK) {
         status = gr_big_choose(&s->big, d, n, radius, s->L, sheared ? INFINITY : cfg->big_ratio,

@@ -15,6 +15,7 @@
 #include "drive.h"
 #include "engine.h"
 #include "hugemem.h"
+#include "le_cells.h"
 #include "scene_params.h"
 
 static const char magic[8] = {'G', 'R', 'E', 'D', 'M', 'D', 'C', 'K'};
@@ -272,7 +273,10 @@ static void transfer(cursor *c, gr_edmd *s)
             }
             io(c, nl_row(&s->nl, i), (size_t)nn * sizeof(int32_t));
         }
-        if (s->nl.built) io(c, s->nl.built, (size_t)n * sizeof *s->nl.built); /* sheared */
+        if (s->nl.built) { /* sheared */
+            io(c, s->nl.built, (size_t)n * sizeof *s->nl.built);
+            IO(c, s->nl.tref);
+        }
     }
 }
 
@@ -496,8 +500,7 @@ static const char *check_state(const gr_edmd *t, const gr_edmd *s, uint8_t *seen
         }
         if (s->nl.shell > 0.0 && !same_double(t->nl.centre[(size_t)i * (d + 1) + d], RAD(p, d)))
             return "a neighbour list's centre is corrupt";
-        if (t->nl.built && !(t->nl.built[i] == INFINITY ||
-                             (t->nl.built[i] >= 0.0 && t->nl.built[i] <= t->t)))
+        if (t->nl.built && !(t->nl.built[i] >= 0.0 && t->nl.built[i] <= t->t))
             return "a neighbour list's build time is out of range";
         if (t->spin)
             for (int k = 0; k < GR_SPIN_DIM(d); k++)
@@ -569,58 +572,31 @@ static int listed(const gr_edmd *t, int32_t i, int32_t e)
     return 0;
 }
 
-/* check_lists' pairs through a sliding y face (nlist.h): each pair of shrinking shells
- * whose centres were within reach at the later of their builds is listed, through its y
- * and z image with no x image.  From i's window at its own build (le_nlist.h: five
- * columns about the image of its centre): at j's later build the image has slid by less
- * than 2 delta since (i's shell was alive), still within the window. */
+/* check_lists in a sheared box (nlist.h, le_cells.h): every centre filed where the flow
+ * carries it at the filing time, and every pair listed whose centres were within reach at
+ * the later of their builds (up to rounding, as check_lists), through the image found
+ * then. */
 static const char *check_sheared_lists(const gr_edmd *t)
 {
     const int d = t->dim;
-    const gr_cells *g = &t->cells;
-    const int32_t nx = g->nc[0];
-    for (int32_t i = 0; i < t->n; i++) { /* shrinking exactly next to a sliding face */
-        const int32_t c1 = t->sched[i].c[1];
-        if ((t->nl.built[i] < INFINITY) != (c1 == 0 || c1 == g->nc[1] - 1))
-            return "a neighbour list's shell shrinks away from a sliding face, or not next to one";
+    if (!(isfinite(t->nl.tref) && t->nl.tref <= t->t + t->nl.span))
+        return "a neighbour list's filing time is out of range";
+    for (int32_t i = 0; i < t->n; i++) {
+        const double *ci = t->nl.centre + (size_t)i * (d + 1);
+        int32_t c[3] = {0, 0, 0};
+        cell_coords(&t->cells, d, ci, c);
+        c[0] = le_column(&t->cells, &t->nl, ci, t->nl.built[i]);
+        if (cell_of(&t->cells, d, c) != cell_of(&t->cells, d, t->sched[i].c))
+            return "a neighbour list's centre is filed in another cell than the flow's";
     }
     for (int32_t i = 0; i < t->n; i++) {
         const double tbi = t->nl.built[i];
-        if (!(tbi < INFINITY)) continue;
         const double *ci = t->nl.centre + (size_t)i * (d + 1);
-        const int32_t *c = t->sched[i].c;
-        const double delta_i = bd_le_offset(t->cfg.shear_offset, t->le_u, tbi, t->L[0]);
-        for (int ky = -1; ky <= 1; ky += 2) {
-            const int32_t r = c[1] + ky;
-            if (r >= 0 && r < g->nc[1]) continue; /* not across the face */
-            const int32_t q1 = r - ky * g->nc[1];
-            for (int kz = 0; kz < (d == 3 ? 3 : 1); kz++) {
-                const int32_t q2 = d == 3 ? g->nb_cell[2][3 * c[2] + kz] : 0;
-                const double sh[3] = {0.0, (double)ky * t->L[1],
-                                      d == 3 ? g->nb_shift[2][3 * c[2] + kz] : 0.0};
-                const int32_t code = nl_code(d, sh);
-                const int32_t K0 = (int32_t)floor((ci[0] - g->lo[0] - ky * delta_i) / g->w[0]) - 2;
-                for (int32_t K = K0; K < K0 + 5; K++) {
-                    const int32_t cell = (q2 * g->nc[1] + q1) * nx + bd_cell_wrap(K, nx);
-                    for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
-                        const double tbj = t->nl.built[j];
-                        if (j == i || !(tbj < INFINITY)) continue;
-                        const double tb = tbi > tbj ? tbi : tbj;
-                        const double *cj = t->nl.centre + (size_t)j * (d + 1);
-                        const double delta = bd_le_offset(t->cfg.shear_offset, t->le_u, tb, t->L[0]);
-                        double d2 = 0.0;
-                        for (int a = 0; a < d; a++) {
-                            double x = cj[a] + sh[a] - ci[a];
-                            if (a == 0) x = bd_nearest(x + ky * delta, t->L[0]);
-                            d2 += x * x;
-                        }
-                        const double cut = (ci[d] + cj[d] + 2.0 * t->nl.shell) * (1.0 - 1e-9);
-                        if (d2 < cut * cut && !listed(t, i, (j << GR_NL_BITS) | code))
-                            return "a neighbour list misses a particle within reach through "
-                                   "a sliding face";
-                    }
-                }
-            }
+        const int32_t m = le_gather(t, d, ci, tbi, i, 0, 1.0 - 1e-9, t->nl.near);
+        for (int32_t k = 0; k < m; k++) {
+            const int32_t j = t->nl.near[k] >> GR_NL_BITS;
+            if (t->nl.built[j] <= tbi && !listed(t, i, t->nl.near[k]))
+                return "a neighbour list misses a particle within reach";
         }
     }
     return NULL;
@@ -644,12 +620,12 @@ static const char *check_lists(const gr_edmd *t)
                 return "a neighbour list is not listed back the other way";
         }
     }
+    if (t->le) return check_sheared_lists(t);
     for (int32_t i = 0; i < t->n; i++) {
         const double *ci = t->nl.centre + (size_t)i * (d + 1);
         gr_nbr nb[27];
         const int count = cell_neighbours(&t->cells, d, t->sched[i].c, -1, 0, nb);
         for (int k = 0; k < count; k++) {
-            if (t->le && nb[k].shift[1] != 0.0) continue; /* sliding: check_sheared_lists */
             const int32_t code = nl_code(d, nb[k].shift);
             for (int32_t j = t->cells.head[nb[k].cell]; j >= 0; j = t->cells.next[j]) {
                 const double *cj = t->nl.centre + (size_t)j * (d + 1);
@@ -664,7 +640,7 @@ static const char *check_lists(const gr_edmd *t)
             }
         }
     }
-    return t->le ? check_sheared_lists(t) : NULL;
+    return NULL;
 }
 
 int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error *err)

@@ -849,6 +849,7 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
     int wrapped = 0;
     if (s->le) {
         wrapped = le_list_reenter(s, dyn, dim, i, t); /* through a sliding face too */
+        if (t > s->nl.tref + s->nl.span) le_refile(s, dim, t); /* (le_cells.h) */
     } else if (s->cfg.periodic) {
         for (int a = 0; a < dim; a++) /* not wrapped |= ...: that costs the cell-crossing
                                         * loop 5 instructions an event (cachegrind) */
@@ -918,11 +919,17 @@ static void predict(gr_edmd *s, int dyn, int dim, int32_t i)
     predict_wall(s, dyn, dim, i);
     if (s->nl.shell > 0.0 && s->le) { /* the sliding images (le_nlist.h) */
         le_shell_exit(s, dyn, dim, i);
+        /* only a centre in a row next to a y face can list through it: the others scan
+         * as in a plain box */
+        const int face = le_edge_row(&s->cells, s->sched[i].c[1]);
 #ifdef GR_SCAN_X86
-        if (dim == 3 && dyn == GR_FLIGHT_LINEAR && scan_avx2) scan_list_avx2_sheared(s, i);
-        else
+        if (dim == 3 && dyn == GR_FLIGHT_LINEAR && scan_avx2) {
+            if (face) scan_list_avx2_sheared(s, i);
+            else scan_list_avx2(s, i);
+        } else
 #endif
-            le_scan_list(s, dyn, dim, i);
+        if (face) le_scan_list(s, dyn, dim, i);
+        else scan_list(s, dyn, dim, i);
     } else if (s->nl.shell > 0.0) {
         const double *p = rec(s, dim, i);
         s->sched[i].t_cross = TIME(p, dim) + fl_exit_time(dyn, dim, p, VEL(p, dim),
@@ -1054,6 +1061,7 @@ static int start(gr_edmd *s, int dyn, int dim, gr_error *err)
 {
     if (s->nl.shell > 0.0) {
         for (int32_t i = 0; i < s->n; i++) set_centre(s, dim, i); /* the cells as filed */
+        if (s->le) le_refile(s, dim, s->t); /* ... but for the flow's (le_cells.h) */
         for (int32_t i = 0; i < s->n; i++) {
             int status = link_all(s, dim, i, find_near(s, dim, i, 1), err);
             if (status != GR_OK) return status;

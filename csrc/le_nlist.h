@@ -12,59 +12,26 @@
 
 #include "engine.h"
 
-/* The first column of the five whose images, displaced by ky delta, can hold a centre
- * within a cell width (>= the lists' reach) of x: the column the image of x falls in,
- * less two (one for the reach, one to spare for rounding). */
-static inline int32_t le_window(const gr_cells *g, double x, int ky, double delta)
-{
-    return (int32_t)floor((x - g->lo[0] - (double)ky * delta) / g->w[0]) - 2;
-}
-
-/* find_near for a centre in a cell next to a y face (c[1] in an edge row): the rows
- * within the box as cells.h tabulates them, the row across the face through the window
- * of five columns at delta now (le_window).  Entries through the face carry their y
- * (and z) image only (nl_code with no x shift): the scans take the x image nearest at
- * their time. */
+/* find_near in a sheared box: the centres carried by the flow to i's clock (le_cells.h). */
 static int32_t le_find_near(gr_edmd *s, int dim, int32_t i, int above)
 {
-    const gr_cells *g = &s->cells;
     const double *ci = s->nl.centre + (size_t)i * (dim + 1);
-    const double reach = ci[dim] + 2.0 * s->nl.shell;
-    const int32_t *c = s->sched[i].c, nx = g->nc[0];
-    const double t = TIME(rec(s, dim, i), dim);
-    const double delta = bd_le_offset(s->cfg.shear_offset, s->le_u, t, s->L[0]);
-    const int nz = dim == 3 ? 3 : 1;
-    int32_t m = 0;
-    for (int dy = -1; dy <= 1; dy++) {
-        const int32_t r = c[1] + dy;
-        const int ky = r < 0 ? -1 : r >= g->nc[1] ? 1 : 0; /* the image of that row */
-        const int32_t q1 = r - ky * g->nc[1];
-        for (int kz = 0; kz < nz; kz++) {
-            const int32_t q2 = dim == 3 ? g->nb_cell[2][3 * c[2] + kz] : 0;
-            double shift[3] = {0.0, (double)ky * s->L[1],
-                               dim == 3 ? g->nb_shift[2][3 * c[2] + kz] : 0.0};
-            const int32_t rowbase = (q2 * g->nc[1] + q1) * nx;
-            if (!ky) {
-                for (int kx = 0; kx < 3; kx++) {
-                    shift[0] = g->nb_shift[0][3 * c[0] + kx];
-                    const int32_t cell = rowbase + g->nb_cell[0][3 * c[0] + kx];
-                    if (cell_occupied(g, cell))
-                        m = near_in_cell(s, dim, i, ci, reach, cell, shift, nl_code(dim, shift),
-                                         above, m);
-                }
-                continue;
-            }
-            const int32_t code = nl_code(dim, shift); /* shift[0] = 0: no x image */
-            const int32_t K0 = le_window(g, ci[0], ky, delta);
-            for (int32_t K = K0; K < K0 + 5; K++) {
-                const int32_t k = bd_cell_wrap(K, nx);
-                if (!cell_occupied(g, rowbase + k)) continue;
-                shift[0] = (double)ky * delta + (double)((K - k) / nx) * s->L[0];
-                m = near_in_cell(s, dim, i, ci, reach, rowbase + k, shift, code, above, m);
-            }
-        }
+    return le_gather(s, dim, ci, TIME(rec(s, dim, i), dim), i, above, 1.0, s->nl.near);
+}
+
+/* File every list centre anew where the flow carries it at t + span (le_cells.h), so
+ * that searches from t to t + 2 span see a window of at most 1 + GR_NL_TILT times their
+ * reach either way. */
+static void le_refile(gr_edmd *s, int dim, double t)
+{
+    gr_cells *g = &s->cells;
+    s->nl.tref = t + s->nl.span;
+    gr_cells_clear(g);
+    for (int32_t i = s->n - 1; i >= 0; i--) { /* each cell's list in increasing order */
+        gr_sched *e = &s->sched[i];
+        e->c[0] = le_column(g, &s->nl, s->nl.centre + (size_t)i * (dim + 1), s->nl.built[i]);
+        cell_insert(g, i, cell_of(g, dim, e->c));
     }
-    return m;
 }
 
 /* One listed candidate j through a y face (image shift sh: y and z; ky = sign of its y):
@@ -111,27 +78,39 @@ static void le_scan_list(gr_edmd *s, int dyn, int dim, int32_t i)
     keep_pair(s, dim, i, best, partner);
 }
 
-/* The radius a shrinking shell built at tb has at time t: delta less the plain shell's
- * hair (nlist.c), less 2^-48 (|D(tb)| + L_x) for delta(t)'s rounding (the offset's
- * ulp at most, at the build and at a scan), less the shrink |u|/2 (t - tb). */
-static inline double le_shell_radius(const gr_edmd *s, double tb, double t)
+/* The radius of i's shell (built at tb) at time t: delta less the plain shell's hair
+ * (nlist.c), less 2^-48 (|D(tb)| + L_x) for the rounding of the centre carried by the flow
+ * and of delta(t) (at most the offset's ulp), less the shrink h (t - tb). */
+static inline double le_shell_radius(const gr_edmd *s, double tb, double t, double h)
 {
     const double D = bd_le_total(s->cfg.shear_offset, s->le_u, tb);
-    return s->nl.shell * (1.0 - 1e-9) - 0x1p-48 * (fabs(D) + s->L[0]) - s->nl.shrink * (t - tb);
+    return s->nl.shell * (1.0 - 1e-9) - 0x1p-48 * (fabs(D) + s->L[0]) - h * (t - tb);
 }
 
-/* List mode in a sheared box, i's clock at the present: its shell exit (shrinking next to
- * a y face, nlist.h); edmd.c predict then scans its list (le_scan_list, or in 3D on AVX2
- * CPUs scan_list_avx2_sheared: the same bits). */
+/* List mode in a sheared box, i's clock at the present: its shell exit (nlist.h): when
+ * it leaves the shell about its centre carried by the flow, a shell that shrinks at
+ * |rate| (r_i + delta) / 2, or when the list's life ends (the strain it may last, and the
+ * drift of its centre); edmd.c predict then scans its list (le_scan_list, or in 3D on
+ * AVX2 CPUs scan_list_avx2_sheared: the same bits). */
 static void le_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i)
 {
-    const double *p = rec(s, dim, i), *centre = s->nl.centre + (size_t)i * (dim + 1);
-    const double tb = s->nl.built[i], t = TIME(p, dim);
-    const double exit =
-        tb < INFINITY ? fl_shrink_exit_time(dyn, dim, p, VEL(p, dim), s->cfg.gravity, centre,
-                                            le_shell_radius(s, tb, t), s->nl.shrink)
-                      : fl_exit_time(dyn, dim, p, VEL(p, dim), s->cfg.gravity, centre,
-                                     s->nl.exit2);
+    const gr_nlist *nl = &s->nl;
+    const double *p = rec(s, dim, i), *c = nl->centre + (size_t)i * (dim + 1);
+    const double tb = nl->built[i], t = TIME(p, dim);
+    const double w = nl->rate * (c[1] - nl->yc); /* the flow at the centre */
+    double centre[3], v[3];
+    for (int a = 0; a < dim; a++) {
+        centre[a] = c[a];
+        v[a] = VEL(p, dim)[a];
+    }
+    centre[0] = le_centre_x(nl, c, tb, t);
+    v[0] -= w;
+    const double h = 0.5 * fabs(nl->rate) * (c[dim] + nl->shell);
+    double exit = fl_shrink_exit_time(dyn, dim, p, v, s->cfg.gravity, centre,
+                                      le_shell_radius(s, tb, t, h), h);
+    const double life = fabs(w) * nl->life > nl->drift ? nl->drift / fabs(w) : nl->life;
+    const double left = tb + life - t;
+    if (left < exit) exit = left > 0.0 ? left : 0.0;
     s->sched[i].t_cross = t + exit;
 }
 

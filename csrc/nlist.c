@@ -26,12 +26,28 @@ int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *
     return nl->centre && nl->rows && nl->near && nl->mark ? GR_OK : GR_ERR_NOMEM;
 }
 
-int gr_nlist_shear(gr_nlist *nl, int32_t n, double u)
+double gr_nlist_shear_strain(int dim, const double *L, double sigma_max, double shell)
 {
-    nl->shrink = 0.5 * fabs(u);
+    double lmin = L[0];
+    for (int a = 1; a < dim; a++) lmin = fmin(lmin, L[a]);
+    /* e^(strain / 2) (sigma + 2 delta) + 2 delta within 0.49 L (nlist.h), at most 1 */
+    const double room = (0.49 * lmin - 2.0 * shell) / (sigma_max + 2.0 * shell);
+    return room > 1.0 ? fmin(1.0, 2.0 * log(room)) : 0.0;
+}
+
+int gr_nlist_shear(gr_nlist *nl, int dim, int32_t n, double rate, const double *lo,
+                   const double *L, double sigma_max)
+{
+    nl->rate = rate;
+    nl->yc = lo[1] + 0.5 * L[1];
+    nl->r_max = 0.5 * sigma_max;
+    nl->life = 0.999 * gr_nlist_shear_strain(dim, L, sigma_max, nl->shell) / fabs(rate);
+    nl->drift = 0.999 * (0.25 * L[0] - nl->shell);
+    nl->span = GR_NL_TILT / fabs(rate);
+    nl->tref = nl->span;
     nl->built = malloc((size_t)n * sizeof *nl->built);
     if (!nl->built) return GR_ERR_NOMEM;
-    for (int32_t i = 0; i < n; i++) nl->built[i] = INFINITY;
+    for (int32_t i = 0; i < n; i++) nl->built[i] = 0.0;
     return GR_OK;
 }
 

@@ -60,6 +60,9 @@
 #define GR_NL_CAP_MAX 16384
 #define GR_NL_CAP_START(dim) ((dim) == 3 ? 32 : 16) /* rows' capacity before any growth */
 #define GR_NL_BITS 5
+/* a sheared box's centres are filed anew when the strain since their filing time passes
+ * this, as |rate (t - t_ref)| (le_cells.h) */
+#define GR_NL_TILT 0.05
 #define GR_NL_CODE_MASK ((1 << GR_NL_BITS) - 1)
 /* the image code in the low GR_NL_BITS bits leaves list mode n < 2^26 */
 #define GR_NL_MAX_N ((int64_t)1 << (31 - GR_NL_BITS))
@@ -73,9 +76,15 @@ typedef struct {
     int32_t *near;    /* n: room for a rebuild's new neighbours */
     uint8_t *mark;    /* n, all 0 but during a shell exit's relinking (search.h) */
     int broken;       /* a list could not grow: lists are incomplete, no more events */
-    double *built;    /* n, sheared boxes only (else NULL): a shrinking shell's build time,
-                       * +inf for a plain shell */
-    double shrink;    /* the shrinking shells' rate |u| / 2 (sheared boxes) */
+    /* sheared boxes only (le_cells.h, le_nlist.h): */
+    double *built;    /* n (else NULL): each list's build time */
+    double rate;      /* the shear rate: a centre moves with the flow rate (y - yc) */
+    double yc;        /* the box's middle in y, where the flow is at rest */
+    double r_max;     /* the largest radius */
+    double life;      /* a list's longest life */
+    double drift;     /* the farthest the flow may carry a centre along x */
+    double tref;      /* the time the centres are filed at (le_cells.h) */
+    double span;      /* filed anew once the time passes tref + span */
     double img[32][4];/* image code -> shift, code = sum over axes of (s_a + 1) 3^a; the
                        * fourth column 0, for loads of four (scan_avx2.h) */
 } gr_nlist;
@@ -95,9 +104,13 @@ static inline int32_t nl_code(int dim, const double *shift)
  * GR_ERR_NOMEM. */
 int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *L);
 void gr_nlist_free(gr_nlist *nl);
-/* A sheared box's lists (images sliding at speed u): the shrinking shells' build times.
- * GR_OK or GR_ERR_NOMEM. */
-int gr_nlist_shear(gr_nlist *nl, int32_t n, double u);
+/* The longest life of a sheared box's list as a shear strain |rate| t (nlist.h), for a
+ * box of sides L, the largest diameter sigma_max and a shell delta; <= 0 if the box is
+ * too small for lists under shear. */
+double gr_nlist_shear_strain(int dim, const double *L, double sigma_max, double shell);
+/* A sheared box's lists (le_cells.h): build times and the flow.  GR_OK or GR_ERR_NOMEM. */
+int gr_nlist_shear(gr_nlist *nl, int dim, int32_t n, double rate, const double *lo,
+                   const double *L, double sigma_max);
 /* Double the rows' capacity; on failure the lists are marked broken.  GR_OK or
  * GR_ERR_NOMEM. */
 int gr_nlist_grow(gr_nlist *nl, int32_t n, const gr_sched *sched);

@@ -11,6 +11,7 @@
 
 #include "collide.h"
 #include "engine.h"
+#include "le_cells.h"
 
 /* A pair that collided with each other at this very instant cannot approach again in
  * exact arithmetic (the normal relative velocity became -xi times the old one); any
@@ -248,8 +249,10 @@ static inline void set_centre(gr_edmd *s, int dim, int32_t i)
     centre[dim] = RAD(p, dim);
     for (int a = 0; a < dim; a++) centre[a] = p[a];
     cell_coords(&s->cells, dim, p, s->sched[i].c);
-    if (s->nl.built) /* sheared: next to a y face its shell shrinks from now (nlist.h) */
-        s->nl.built[i] = le_edge_row(&s->cells, s->sched[i].c[1]) ? TIME(p, dim) : INFINITY;
+    if (s->nl.built) { /* sheared: filed where the flow carries it (le_cells.h) */
+        s->nl.built[i] = TIME(p, dim);
+        s->sched[i].c[0] = le_column(&s->cells, &s->nl, centre, TIME(p, dim));
+    }
 }
 
 /* List mode, for find_near: append to s->nl.near (m entries so far) every particle j of
@@ -289,6 +292,7 @@ static int32_t find_near(gr_edmd *s, int dim, int32_t i, int above)
     const double reach = ci[dim] + 2.0 * s->nl.shell;
     /* first the new neighbours (near_in_cell), then the links */
     int32_t m = 0;
+    if (s->le) return le_find_near(s, dim, i, above);
     if (cell_interior(g, dim, s->sched[i].c)) {
         /* away from the box edge (the common case): no image shifts, no wrapping */
         const int32_t base = cell_of(g, dim, s->sched[i].c);
@@ -299,7 +303,6 @@ static int32_t find_near(gr_edmd *s, int dim, int32_t i, int above)
         }
         return m;
     }
-    if (s->le && le_edge_row(g, s->sched[i].c[1])) return le_find_near(s, dim, i, above);
     gr_nbr nb[27];
     const int count = cell_neighbours(g, dim, s->sched[i].c, -1, 0, nb);
     for (int k = 0; k < count; k++) {
