@@ -304,6 +304,32 @@ def test_lists_see_the_sliding_images_of_particles_at_rest(dim):
     np.testing.assert_allclose(tr.positions[-1], rx[-1], rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_lists_catch_a_pair_the_mean_flow_brings_together(dim):
+    """Two spheres (radius 0.5, shell 0.25: reach 1.5) moving exactly with the mean flow
+    never leave shells carried by it; their centres start 1.17 apart along x and 0.95
+    along y (1.507: not listed), in the quadrant where the flow closes the gap.  They touch
+    after a strain of (1.17 - sqrt(1 - 0.95^2)) / 0.95 = 0.90, within a list's longest life
+    (strain 1 in this box); only the shells' shrinking at |rate| (r + delta) / 2 (a strain
+    of 2 delta / (r + delta) = 0.67 to nothing) rebuilds the lists before.  With the
+    shrinking off the spheres pass through each other (the reference has them collide)."""
+    rate, L = 1.0, 10.0
+    z = [5.0] if dim == 3 else []
+    pos = np.array([[4.0, 5.475, *z], [5.17, 4.525, *z]])
+    vel = np.zeros((2, dim))
+    vel[:, 0] = rate * (pos[:, 1] - L / 2)
+    box = (np.zeros(dim), np.full(dim, L))
+    s = Scene(pos, vel, 0.5, box=box, shear_rate=rate)
+    t_hit = (1.17 - math.sqrt(1 - 0.95**2)) / 0.95 / rate
+    sim = Simulation(s, shell=0.25)
+    tr = sim.run(t_stop=t_hit + 0.5, sample_times=[t_hit + 0.5])
+    assert sim.stats["shell"] == 0.25 and sim.stats["pair_collisions"] == 1
+    rx, rv, _, _ = _reference(s, t_hit + 0.5, [t_hit - 1e-6, t_hit + 0.5])
+    np.testing.assert_allclose(rv[0], vel, atol=1e-12)  # not before
+    np.testing.assert_allclose(tr.velocities[-1], rv[-1], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(tr.positions[-1], rx[-1], rtol=0, atol=1e-9)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("dim,n,eta,rate", [(2, 300, 0.6, 0.1), (3, 400, 0.45, 0.2)])
 def test_lists_never_let_a_pair_overlap_in_a_dense_sheared_gas(dim, n, eta, rate):
