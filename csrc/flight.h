@@ -252,42 +252,6 @@ static inline double fl_exit_time(int dyn, int dim, const double *x, const doubl
     return b > 0.0 ? -c / (b + q) : (q - b) / a;
 }
 
-/* A shell that shrinks at rate h (a sheared box's lists next to a sliding face, nlist.h):
- * when |x(t) - centre| + h t first reaches `radius` (the shell's radius now, > 0 or the
- * exit is now), the time from now.  Along a straight line f(t) = |d + v t| + h t - radius
- * is convex, negative now and grows without bound (h > 0), so it has one root; it is the
- * first root of A t^2 + 2 B t + C = 0 (|d + v t|^2 = (radius - h t)^2) with A = v.v - h^2,
- * B = d.v + radius h, C = d.d - radius^2 < 0, because the squared form is positive at
- * t = radius / h.  Without cancellation: -C / (B + sqrt D) when B > 0 (then the smaller
- * root whatever the sign of A), else (sqrt D - B) / A, where A > 0 (A <= 0 needs B > 0
- * for the root to exist).  Under gravity the bound of fl_exit_time_gravity with h added
- * to the speed: an early exit only rebuilds the list early.  Out of line: only sheared
- * lists call it. */
-static GR_NOINLINE double fl_shrink_exit_time(int dyn, int dim, const double *x, const double *v,
-                                              const double *g, const double *centre,
-                                              double radius, double h)
-{
-    double A = -h * h, B = radius * h, C = -radius * radius, d2 = 0.0, v2 = 0.0, g2 = 0.0;
-    for (int k = 0; k < dim; k++) {
-        const double d = x[k] - centre[k];
-        A += v[k] * v[k];
-        B += d * v[k];
-        d2 += d * d;
-        v2 += v[k] * v[k];
-        g2 += g[k] * g[k];
-    }
-    C += d2;
-    if (!(radius > 0.0) || C >= 0.0) return 0.0; /* shrunk to nothing, or out by rounding */
-    if (dyn == GR_FLIGHT_GRAVITY) {
-        const double room = radius - sqrt(d2), speed = sqrt(v2) + h, half_g = 0.5 * sqrt(g2);
-        return 2.0 * room / (speed + sqrt(speed * speed + 4.0 * half_g * room));
-    }
-    const double disc = B * B - A * C, q = sqrt(disc > 0.0 ? disc : 0.0);
-    if (B > 0.0) return -C / (B + q);
-    if (A > 0.0) return (q - B) / A;
-    return h > 0.0 ? 0.0 : INFINITY; /* by rounding: leave now; h = 0 and at rest: never */
-}
-
 /* The kinetic energy of one particle of mass m, velocity v (at the particle's clock). */
 static inline double fl_kinetic(int dyn, int dim, double m, const double *v)
 {

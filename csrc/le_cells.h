@@ -33,11 +33,14 @@ static inline int32_t le_column(const gr_cells *g, const gr_nlist *nl, const dou
     return bd_cell_wrap((int32_t)f, g->nc[0]); /* |f| stays below ~2 nc (nlist.h) */
 }
 
-/* Every particle j whose list centre, carried to time t, lies within
- * scale (r_i + r_j + 2 delta) of the point ci (radius ci[dim]) through some image: as
- * list entries (j << GR_NL_BITS | image code) in out; skipping `self`, and j <= self if
- * `above`.  An entry through a y face carries its y (and z) image only, one within the
- * box its x image as well (-L_x, 0 or L_x).  Returns how many. */
+/* Every particle j whose list centre, carried by the flow from time t on for a list's
+ * longest life, comes within scale (r_i + r_j + 2 delta) of the point ci (radius ci[dim])
+ * carried likewise, through some image: as list entries (j << GR_NL_BITS | image code)
+ * in out; skipping `self`, and j <= self if `above`.  The flow changes the separation
+ * only along x, at rate (dy), so over the life its x part runs linearly from dx to
+ * dx + sweep dy: its smallest square is 0 if that passes 0, else the smaller end's.  An
+ * entry through a y face carries its y (and z) image only, one within the box its x image
+ * as well (-L_x, 0 or L_x).  Returns how many. */
 static int32_t le_gather(const gr_edmd *s, int dim, const double *ci, double t, int32_t self,
                          int above, double scale, int32_t *out)
 {
@@ -50,7 +53,8 @@ static int32_t le_gather(const gr_edmd *s, int dim, const double *ci, double t, 
     const double dref = bd_le_offset(s->cfg.shear_offset, s->le_u, nl->tref, Lx);
     /* the window's half width in the filing coordinate, with room for its rounding */
     const double tilt = fabs(nl->rate * (t - nl->tref));
-    const double half = (reach + nl->r_max) * (1.0 + tilt) +
+    const double sweep = nl->rate * nl->life;
+    const double half = (reach + nl->r_max) * (1.0 + tilt + fabs(sweep)) +
                         1e-9 * (Lx + fabs(s->le_u) * (fabs(t) + fabs(nl->tref)));
     const double xref = le_centre_x(nl, ci, t, nl->tref);
     const int32_t nx = g->nc[0];
@@ -87,8 +91,9 @@ static int32_t le_gather(const gr_edmd *s, int dim, const double *ci, double t, 
                         sx = (raw < -0.5 * Lx) - (raw > 0.5 * Lx);
                         dx = raw + (double)sx * Lx;
                     }
-                    const double ddy = cj[1] + yoff;
-                    double d2 = dx * dx + ddy * ddy;
+                    const double ddy = cj[1] + yoff, end = dx + sweep * ddy;
+                    const double dx2 = dx * dx, end2 = end * end;
+                    double d2 = (dx * end <= 0.0 ? 0.0 : dx2 < end2 ? dx2 : end2) + ddy * ddy;
                     if (dim == 3) {
                         const double ddz = cj[2] + zoff;
                         d2 += ddz * ddz;

@@ -78,20 +78,11 @@ static void le_scan_list(gr_edmd *s, int dyn, int dim, int32_t i)
     keep_pair(s, dim, i, best, partner);
 }
 
-/* The radius of i's shell (built at tb) at time t: delta less the plain shell's hair
- * (nlist.c), less 2^-48 (|D(tb)| + L_x) for the rounding of the centre carried by the flow
- * and of delta(t) (at most the offset's ulp), less the shrink h (t - tb). */
-static inline double le_shell_radius(const gr_edmd *s, double tb, double t, double h)
-{
-    const double D = bd_le_total(s->cfg.shear_offset, s->le_u, tb);
-    return s->nl.shell * (1.0 - 1e-9) - 0x1p-48 * (fabs(D) + s->L[0]) - h * (t - tb);
-}
-
-/* List mode in a sheared box, i's clock at the present: its shell exit (nlist.h): when
- * it leaves the shell about its centre carried by the flow, a shell that shrinks at
- * |rate| (r_i + delta) / 2, or when the list's life ends (the strain it may last, and the
- * drift of its centre); edmd.c predict then scans its list (le_scan_list, or in 3D on
- * AVX2 CPUs scan_list_avx2_sheared: the same bits). */
+/* List mode in a sheared box, i's clock at the present: its shell exit (nlist.h), when
+ * it leaves the shell about its centre carried by the flow, or when the list's life ends
+ * (the strain it may last, and the drift of its centre); edmd.c predict then scans its
+ * list.  The shell is the plain one less 2^-48 (|D(tb)| + L_x), for the rounding of the
+ * centre carried by the flow and of delta(t) (at most the offset's ulp). */
 static void le_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i)
 {
     const gr_nlist *nl = &s->nl;
@@ -105,9 +96,11 @@ static void le_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i)
     }
     centre[0] = le_centre_x(nl, c, tb, t);
     v[0] -= w;
-    const double h = 0.5 * fabs(nl->rate) * (c[dim] + nl->shell);
-    double exit = fl_shrink_exit_time(dyn, dim, p, v, s->cfg.gravity, centre,
-                                      le_shell_radius(s, tb, t, h), h);
+    const double D = bd_le_total(s->cfg.shear_offset, s->le_u, tb);
+    const double radius = nl->shell * (1.0 - 1e-9) - 0x1p-48 * (fabs(D) + s->L[0]);
+    double exit = radius > 0.0 ? fl_exit_time(dyn, dim, p, v, s->cfg.gravity, centre,
+                                              radius * radius)
+                               : 0.0;
     const double life = fabs(w) * nl->life > nl->drift ? nl->drift / fabs(w) : nl->life;
     const double left = tb + life - t;
     if (left < exit) exit = left > 0.0 ? left : 0.0;

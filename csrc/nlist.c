@@ -41,7 +41,8 @@ int gr_nlist_shear(gr_nlist *nl, int dim, int32_t n, double rate, const double *
     nl->rate = rate;
     nl->yc = lo[1] + 0.5 * L[1];
     nl->r_max = 0.5 * sigma_max;
-    nl->life = 0.999 * gr_nlist_shear_strain(dim, L, sigma_max, nl->shell) / fabs(rate);
+    nl->life = 0.999 * fmin(GR_NL_STRAIN, gr_nlist_shear_strain(dim, L, sigma_max, nl->shell)) /
+               fabs(rate);
     nl->drift = 0.999 * (0.25 * L[0] - nl->shell);
     nl->span = GR_NL_TILT / fabs(rate);
     nl->tref = nl->span;

@@ -63,6 +63,10 @@
 /* a sheared box's centres are filed anew when the strain since their filing time passes
  * this, as |rate (t - t_ref)| (le_cells.h) */
 #define GR_NL_TILT 0.05
+/* a sheared box's list lives at most this strain, |rate| t (nlist.h) */
+#ifndef GR_NL_STRAIN
+#define GR_NL_STRAIN 0.3
+#endif
 #define GR_NL_CODE_MASK ((1 << GR_NL_BITS) - 1)
 /* the image code in the low GR_NL_BITS bits leaves list mode n < 2^26 */
 #define GR_NL_MAX_N ((int64_t)1 << (31 - GR_NL_BITS))
