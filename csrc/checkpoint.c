@@ -275,6 +275,7 @@ static void transfer(cursor *c, gr_edmd *s)
         }
         if (s->nl.built) { /* sheared */
             io(c, s->nl.built, (size_t)n * sizeof *s->nl.built);
+            io(c, s->nl.lap, (size_t)n * sizeof *s->nl.lap);
             IO(c, s->nl.tref);
         }
     }
@@ -336,6 +337,7 @@ static void free_state(gr_edmd *t)
     free(t->nl.centre);
     free(t->nl.rows);
     free(t->nl.built);
+    free(t->nl.lap);
 }
 
 /* t: a copy of s whose replaceable arrays are fresh, sized as s's (neighbour rows with
@@ -363,7 +365,8 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     t->nl.rows = lists ? gr_big_alloc(n * (size_t)cap * sizeof(int32_t)) : NULL;
     t->nl.cap = cap;
     t->nl.built = s->nl.built ? malloc(n * sizeof(double)) : NULL;
-    if ((s->nl.built && !t->nl.built) ||!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
+    t->nl.lap = s->nl.built ? malloc(n) : NULL;
+    if ((s->nl.built && (!t->nl.built || !t->nl.lap)) ||!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
         !t->order.id_of || !t->big.is_big || !t->queue.item || !t->queue.head || !t->queue.near || !t->cells.head ||
         !t->cells.next || !t->cells.occ ||
         (lists && (!t->nl.centre || !t->nl.rows))) {
@@ -572,27 +575,30 @@ static int listed(const gr_edmd *t, int32_t i, int32_t e)
     return 0;
 }
 
-/* check_lists in a sheared box (nlist.h, le_cells.h): every centre filed where the flow
- * carries it at the filing time, and every pair listed whose centres were within reach at
- * the later of their builds (up to rounding, as check_lists), through the image found
- * then. */
+/* check_lists in a sheared box (nlist.h, le_cells.h): every centre filed in the box, in
+ * the cell of its filed x, with at most a lap; and every pair listed whose centres, carried
+ * by the flow from the later of their builds for a list's life, come within reach (up to
+ * rounding, as check_lists), through the image found then. */
 static const char *check_sheared_lists(const gr_edmd *t)
 {
     const int d = t->dim;
+    const gr_cells *g = &t->cells;
     if (!(isfinite(t->nl.tref) && t->nl.tref <= t->t + t->nl.span))
         return "a neighbour list's filing time is out of range";
     for (int32_t i = 0; i < t->n; i++) {
         const double *ci = t->nl.centre + (size_t)i * (d + 1);
         int32_t c[3] = {0, 0, 0};
-        cell_coords(&t->cells, d, ci, c);
-        c[0] = le_column(&t->cells, &t->nl, ci, t->nl.built[i]);
-        if (cell_of(&t->cells, d, c) != cell_of(&t->cells, d, t->sched[i].c))
+        cell_coords(g, d, ci, c);
+        if (!(ci[0] >= g->lo[0] && ci[0] < g->lo[0] + t->nl.lx) || t->nl.lap[i] < -1 ||
+            t->nl.lap[i] > 1 || cell_of(g, d, c) != cell_of(g, d, t->sched[i].c))
             return "a neighbour list's centre is filed in another cell than the flow's";
     }
     for (int32_t i = 0; i < t->n; i++) {
         const double tbi = t->nl.built[i];
         const double *ci = t->nl.centre + (size_t)i * (d + 1);
-        const int32_t m = le_gather(t, d, ci, tbi, i, 0, 1.0 - 1e-9, t->nl.near);
+        const double point[4] = {le_centre_x(&t->nl, ci, t->nl.lap[i], tbi), ci[1],
+                                 d == 3 ? ci[2] : ci[d], ci[d]};
+        const int32_t m = le_gather(t, d, point, tbi, i, 0, 1.0 - 1e-9, t->nl.near);
         for (int32_t k = 0; k < m; k++) {
             const int32_t j = t->nl.near[k] >> GR_NL_BITS;
             if (t->nl.built[j] <= tbi && !listed(t, i, t->nl.near[k]))

@@ -1,14 +1,17 @@
 /* le_cells.h -- a sheared box's list centres in the cells: filed where the mean flow
  * carries them at a reference time, and found again from any instant (nlist.h has why).
  *
- * A list centre c_j built at t_j moves with the flow, c_j(t) = c_j + w_j (t - t_j) e_x with
- * w_j = rate (c_j,y - y_c).  It is filed in the cell of c_j(t_ref): a coordinate that does
- * not change while its list lives.  Seen from a point P at time t, a centre within R of
- * P has |x_j(t_ref) - P_x(t_ref)| <= R (1 + |rate (t - t_ref)|), P_x(t_ref) being where the
- * flow would carry P at t_ref; so the cells to search are a window of columns that widens
- * with |t - t_ref|, and edmd.c files every centre anew (le_refile) when it grows past a
- * quarter of R.  Across a y face the flow's images sit a fixed offset D(t_ref) apart in
- * this coordinate, because the images slide at u = rate L_y, as the flow does.
+ * A list centre moves with the flow, c(t) = c + w (t - t_b) e_x with w = rate (c_y - y_c).
+ * What its record keeps as x is where the flow carries it at the filing time t_ref,
+ * brought into the box; `lap` holds the box lengths dropped so, so that
+ *   c_x(t) = x + lap L_x + rate (t - t_ref) (c_y - y_c),
+ * and the centre is filed in the cell of that x: a coordinate that does not change while
+ * its list lives.  Seen from a point P at time t, a centre within R of P has a filed x
+ * within R (1 + |rate (t - t_ref)|) of where the flow would carry P at t_ref; so the
+ * cells to search are a window of columns that widens with |t - t_ref|, and edmd.c files
+ * every centre anew (le_refile) when the strain since t_ref passes GR_NL_TILT.  Across a y
+ * face the images of the flow sit a fixed offset D(t_ref) apart in this coordinate:
+ * the images slide at u = rate L_y, as the flow does.
  *
  * Static functions shared by the event loop (le_nlist.h) and the checkpoint's check of
  * the lists (checkpoint.c). */
@@ -19,44 +22,55 @@
 
 #include "engine.h"
 
-/* The x of centre c (built at tb) carried by the flow to time t. */
-static inline double le_centre_x(const gr_nlist *nl, const double *c, double tb, double t)
+/* The x of centre record c (lap its laps) at time t, carried by the flow. */
+static inline double le_centre_x(const gr_nlist *nl, const double *c, int lap, double t)
 {
-    return c[0] + nl->rate * (c[1] - nl->yc) * (t - tb);
+    return c[0] + (double)lap * nl->lx + nl->rate * (t - nl->tref) * (c[1] - nl->yc);
 }
 
-/* The column of the cell a centre c built at tb is filed in: that of where the flow
- * carries it at t_ref, wrapped around the box. */
-static inline int32_t le_column(const gr_cells *g, const gr_nlist *nl, const double *c, double tb)
+/* File centre record c, whose x at time t is x: its x where the flow carries it at
+ * t_ref, brought into the box, and *lap; returns its column. */
+static inline int32_t le_file(const gr_cells *g, const gr_nlist *nl, double *c, int8_t *lap,
+                              double x, double t)
 {
-    const double f = floor((le_centre_x(nl, c, tb, nl->tref) - g->lo[0]) / g->w[0]);
-    return bd_cell_wrap((int32_t)f, g->nc[0]); /* |f| stays below ~2 nc (nlist.h) */
+    double X = x + nl->rate * (nl->tref - t) * (c[1] - nl->yc);
+    const double k = floor((X - g->lo[0]) / nl->lx); /* |k| <= 1: the drift is bounded */
+    X -= k * nl->lx;
+    int8_t laps = (int8_t)k;
+    if (X >= g->lo[0] + nl->lx) { /* by rounding */
+        X -= nl->lx;
+        laps++;
+    }
+    c[0] = X;
+    *lap = laps;
+    const double f = floor((X - g->lo[0]) / g->w[0]);
+    return f < 0.0 ? 0 : f >= g->nc[0] ? g->nc[0] - 1 : (int32_t)f;
 }
 
 /* Every particle j whose list centre, carried by the flow from time t on for a list's
- * longest life, comes within scale (r_i + r_j + 2 delta) of the point ci (radius ci[dim])
+ * longest life, comes within scale (r_i + r_j + 2 delta) of the point ci (x y z r at t)
  * carried likewise, through some image: as list entries (j << GR_NL_BITS | image code)
  * in out; skipping `self`, and j <= self if `above`.  The flow changes the separation
  * only along x, at rate (dy), so over the life its x part runs linearly from dx to
- * dx + sweep dy: its smallest square is 0 if that passes 0, else the smaller end's.  An
- * entry through a y face carries its y (and z) image only, one within the box its x image
- * as well (-L_x, 0 or L_x).  Returns how many. */
-static int32_t le_gather(const gr_edmd *s, int dim, const double *ci, double t, int32_t self,
-                         int above, double scale, int32_t *out)
+ * dx + sweep dy: its smallest square is 0 if that passes 0, else the smaller end's.  The
+ * window's columns hold each centre once, at the image the window wraps it to: the one
+ * within reach, if any.  An entry through a y face carries its y (and z) image only, one
+ * within the box its x image as well (-L_x, 0 or L_x: that of the window less the
+ * centre's laps).  Returns how many. */
+static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const double *ci, double t,
+                                          int32_t self, int above, double scale, int32_t *out)
 {
     const gr_cells *g = &s->cells;
     const gr_nlist *nl = &s->nl;
-    const double Lx = s->L[0], reach = ci[dim] + 2.0 * nl->shell;
+    const double Lx = nl->lx, reach = ci[dim] + 2.0 * nl->shell;
     int32_t c[3] = {0, 0, 0};
     cell_coords(g, dim, ci, c); /* y and z: the rows; x is taken from the flow below */
-    const double delta = bd_le_offset(s->cfg.shear_offset, s->le_u, t, Lx);
     const double dref = bd_le_offset(s->cfg.shear_offset, s->le_u, nl->tref, Lx);
-    /* the window's half width in the filing coordinate, with room for its rounding */
-    const double tilt = fabs(nl->rate * (t - nl->tref));
-    const double sweep = nl->rate * nl->life;
-    const double half = (reach + nl->r_max) * (1.0 + tilt + fabs(sweep)) +
+    const double theta = nl->rate * (t - nl->tref), sweep = nl->rate * nl->life;
+    /* the window's half width in the filed x, with room for its rounding */
+    const double half = (reach + nl->r_max) * (1.0 + fabs(theta) + fabs(sweep)) +
                         1e-9 * (Lx + fabs(s->le_u) * (fabs(t) + fabs(nl->tref)));
-    const double xref = le_centre_x(nl, ci, t, nl->tref);
+    const double xref = ci[0] - theta * (ci[1] - nl->yc);
     const int32_t nx = g->nc[0];
     const int nz = dim == 3 ? 3 : 1;
     int32_t m = 0;
@@ -68,7 +82,11 @@ static int32_t le_gather(const gr_edmd *s, int dim, const double *ci, double t, 
         const int32_t K0 = (int32_t)floor((x0 - half) / g->w[0]);
         int32_t K1 = (int32_t)floor((x0 + half) / g->w[0]);
         if (K1 > K0 + nx - 1) K1 = K0 + nx - 1; /* each cell once */
-        const double yoff = (double)ky * s->L[1] - ci[1], xoff = (double)ky * delta;
+        /* the separation from ci of a centre (filed x, y) in this row, less its laps:
+         * x + theta y + xoff (+ the window's wrap), y + yoff */
+        const double yoff = (double)ky * s->L[1] - ci[1];
+        const double xoff = (double)ky * dref + theta * ((double)ky * s->L[1] - nl->yc) - ci[0];
+        const int32_t inbox = !ky; /* an x image in the entry: within the box only */
         for (int kz = 0; kz < nz; kz++) {
             const int32_t q2 = dim == 3 ? g->nb_cell[2][3 * c[2] + kz] : 0;
             const double shz = dim == 3 ? g->nb_shift[2][3 * c[2] + kz] : 0.0;
@@ -77,29 +95,22 @@ static int32_t le_gather(const gr_edmd *s, int dim, const double *ci, double t, 
             const int32_t code0 = 3 * (ky + 1) + 9 * ((shz > 0.0) - (shz < 0.0) + 1) * (dim == 3);
             const int32_t rowbase = (q2 * g->nc[1] + q1) * nx;
             for (int32_t K = K0; K <= K1; K++) {
-                const int32_t cell = rowbase + bd_cell_wrap(K, nx);
+                const int32_t k = bd_cell_wrap(K, nx), cell = rowbase + k;
                 if (!cell_occupied(g, cell)) continue;
+                const int32_t wrap = (K - k) / nx; /* the window's image: -1, 0 or 1 */
+                const double xcell = xoff + (double)wrap * Lx;
+                const int32_t code1 = code0 + 1 + inbox * wrap;
                 for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
                     const double *cj = nl->centre + (size_t)j * (dim + 1);
-                    /* the centres stay within L_x / 4 of the box (nlist.h): one step */
-                    const double raw = le_centre_x(nl, cj, nl->built[j], t) - ci[0];
-                    double dx;
-                    int32_t sx = 0;
-                    if (ky) {
-                        dx = bd_nearest(bd_nearest(raw, Lx) + xoff, Lx);
-                    } else {
-                        sx = (raw < -0.5 * Lx) - (raw > 0.5 * Lx);
-                        dx = raw + (double)sx * Lx;
-                    }
-                    const double ddy = cj[1] + yoff, end = dx + sweep * ddy;
-                    const double dx2 = dx * dx, end2 = end * end;
+                    const double dx = cj[0] + theta * cj[1] + xcell, ddy = cj[1] + yoff;
+                    const double end = dx + sweep * ddy, dx2 = dx * dx, end2 = end * end;
                     double d2 = (dx * end <= 0.0 ? 0.0 : dx2 < end2 ? dx2 : end2) + ddy * ddy;
                     if (dim == 3) {
                         const double ddz = cj[2] + zoff;
                         d2 += ddz * ddz;
                     }
                     const double cut = scale * (cj[dim] + reach);
-                    out[m] = (j << GR_NL_BITS) | (code0 + sx + 1);
+                    out[m] = (j << GR_NL_BITS) | (code1 - inbox * nl->lap[j]);
                     m += (d2 < cut * cut) & (j != self) & (!above | (j > self));
                 }
             }

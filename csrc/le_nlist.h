@@ -12,24 +12,29 @@
 
 #include "engine.h"
 
-/* find_near in a sheared box: the centres carried by the flow to i's clock (le_cells.h). */
+/* find_near in a sheared box, from i's position (its new centre) at its clock
+ * (le_cells.h). */
 static int32_t le_find_near(gr_edmd *s, int dim, int32_t i, int above)
 {
-    const double *ci = s->nl.centre + (size_t)i * (dim + 1);
-    return le_gather(s, dim, ci, TIME(rec(s, dim, i), dim), i, above, 1.0, s->nl.near);
+    const double *p = rec(s, dim, i);
+    const double point[4] = {p[0], p[1], dim == 3 ? p[2] : RAD(p, dim), RAD(p, dim)};
+    return le_gather(s, dim, point, TIME(p, dim), i, above, 1.0, s->nl.near);
 }
 
 /* File every list centre anew where the flow carries it at t + span (le_cells.h), so
- * that searches from t to t + 2 span see a window of at most 1 + GR_NL_TILT times their
- * reach either way. */
+ * that searches from t to t + 2 span see a window widened by a strain of at most
+ * GR_NL_TILT. */
 static void le_refile(gr_edmd *s, int dim, double t)
 {
     gr_cells *g = &s->cells;
-    s->nl.tref = t + s->nl.span;
+    gr_nlist *nl = &s->nl;
+    const double tref = nl->tref;
+    nl->tref = t + nl->span;
     gr_cells_clear(g);
     for (int32_t i = s->n - 1; i >= 0; i--) { /* each cell's list in increasing order */
         gr_sched *e = &s->sched[i];
-        e->c[0] = le_column(g, &s->nl, s->nl.centre + (size_t)i * (dim + 1), s->nl.built[i]);
+        double *c = nl->centre + (size_t)i * (dim + 1);
+        e->c[0] = le_file(g, nl, c, &nl->lap[i], c[0] + (double)nl->lap[i] * nl->lx, tref);
         cell_insert(g, i, cell_of(g, dim, e->c));
     }
 }
@@ -94,7 +99,7 @@ static void le_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i)
         centre[a] = c[a];
         v[a] = VEL(p, dim)[a];
     }
-    centre[0] = le_centre_x(nl, c, tb, t);
+    centre[0] = le_centre_x(nl, c, nl->lap[i], t);
     v[0] -= w;
     const double D = bd_le_total(s->cfg.shear_offset, s->le_u, tb);
     const double radius = nl->shell * (1.0 - 1e-9) - 0x1p-48 * (fabs(D) + s->L[0]);

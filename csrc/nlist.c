@@ -46,8 +46,10 @@ int gr_nlist_shear(gr_nlist *nl, int dim, int32_t n, double rate, const double *
     nl->drift = 0.999 * (0.25 * L[0] - nl->shell);
     nl->span = GR_NL_TILT / fabs(rate);
     nl->tref = nl->span;
+    nl->lx = L[0];
     nl->built = malloc((size_t)n * sizeof *nl->built);
-    if (!nl->built) return GR_ERR_NOMEM;
+    nl->lap = calloc((size_t)n, sizeof *nl->lap);
+    if (!nl->built || !nl->lap) return GR_ERR_NOMEM;
     for (int32_t i = 0; i < n; i++) nl->built[i] = 0.0;
     return GR_OK;
 }
@@ -55,6 +57,7 @@ int gr_nlist_shear(gr_nlist *nl, int dim, int32_t n, double rate, const double *
 void gr_nlist_free(gr_nlist *nl)
 {
     free(nl->built);
+    free(nl->lap);
     free(nl->centre);
     free(nl->rows);
     free(nl->near);

@@ -82,6 +82,8 @@ typedef struct {
     int broken;       /* a list could not grow: lists are incomplete, no more events */
     /* sheared boxes only (le_cells.h, le_nlist.h): */
     double *built;    /* n (else NULL): each list's build time */
+    int8_t *lap;      /* n: the box lengths from a centre's filed x to the flow's (le_cells.h) */
+    double lx;        /* L_x */
     double rate;      /* the shear rate: a centre moves with the flow rate (y - yc) */
     double yc;        /* the box's middle in y, where the flow is at rest */
     double r_max;     /* the largest radius */

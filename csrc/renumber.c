@@ -56,7 +56,10 @@ int gr_renumber(gr_edmd *s)
     PERMUTE(s->order.id_of, int32_t, 1);
     PERMUTE(s->big.is_big, uint8_t, 1);
     if (lists) PERMUTE(s->nl.centre, double, (size_t)d + 1);
-    if (s->nl.built) PERMUTE(s->nl.built, double, 1);
+    if (s->nl.built) {
+        PERMUTE(s->nl.built, double, 1);
+        PERMUTE(s->nl.lap, int8_t, 1);
+    }
 #undef PERMUTE
     if (lists) {
         for (int32_t i = 0; i < n; i++) {

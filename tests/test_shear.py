@@ -424,31 +424,31 @@ def test_a_sheared_list_that_misses_a_pair_is_refused():
     0.12 apart, reach 0.1 + 2 x 0.025) list each other through the image of y shift -L
     and no x image (code 1 + 3 * 0 + 9 * 1 = 10, its opposite 16); listed as if in the
     box instead (13 both ways: symmetric) the pair is missing and the state is refused.
-    A build time in the future is refused, and so is a filing time (csrc/le_cells.h) at
-    which the flow (rate 0.1, the lower sphere 0.46 below the middle) would carry the
-    lower centre half a box along x, out of the cell it is filed in.  The state ends with
-    the rows (one entry each, j << 5 | code), the build times (two doubles) and the
-    filing time (one double)."""
+    A build time in the future is refused, and so is a centre's lap (the box lengths
+    between its filed x and the flow's, csrc/le_cells.h) that no drift can reach.  The
+    state ends with the rows (one entry each, j << 5 | code), the build times (two
+    doubles), the laps (two bytes) and the filing time (one double)."""
     pos = [[0.5, 0.04, 0.5], [0.5, 0.92, 0.5]]
     s = Scene(pos, [[0.0, 0.1, 0.0], [0.0, -0.1, 0.0]], 0.05, shear_rate=0.1)
     sim = Simulation(s, shell=0.25)
     state = bytearray(sim._engine.save_state())
-    rows = np.frombuffer(bytes(state[-32:-24]), np.int32)
+    rows = np.frombuffer(bytes(state[-34:-26]), np.int32)
     assert sorted(rows >> 5) == [0, 1] and sorted(rows & 31) == [10, 16]
-    assert list(np.frombuffer(bytes(state[-24:-8]), np.float64)) == [0.0, 0.0]
+    assert list(np.frombuffer(bytes(state[-26:-10]), np.float64)) == [0.0, 0.0]
+    assert list(state[-10:-8]) == [0, 0]
     sim._engine.restore_state(bytes(state))  # as saved: fine
     inside = bytearray(state)
-    inside[-32:-24] = ((rows & ~31) | 13).astype(np.int32).tobytes()
+    inside[-34:-26] = ((rows & ~31) | 13).astype(np.int32).tobytes()
     with pytest.raises(ValueError, match="misses a particle within reach"):
         sim._engine.restore_state(bytes(inside))
     future = bytearray(state)
-    future[-24:-16] = np.float64(1.0).tobytes()
+    future[-26:-18] = np.float64(1.0).tobytes()
     with pytest.raises(ValueError, match="build time is out of range"):
         sim._engine.restore_state(bytes(future))
-    half_box = bytearray(state)
-    half_box[-8:] = np.float64(-0.5 / (0.1 * 0.46)).tobytes()
+    lapped = bytearray(state)
+    lapped[-10] = 3
     with pytest.raises(ValueError, match="filed in another cell"):
-        sim._engine.restore_state(bytes(half_box))
+        sim._engine.restore_state(bytes(lapped))
 
 
 def test_auto_uses_lists_for_a_dense_sheared_gas():
