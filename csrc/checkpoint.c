@@ -598,7 +598,8 @@ static const char *check_sheared_lists(const gr_edmd *t)
         const double *ci = t->nl.centre + (size_t)i * (d + 1);
         const double point[4] = {le_centre_x(&t->nl, ci, t->nl.lap[i], tbi), ci[1],
                                  d == 3 ? ci[2] : ci[d], ci[d]};
-        const int32_t m = le_gather(t, d, point, tbi, i, 0, 1.0 - 1e-9, t->nl.near);
+        const int32_t m = le_gather(t, d, point, tbi, i, 0, 1.0 - 1e-9, t->nl.near,
+                                    le_test_scalar);
         for (int32_t k = 0; k < m; k++) {
             const int32_t j = t->nl.near[k] >> GR_NL_BITS;
             if (t->nl.built[j] <= tbi && !listed(t, i, t->nl.near[k]))

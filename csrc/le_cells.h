@@ -47,6 +47,59 @@ static inline int32_t le_file(const gr_cells *g, const gr_nlist *nl, double *c, 
     return f < 0.0 ? 0 : f >= g->nc[0] ? g->nc[0] - 1 : (int32_t)f;
 }
 
+/* A line of cells' candidates for le_gather, tested in a batch: their indices, each
+ * one's x offset (the line's, with its cell's wrap) and image code (less its laps); and
+ * what the line shares. */
+#define GR_LE_BATCH 64
+typedef struct {
+    int32_t j[GR_LE_BATCH + 3];
+    double xoff[GR_LE_BATCH + 3];
+    int32_t code[GR_LE_BATCH + 3];
+    int n;
+    double theta, sweep, yoff, zoff, reach, scale;
+    int32_t inbox, self, above;
+} le_batch;
+
+/* Test a batch's candidates (le_gather), appending those within reach to out (m so far);
+ * returns the new count.  The separation of candidate j (centre record cj: filed x, y,
+ * z, r) from the point, less its laps: dx = x + theta y + xoff, dy = y + yoff,
+ * dz = z + zoff; over a list's life its x part runs from dx to dx + sweep dy.  The
+ * scalar test; le_nlist.h has the same in AVX2's lanes, the same bits. */
+typedef int32_t (*le_batch_test)(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
+                                 int32_t m);
+
+/* One candidate's test (as le_batch_test says), its steps in the order the lanes take. */
+static inline int le_within(const double *cj, int dim, const le_batch *b, double xoff)
+{
+    const double dx = cj[0] + b->theta * cj[1] + xoff, ddy = cj[1] + b->yoff;
+    const double end = dx + b->sweep * ddy, dx2 = dx * dx, end2 = end * end;
+    double d2 = (dx * end <= 0.0 ? 0.0 : dx2 < end2 ? dx2 : end2) + ddy * ddy;
+    if (dim == 3) {
+        const double ddz = cj[2] + b->zoff;
+        d2 += ddz * ddz;
+    }
+    const double cut = b->scale * (cj[dim] + b->reach);
+    return d2 < cut * cut;
+}
+
+/* Append candidate k of a batch that passed: its entry, laps taken off an x image. */
+static inline int32_t le_append(const gr_nlist *nl, const le_batch *b, int k, int32_t *out,
+                                int32_t m)
+{
+    const int32_t j = b->j[k];
+    out[m] = (j << GR_NL_BITS) | (b->code[k] - b->inbox * nl->lap[j]);
+    return m + ((j != b->self) & (!b->above | (j > b->self)));
+}
+
+static int32_t le_test_scalar(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
+                              int32_t m)
+{
+    for (int k = 0; k < b->n; k++)
+        if (le_within(s->nl.centre + (size_t)b->j[k] * (dim + 1), dim, b, b->xoff[k]))
+            m = le_append(&s->nl, b, k, out, m);
+    return m;
+}
+
 /* Every particle j whose list centre, carried by the flow from time t on for a list's
  * longest life, comes within scale (r_i + r_j + 2 delta) of the point ci (x y z r at t)
  * carried likewise, through some image: as list entries (j << GR_NL_BITS | image code)
@@ -56,21 +109,29 @@ static inline int32_t le_file(const gr_cells *g, const gr_nlist *nl, double *c, 
  * window's columns hold each centre once, at the image the window wraps it to: the one
  * within reach, if any.  An entry through a y face carries its y (and z) image only, one
  * within the box its x image as well (-L_x, 0 or L_x: that of the window less the
- * centre's laps).  Returns how many. */
+ * centre's laps).  Candidates are tested by `test` a line of cells at a time, in the
+ * order the cells list them.  Returns how many. */
 static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const double *ci, double t,
-                                          int32_t self, int above, double scale, int32_t *out)
+                                          int32_t self, int above, double scale, int32_t *out,
+                                          le_batch_test test)
 {
     const gr_cells *g = &s->cells;
     const gr_nlist *nl = &s->nl;
-    const double Lx = nl->lx, reach = ci[dim] + 2.0 * nl->shell;
+    const double Lx = nl->lx;
+    le_batch b;
+    b.reach = ci[dim] + 2.0 * nl->shell;
+    b.scale = scale;
+    b.self = self;
+    b.above = above;
     int32_t c[3] = {0, 0, 0};
     cell_coords(g, dim, ci, c); /* y and z: the rows; x is taken from the flow below */
     const double dref = bd_le_offset(s->cfg.shear_offset, s->le_u, nl->tref, Lx);
-    const double theta = nl->rate * (t - nl->tref), sweep = nl->rate * nl->life;
+    b.theta = nl->rate * (t - nl->tref);
+    b.sweep = nl->rate * nl->life;
     /* the window's half width in the filed x, with room for its rounding */
-    const double half = (reach + nl->r_max) * (1.0 + fabs(theta) + fabs(sweep)) +
+    const double half = (b.reach + nl->r_max) * (1.0 + fabs(b.theta) + fabs(b.sweep)) +
                         1e-9 * (Lx + fabs(s->le_u) * (fabs(t) + fabs(nl->tref)));
-    const double xref = ci[0] - theta * (ci[1] - nl->yc);
+    const double xref = ci[0] - b.theta * (ci[1] - nl->yc);
     const int32_t nx = g->nc[0];
     const int nz = dim == 3 ? 3 : 1;
     int32_t m = 0;
@@ -82,38 +143,34 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
         const int32_t K0 = (int32_t)floor((x0 - half) / g->w[0]);
         int32_t K1 = (int32_t)floor((x0 + half) / g->w[0]);
         if (K1 > K0 + nx - 1) K1 = K0 + nx - 1; /* each cell once */
-        /* the separation from ci of a centre (filed x, y) in this row, less its laps:
-         * x + theta y + xoff (+ the window's wrap), y + yoff */
-        const double yoff = (double)ky * s->L[1] - ci[1];
-        const double xoff = (double)ky * dref + theta * ((double)ky * s->L[1] - nl->yc) - ci[0];
-        const int32_t inbox = !ky; /* an x image in the entry: within the box only */
+        b.yoff = (double)ky * s->L[1] - ci[1];
+        const double xoff = (double)ky * dref + b.theta * ((double)ky * s->L[1] - nl->yc) - ci[0];
+        b.inbox = !ky; /* an x image in the entry: within the box only */
         for (int kz = 0; kz < nz; kz++) {
             const int32_t q2 = dim == 3 ? g->nb_cell[2][3 * c[2] + kz] : 0;
             const double shz = dim == 3 ? g->nb_shift[2][3 * c[2] + kz] : 0.0;
-            const double zoff = shz - (dim == 3 ? ci[2] : 0.0);
+            b.zoff = shz - (dim == 3 ? ci[2] : 0.0);
             /* the image code (nlist.h nl_code) but for its x digit */
             const int32_t code0 = 3 * (ky + 1) + 9 * ((shz > 0.0) - (shz < 0.0) + 1) * (dim == 3);
             const int32_t rowbase = (q2 * g->nc[1] + q1) * nx;
+            b.n = 0;
             for (int32_t K = K0; K <= K1; K++) {
                 const int32_t k = bd_cell_wrap(K, nx), cell = rowbase + k;
                 if (!cell_occupied(g, cell)) continue;
                 const int32_t wrap = (K - k) / nx; /* the window's image: -1, 0 or 1 */
                 const double xcell = xoff + (double)wrap * Lx;
-                const int32_t code1 = code0 + 1 + inbox * wrap;
+                const int32_t code1 = code0 + 1 + b.inbox * wrap;
                 for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
-                    const double *cj = nl->centre + (size_t)j * (dim + 1);
-                    const double dx = cj[0] + theta * cj[1] + xcell, ddy = cj[1] + yoff;
-                    const double end = dx + sweep * ddy, dx2 = dx * dx, end2 = end * end;
-                    double d2 = (dx * end <= 0.0 ? 0.0 : dx2 < end2 ? dx2 : end2) + ddy * ddy;
-                    if (dim == 3) {
-                        const double ddz = cj[2] + zoff;
-                        d2 += ddz * ddz;
+                    b.j[b.n] = j;
+                    b.xoff[b.n] = xcell;
+                    b.code[b.n] = code1;
+                    if (++b.n == GR_LE_BATCH) {
+                        m = test(s, dim, &b, out, m);
+                        b.n = 0;
                     }
-                    const double cut = scale * (cj[dim] + reach);
-                    out[m] = (j << GR_NL_BITS) | (code1 - inbox * nl->lap[j]);
-                    m += (d2 < cut * cut) & (j != self) & (!above | (j > self));
                 }
             }
+            if (b.n) m = test(s, dim, &b, out, m);
         }
     }
     return m;

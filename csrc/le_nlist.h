@@ -12,13 +12,56 @@
 
 #include "engine.h"
 
+#ifdef GR_SCAN_X86
+/* le_test_scalar (le_cells.h) in 3D, four candidates at a time in AVX2's lanes: each
+ * lane takes le_within's steps in its order, so passes exactly when it does; the lanes
+ * that pass are appended in order.  A short last group repeats its first lane, masked. */
+static GR_AVX2 int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
+                                    int32_t m)
+{
+    (void)dim;
+    const double *centre = s->nl.centre;
+    const __m256d theta = _mm256_set1_pd(b->theta), sweep = _mm256_set1_pd(b->sweep),
+                  yoff = _mm256_set1_pd(b->yoff), zoff = _mm256_set1_pd(b->zoff),
+                  reach = _mm256_set1_pd(b->reach), scale = _mm256_set1_pd(b->scale),
+                  zero = _mm256_setzero_pd();
+    for (int k = 0; k < b->n; k += 4) {
+        const double *q[4];
+        for (int l = 0; l < 4; l++) q[l] = centre + (size_t)4 * b->j[k + l < b->n ? k + l : k];
+        __m256d X, Y, Z, R;
+        GR_TRANSPOSE4(_mm256_load_pd(q[0]), _mm256_load_pd(q[1]), _mm256_load_pd(q[2]),
+                      _mm256_load_pd(q[3]), X, Y, Z, R);
+        const __m256d dx = _mm256_add_pd(_mm256_add_pd(X, _mm256_mul_pd(theta, Y)),
+                                         _mm256_loadu_pd(b->xoff + k));
+        const __m256d dy = _mm256_add_pd(Y, yoff);
+        const __m256d end = _mm256_add_pd(dx, _mm256_mul_pd(sweep, dy));
+        const __m256d dx2 = _mm256_mul_pd(dx, dx), end2 = _mm256_mul_pd(end, end);
+        const __m256d passes = _mm256_cmp_pd(_mm256_mul_pd(dx, end), zero, _CMP_LE_OQ);
+        /* dx2 < end2 ? dx2 : end2, as _mm256_min_pd picks */
+        const __m256d least = _mm256_blendv_pd(_mm256_min_pd(dx2, end2), zero, passes);
+        const __m256d dz = _mm256_add_pd(Z, zoff);
+        const __m256d d2 = _mm256_add_pd(_mm256_add_pd(least, _mm256_mul_pd(dy, dy)),
+                                         _mm256_mul_pd(dz, dz));
+        const __m256d cut = _mm256_mul_pd(scale, _mm256_add_pd(R, reach));
+        int mask = _mm256_movemask_pd(_mm256_cmp_pd(d2, _mm256_mul_pd(cut, cut), _CMP_LT_OQ));
+        if (b->n - k < 4) mask &= (1 << (b->n - k)) - 1;
+        for (; mask; mask &= mask - 1) m = le_append(&s->nl, b, k + __builtin_ctz(mask), out, m);
+    }
+    return m;
+}
+#endif
+
 /* find_near in a sheared box, from i's position (its new centre) at its clock
- * (le_cells.h). */
+ * (le_cells.h), in AVX2's lanes in 3D on CPUs that have them (the same bits). */
 static int32_t le_find_near(gr_edmd *s, int dim, int32_t i, int above)
 {
     const double *p = rec(s, dim, i);
     const double point[4] = {p[0], p[1], dim == 3 ? p[2] : RAD(p, dim), RAD(p, dim)};
-    return le_gather(s, dim, point, TIME(p, dim), i, above, 1.0, s->nl.near);
+    le_batch_test test = le_test_scalar;
+#ifdef GR_SCAN_X86
+    if (dim == 3 && gr_scan_avx2) test = le_test_avx2;
+#endif
+    return le_gather(s, dim, point, TIME(p, dim), i, above, 1.0, s->nl.near, test);
 }
 
 /* File every list centre anew where the flow carries it at t + span (le_cells.h), so
