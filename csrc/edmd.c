@@ -680,7 +680,10 @@ static int do_pair_sheared(gr_edmd *s, int dyn, int dim, int laws, int32_t i, in
     move(s, dyn, dim, q, t);
     double dr[3], vq[3];
     for (int a = 0; a < dim; a++) dr[a] = bd_nearest(q[a] - p[a], s->L[a]);
-    const double delta = bd_le_offset(s->cfg.shear_offset, s->le_u, t, s->L[0]);
+    /* the offset (an fmod) only for a pair across a y face, the one that uses it */
+    const double delta = fabs(q[1] - p[1]) > 0.5 * s->L[1]
+                             ? bd_le_offset(s->cfg.shear_offset, s->le_u, t, s->L[0])
+                             : 0.0;
     const int ky = bd_le_image(dr, q[1] - p[1], s->L[1], s->L[0], delta);
     const double vx = (double)ky * s->le_u;
     for (int a = 0; a < dim; a++) vq[a] = VEL(q, dim)[a];

@@ -128,9 +128,9 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
     const double dref = bd_le_offset(s->cfg.shear_offset, s->le_u, nl->tref, Lx);
     b.theta = nl->rate * (t - nl->tref);
     b.sweep = nl->rate * nl->life;
-    /* the window's half width in the filed x, with room for its rounding */
-    const double half = (b.reach + nl->r_max) * (1.0 + fabs(b.theta) + fabs(b.sweep)) +
-                        1e-9 * (Lx + fabs(s->le_u) * (fabs(t) + fabs(nl->tref)));
+    /* the reach at most, and room for the window's rounding */
+    const double R = b.reach + nl->r_max;
+    const double slack = 1e-9 * (Lx + fabs(s->le_u) * (fabs(t) + fabs(nl->tref)));
     const double xref = ci[0] - b.theta * (ci[1] - nl->yc);
     const int32_t nx = g->nc[0];
     const int nz = dim == 3 ? 3 : 1;
@@ -140,8 +140,18 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
         const int ky = r < 0 ? -1 : r >= g->nc[1] ? 1 : 0; /* the image of that row */
         const int32_t q1 = r - ky * g->nc[1];
         const double x0 = xref - (double)ky * dref - g->lo[0];
-        const int32_t K0 = (int32_t)floor((x0 - half) / g->w[0]);
-        int32_t K1 = (int32_t)floor((x0 + half) / g->w[0]);
+        /* the window: a centre dy = a..b above ci (the row, within reach) has a filed x
+         * of x0 + dx - theta dy, where dx must come within R over the life: from
+         * -R - max(0, sweep dy) to R - min(0, sweep dy); the extremes over the row are
+         * at its ends */
+        const double ylo = g->lo[1] + (double)r * g->w[1] - ci[1];
+        const double ya = fmax(ylo, -R), yb = fmin(ylo + g->w[1], R);
+        const double lower = -R - fmax(fmax(0.0, b.sweep * ya) + b.theta * ya,
+                                       fmax(0.0, b.sweep * yb) + b.theta * yb);
+        const double upper = R - fmin(fmin(0.0, b.sweep * ya) + b.theta * ya,
+                                      fmin(0.0, b.sweep * yb) + b.theta * yb);
+        const int32_t K0 = (int32_t)floor((x0 + lower - slack) / g->w[0]);
+        int32_t K1 = (int32_t)floor((x0 + upper + slack) / g->w[0]);
         if (K1 > K0 + nx - 1) K1 = K0 + nx - 1; /* each cell once */
         b.yoff = (double)ky * s->L[1] - ci[1];
         const double xoff = (double)ky * dref + b.theta * ((double)ky * s->L[1] - nl->yc) - ci[0];

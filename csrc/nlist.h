@@ -65,7 +65,7 @@
 #define GR_NL_TILT 0.05
 /* a sheared box's list lives at most this strain, |rate| t (nlist.h) */
 #ifndef GR_NL_STRAIN
-#define GR_NL_STRAIN 0.3
+#define GR_NL_STRAIN 0.4
 #endif
 #define GR_NL_CODE_MASK ((1 << GR_NL_BITS) - 1)
 /* the image code in the low GR_NL_BITS bits leaves list mode n < 2^26 */
