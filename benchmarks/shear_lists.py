@@ -28,16 +28,17 @@ time only), only on gamma* and xi.  So pair collisions a CPU second compare the 
 work a collision fairly: T = 1 is a convention that keeps the figures legible.
 
     python shear_lists.py prep DIR                      # once (a minute or two)
-    python shear_lists.py run DIR CASE MODE EVENTS      # one case, one line
-    python shear_lists.py rounds DIR EVENTS ROUNDS      # interleaved, medians and ranges
+    python shear_lists.py run DIR CASE MODE EVENTS [WARMUP]   # one case, one line
+    python shear_lists.py rounds DIR EVENTS ROUNDS            # interleaved, medians, ranges
 
 CASE is eq, usf0.5 or usf1.5, or onset0.5: the equilibrium gas sheared from rest at
 gamma* = 0.5 (elastic, no mean flow yet: its first 10^5 or so events are the transient that
 an earlier measurement counted); MODE is lists (``shell="auto"``) or cells (``shell=0``).
-`run` rebuilds a Simulation from the saved state, runs EVENTS events and prints the pair
-collisions, shell exits and cell crossings a pair collision, the CPU seconds of the run
-alone (not the start-up or the build) and pair collisions a CPU second.  `rounds` runs
-every case in a fresh interpreter, ROUNDS times, the order reversed every other round.
+`run` rebuilds a Simulation from the saved state, runs WARMUP events (default 0), then
+EVENTS events and prints, of those, the pair collisions, shell exits and cell crossings a
+pair collision, the CPU seconds (not the start-up, the build or the warm-up) and pair
+collisions a CPU second.  `rounds` runs every case and mode in a fresh interpreter (WARMUP
+200 000), ROUNDS times, the order reversed every other round.
 `shear_lists.sh` counts instructions a pair collision between two event counts under
 cachegrind.  `--tiny` runs prep (N = 500, short) and each case for a few thousand events in
 a temporary folder (that it works, not a measurement).
@@ -203,31 +204,36 @@ def prep(folder, tiny=False):
             prep_usf(folder, name, eq, chunk=25.0, chunks=24, last=8)
 
 
-def run(folder, case, mode, events):
+def run(folder, case, mode, events, warmup=0):
+    """`warmup` events untimed (lists built afresh rebuild in a burst first), then `events`
+    timed; the figures are those of the timed events."""
     sim = Simulation(load(folder, case), shell=MODES[mode])
+    if warmup:
+        sim.run(stop_when={"events": warmup}, store=())
+    keys = ("events", "pair_collisions", "shell_exits", "cell_crossings")
+    s0 = sim.stats
     c0 = time.process_time()
-    sim.run(stop_when={"events": events}, store=())
+    sim.run(stop_when={"events": events}, store=())  # (events of this run)
     cpu = time.process_time() - c0
     s = sim.stats
-    pairs = s["pair_collisions"]
+    ev, pairs, exits, crossings = (s.get(k, 0) - s0.get(k, 0) for k in keys)
     print(
-        f"pairs {pairs} events {s['events']} exits {s.get('shell_exits', 0)} "
+        f"pairs {pairs} events {ev} exits {exits} crossings {crossings} "
         f"case {case} mode {mode} shell {s['shell']:g} "
-        f"exits/pair {s.get('shell_exits', 0) / pairs:.4f} "
-        f"crossings/pair {s.get('cell_crossings', 0) / pairs:.4f} cpu {cpu:.3f} "
-        f"pairs/cpu_s {pairs / cpu:.4g} T_flow {s['temperature']:.4f}"
+        f"exits/pair {exits / pairs:.4f} crossings/pair {crossings / pairs:.4f} "
+        f"cpu {cpu:.3f} pairs/cpu_s {pairs / cpu:.4g} T_flow {s['temperature']:.4f}"
     )
     return pairs / cpu
 
 
-def rounds(folder, events, count, runs):
+def rounds(folder, events, count, runs, warmup):
     """Each of `runs` (case, mode) in a fresh interpreter, `count` rounds, every other round
     in the reverse order; medians and ranges of pair collisions a CPU second."""
     rates = {r: [] for r in runs}
     for i in range(count):
         for case, mode in runs if i % 2 == 0 else runs[::-1]:
             out = subprocess.run(
-                [sys.executable, __file__, "run", folder, case, mode, str(events)],
+                [sys.executable, __file__, "run", folder, case, mode, str(events), str(warmup)],
                 capture_output=True,
                 text=True,
                 check=True,
@@ -243,17 +249,18 @@ def rounds(folder, events, count, runs):
 
 
 RUNS = [(c, m) for c in CASES for m in MODES]
+WARMUP = 200_000  # events: the burst of rebuilds after lists are built (some 20 a particle)
 
 if __name__ == "__main__":
     if sys.argv[1] == "--tiny":
         with tempfile.TemporaryDirectory() as tmp:
             prep(tmp, tiny=True)
-            rounds(tmp, 2000, 1, RUNS)
+            rounds(tmp, 2000, 1, RUNS, 500)
     elif sys.argv[1] == "prep":
         prep(sys.argv[2])
     elif sys.argv[1] == "run":
-        run(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5]))
+        run(*sys.argv[2:5], *map(int, sys.argv[5:7]))
     elif sys.argv[1] == "rounds":
-        rounds(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), RUNS)
+        rounds(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), RUNS, WARMUP)
     else:
         sys.exit(__doc__)

@@ -14,8 +14,7 @@ done
 ir() { grep '^summary:' "$dir/scg.$tag.$1.$$" | awk '{print $2}'; }
 field() { grep '^pairs' "$dir/scg.$tag.$2.$$.log" | awk -v k="$1" '{for (i = 1; i < NF; i++) if ($i == k) print $(i + 1)}'; }
 a=$(ir "$e1") b=$(ir "$e2") p=$(field pairs "$e1") q=$(field pairs "$e2")
-x=$(field exits "$e1") y=$(field exits "$e2")
-echo "$case $mode: Ir/pair $(( (b - a) / (q - p) ))  shell exits/pair" \
-    "$(echo "$x $y $p $q" | awk '{printf "%.3f", ($2 - $1) / ($4 - $3)}')" \
-    " (pairs $((q - p)) in $((e2 - e1)) events)"
+per_pair() { echo "$(field "$1" "$e1") $(field "$1" "$e2") $p $q" | awk '{printf "%.3f", ($2 - $1) / ($4 - $3)}'; }
+echo "$case $mode: Ir/pair $(( (b - a) / (q - p) ))  shell exits/pair $(per_pair exits)" \
+    " cell crossings/pair $(per_pair crossings)  (pairs $((q - p)) in $((e2 - e1)) events)"
 rm -f "$dir/scg.$tag.$e1.$$" "$dir/scg.$tag.$e2.$$" "$dir/scg.$tag.$e1.$$.log" "$dir/scg.$tag.$e2.$$.log"
