@@ -29,7 +29,7 @@ work a collision fairly: T = 1 is a convention that keeps the figures legible.
 
     python shear_lists.py prep DIR                      # once (a minute or two)
     python shear_lists.py run DIR CASE MODE EVENTS [WARMUP]   # one case, one line
-    python shear_lists.py rounds DIR EVENTS ROUNDS            # interleaved, medians, ranges
+    python shear_lists.py rounds DIR EVENTS ROUNDS [PATH_A PATH_B]  # interleaved, medians
 
 CASE is eq, usf0.5 or usf1.5, or onset0.5: the equilibrium gas sheared from rest at
 gamma* = 0.5 (elastic, no mean flow yet: its first 10^5 or so events are the transient that
@@ -38,12 +38,15 @@ an earlier measurement counted); MODE is lists (``shell="auto"``) or cells (``sh
 EVENTS events and prints, of those, the pair collisions, shell exits and cell crossings a
 pair collision, the CPU seconds (not the start-up, the build or the warm-up) and pair
 collisions a CPU second.  `rounds` runs every case and mode in a fresh interpreter (WARMUP
-200 000), ROUNDS times, the order reversed every other round.
+200 000), ROUNDS times, the order reversed every other round; given two PYTHONPATHs (two
+worktrees with their own builds), each case runs with each in turn, and the ratio B / A is
+taken round by round.
 `shear_lists.sh` counts instructions a pair collision between two event counts under
 cachegrind.  `--tiny` runs prep (N = 500, short) and each case for a few thousand events in
 a temporary folder (that it works, not a measurement).
 """
 
+import os
 import subprocess
 import sys
 import tempfile
@@ -226,26 +229,38 @@ def run(folder, case, mode, events, warmup=0):
     return pairs / cpu
 
 
-def rounds(folder, events, count, runs, warmup):
+def rounds(folder, events, count, runs, warmup, builds=(None,)):
     """Each of `runs` (case, mode) in a fresh interpreter, `count` rounds, every other round
-    in the reverse order; medians and ranges of pair collisions a CPU second."""
-    rates = {r: [] for r in runs}
+    in the reverse order; medians and ranges of pair collisions a CPU second.  `builds`:
+    PYTHONPATHs (None: this one's) run in turn for each case, A B then B A, so that two
+    builds of the engine compare run by run."""
+    rates = {(k, *r): [] for r in runs for k in range(len(builds))}
     for i in range(count):
         for case, mode in runs if i % 2 == 0 else runs[::-1]:
-            out = subprocess.run(
-                [sys.executable, __file__, "run", folder, case, mode, str(events), str(warmup)],
-                capture_output=True,
-                text=True,
-                check=True,
-            ).stdout
-            print(f"round {i + 1}: {out.strip()}", flush=True)
-            words = out.split()
-            rates[case, mode].append(float(words[words.index("pairs/cpu_s") + 1]))
-    base = np.median(rates["eq", "lists"]) if ("eq", "lists") in rates else np.nan
-    print("case    mode   pairs/cpu_s median (min - max)        / eq lists median")
-    for (case, mode), r in rates.items():
+            for k in range(len(builds)) if i % 2 == 0 else range(len(builds))[::-1]:
+                build = builds[k]
+                env = None if build is None else {**os.environ, "PYTHONPATH": build}
+                argv = [sys.executable, __file__, "run", folder, case, mode, str(events)]
+                out = subprocess.run(
+                    [*argv, str(warmup)], capture_output=True, text=True, check=True, env=env
+                ).stdout
+                print(f"round {i + 1}: {out.strip()}" + (f" build {build}" if build else ""))
+                words = out.split()
+                rates[k, case, mode].append(float(words[words.index("pairs/cpu_s") + 1]))
+    print("case    mode   pairs/cpu_s median (min - max)     / eq lists median   build")
+    for (k, case, mode), r in rates.items():
         m = np.median(r)
-        print(f"{case:7s} {mode:6s} {m:.4g} ({min(r):.4g} - {max(r):.4g})  {m / base:.3f}")
+        base = np.median(rates.get((k, "eq", "lists"), [np.nan]))
+        print(
+            f"{case:7s} {mode:6s} {m:.4g} ({min(r):.4g} - {max(r):.4g})  {m / base:.3f}  "
+            f"{'AB'[k] if len(builds) == 2 else ''} {builds[k] or ''}"
+        )
+    if len(builds) == 2:  # the ratio B / A round by round: the machine's drift cancels
+        print("case    mode   pairs/cpu_s of B / A: median (min - max)")
+        for case, mode in runs:
+            a, b = (np.array(rates[k, case, mode]) for k in (0, 1))
+            q = b / a
+            print(f"{case:7s} {mode:6s} {np.median(q):.3f} ({q.min():.3f} - {q.max():.3f})")
 
 
 RUNS = [(c, m) for c in CASES for m in MODES]
@@ -255,12 +270,14 @@ if __name__ == "__main__":
     if sys.argv[1] == "--tiny":
         with tempfile.TemporaryDirectory() as tmp:
             prep(tmp, tiny=True)
-            rounds(tmp, 2000, 1, RUNS, 500)
+            here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+            rounds(tmp, 2000, 1, RUNS[:2], 500, (here, here))
     elif sys.argv[1] == "prep":
         prep(sys.argv[2])
     elif sys.argv[1] == "run":
         run(*sys.argv[2:5], *map(int, sys.argv[5:7]))
     elif sys.argv[1] == "rounds":
-        rounds(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), RUNS, WARMUP)
+        builds = tuple(sys.argv[5:7]) or (None,)
+        rounds(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), RUNS, WARMUP, builds)
     else:
         sys.exit(__doc__)
