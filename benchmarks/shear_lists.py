@@ -27,7 +27,7 @@ a pair collision does not depend on the temperature at all (scaling every speed 
 time only), only on gamma* and xi.  So pair collisions a CPU second compare the engine's
 work a collision fairly: T = 1 is a convention that keeps the figures legible.
 
-    python shear_lists.py prep DIR                      # once (a minute or two)
+    python shear_lists.py prep DIR                      # once (some 20 s)
     python shear_lists.py run DIR CASE MODE EVENTS [WARMUP]   # one case, one line
     python shear_lists.py rounds DIR EVENTS ROUNDS [PATH_A PATH_B]  # interleaved, medians
 
