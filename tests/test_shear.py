@@ -306,25 +306,31 @@ def test_lists_see_the_sliding_images_of_particles_at_rest(dim):
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_lists_catch_a_pair_the_mean_flow_brings_together(dim):
-    """Two spheres (radius 0.5, shell 0.25: reach 1.5) moving exactly with the mean flow
-    never leave shells carried by it; their centres start 1.17 apart along x and 0.95
-    along y (1.507: not listed), in the quadrant where the flow closes the gap.  They touch
-    after a strain of (1.17 - sqrt(1 - 0.95^2)) / 0.95 = 0.90, within a list's longest life
-    (strain 1 in this box); only the shells' shrinking at |rate| (r + delta) / 2 (a strain
-    of 2 delta / (r + delta) = 0.67 to nothing) rebuilds the lists before.  With the
-    shrinking off the spheres pass through each other (the reference has them collide)."""
+    """Two spheres (radius 0.5, shell 0.25: reach 1.5) whose list centres start 1.52
+    apart (0.7 along y: not listed), in the quadrant where the mean flow (rate 1) closes
+    the gap, each moving with the flow at its centre plus 0.5 towards the other.  They
+    touch at t = 0.32, inside both shells (each has moved 0.16) and before a list's
+    longest life (a strain of 0.4): no list is rebuilt before, so only the listing that
+    sweeps the centres' separation over the life (csrc/le_cells.h) can have listed them.
+    Without the sweep they pass through each other; the reference has them collide."""
     rate, L = 1.0, 10.0
     z = [5.0] if dim == 3 else []
-    pos = np.array([[4.0, 5.475, *z], [5.17, 4.525, *z]])
-    vel = np.zeros((2, dim))
-    vel[:, 0] = rate * (pos[:, 1] - L / 2)
+    dx, dy = math.sqrt(1.52**2 - 0.7**2), 0.7
+    pos = np.array([[4.0, 5.35, *z], [4.0 + dx, 5.35 - dy, *z]])
+    unit = (pos[1] - pos[0]) / 1.52
+    vel = np.outer([1.0, -1.0], 0.5 * unit)
+    vel[:, 0] += rate * (pos[:, 1] - L / 2)
     box = (np.zeros(dim), np.full(dim, L))
     s = Scene(pos, vel, 0.5, box=box, shear_rate=rate)
-    t_hit = (1.17 - math.sqrt(1 - 0.95**2)) / 0.95 / rate
+    rel, dv = pos[1] - pos[0], vel[1] - vel[0]  # |rel + dv t| = 1, the first root
+    a, b, c = dv @ dv, rel @ dv, rel @ rel - 1.0
+    t_hit = (-b - math.sqrt(b * b - a * c)) / a
+    assert 0.3 < t_hit < 0.4 * 0.999 / rate and 0.5 * t_hit < 0.25 * (1 - 1e-9)
     sim = Simulation(s, shell=0.25)
-    tr = sim.run(t_stop=t_hit + 0.5, sample_times=[t_hit + 0.5])
-    assert sim.stats["shell"] == 0.25 and sim.stats["pair_collisions"] == 1
-    rx, rv, _, _ = _reference(s, t_hit + 0.5, [t_hit - 1e-6, t_hit + 0.5])
+    tr = sim.run(t_stop=t_hit + 0.01, sample_times=[t_hit + 0.01])
+    assert sim.stats["shell"] == 0.25 and sim.stats["shell_exits"] == 0
+    assert sim.stats["pair_collisions"] == 1
+    rx, rv, _, _ = _reference(s, t_hit + 0.01, [t_hit - 1e-6, t_hit + 0.01])
     np.testing.assert_allclose(rv[0], vel, atol=1e-12)  # not before
     np.testing.assert_allclose(tr.velocities[-1], rv[-1], rtol=0, atol=1e-9)
     np.testing.assert_allclose(tr.positions[-1], rx[-1], rtol=0, atol=1e-9)
