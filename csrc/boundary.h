@@ -27,8 +27,8 @@
  *    -+delta and its v_x by -+u (bd_le_image);
  *  - the cells across a y face slide: lees_edwards.h scans them and bounds how long a
  *    prediction there may live (a "slide" event each time the images pass one cell);
- *    neighbour lists through a y face take the nearest x image at each scan and the
- *    shells next to it shrink (le_nlist.h; nlist.h has why no pair is missed). */
+ *    neighbour lists move with the mean flow and take the nearest x image through a y
+ *    face at each scan (le_cells.h, le_nlist.h; nlist.h has why no pair is missed). */
 #ifndef GR_BOUNDARY_H
 #define GR_BOUNDARY_H
 

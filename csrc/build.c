@@ -110,8 +110,8 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     }
     for (int a = 0; a < 3; a++) s->L[a] = a < d ? cfg->hi[a] - cfg->lo[a] : 1.0;
     /* Lees-Edwards (boundary.h): every particle in the cells or the lists (the big
-     * particles' image tables are fixed, the sliding images are not); the lists follow
-     * the sliding images with shrinking shells (nlist.h) */
+     * particles' image tables are fixed, the sliding images are not); the lists move
+     * with the mean flow (nlist.h) */
     s->le = cfg->periodic && cfg->shear_rate != 0.0;
     const int sheared = s->le;
     s->le_u = cfg->shear_rate * s->L[1];

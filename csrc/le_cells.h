@@ -22,6 +22,10 @@
 
 #include "engine.h"
 
+/* max and min of finite numbers, inline (fmax and fmin are calls here) */
+static inline double le_max(double a, double b) { return a > b ? a : b; }
+static inline double le_min(double a, double b) { return a < b ? a : b; }
+
 /* The x of centre record c (lap its laps) at time t, carried by the flow. */
 static inline double le_centre_x(const gr_nlist *nl, const double *c, int lap, double t)
 {
@@ -145,11 +149,11 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
          * -R - max(0, sweep dy) to R - min(0, sweep dy); the extremes over the row are
          * at its ends */
         const double ylo = g->lo[1] + (double)r * g->w[1] - ci[1];
-        const double ya = fmax(ylo, -R), yb = fmin(ylo + g->w[1], R);
-        const double lower = -R - fmax(fmax(0.0, b.sweep * ya) + b.theta * ya,
-                                       fmax(0.0, b.sweep * yb) + b.theta * yb);
-        const double upper = R - fmin(fmin(0.0, b.sweep * ya) + b.theta * ya,
-                                      fmin(0.0, b.sweep * yb) + b.theta * yb);
+        const double ya = le_max(ylo, -R), yb = le_min(ylo + g->w[1], R);
+        const double lower = -R - le_max(le_max(0.0, b.sweep * ya) + b.theta * ya,
+                                         le_max(0.0, b.sweep * yb) + b.theta * yb);
+        const double upper = R - le_min(le_min(0.0, b.sweep * ya) + b.theta * ya,
+                                        le_min(0.0, b.sweep * yb) + b.theta * yb);
         const int32_t K0 = (int32_t)floor((x0 + lower - slack) / g->w[0]);
         int32_t K1 = (int32_t)floor((x0 + upper + slack) / g->w[0]);
         if (K1 > K0 + nx - 1) K1 = K0 + nx - 1; /* each cell once */

@@ -1,6 +1,6 @@
-/* le_nlist.h -- neighbour lists in a sheared (Lees-Edwards) box: the list search across a
- * sliding face, the scan through the sliding images, the shrinking shells' exits.  Why
- * these keep the lists exact is in nlist.h.
+/* le_nlist.h -- neighbour lists in a sheared (Lees-Edwards) box: the list search (the
+ * centres carried by the flow, le_cells.h), the scan through the sliding images, the
+ * shells' exits and lives.  Why these keep the lists exact is in nlist.h.
  *
  * Static functions included by search.h (so by edmd.c only), reached only when the box
  * is sheared (s->le): the plain loop never runs them.  In 3D on AVX2 CPUs the scan runs

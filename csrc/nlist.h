@@ -18,36 +18,43 @@
  * rebuilds, so scans need no nearest-image arithmetic.  List lengths live in the
  * scheduling state (schedstate.h, `nn`), on the line an event loads anyway.
  *
- * In a sheared box (Lees-Edwards, boundary.h) the images across the y faces slide along
- * x at u = (shear rate) L_y, so a list built through such a face goes stale with no
- * event of either particle.  The lists stay exact so (lees_edwards.h has the code):
- *  - An entry through a y face stores its y (and z) image only; its x image is the
+ * In a sheared box (Lees-Edwards, boundary.h) the gas flows, u_x = rate (y - y_c), and
+ * the images across the y faces slide along x at u = rate L_y.  Shells fixed in the box
+ * would be left at the flow's speed, so here they move with it (le_cells.h has the code,
+ * le_nlist.h the events):
+ *  - A list centre c_i, i's position at its build t_b,i, moves with the flow at its own
+ *    y, c_i(t) = c_i + w_i (t - t_b,i) e_x, w_i = rate (c_i,y - y_c); i leaves its shell
+ *    when |r_i(t) - c_i(t)| reaches delta (flight.h fl_exit_time with v - w_i e_x), or
+ *    when its life ends: a strain |rate| (t - t_b,i) of GR_NL_STRAIN or less (below),
+ *    and no more than a centre drift of L_x / 4 - delta.  The images of a centre across a
+ *    y face move with the flow there too: the flow at y + L_y is the flow at y plus u.
+ *  - Two centres' separation d changes only along x, at rate d_y: over the life, from
+ *    d(t_b) to d(t_b) + s d_y e_x with s up to the strain of a life.  So i lists every j
+ *    (through every image) whose separation comes within r_i + r_j + 2 delta for some s
+ *    in that range: |d_x + s d_y| reaches its least at an end or at 0 (the sweep).
+ *  - Why no pair is missed.  Whether i and j are listed was decided at the later of their
+ *    builds, t_b, from the centres then and their motion with the flow, which is exact
+ *    (d is linear in t).  Until either list ends (within a life of t_b) an unlisted
+ *    pair has |d(t)| >= sigma + 2 delta, and each particle is within delta of its
+ *    centre: no contact, as without shear.
+ *  - Entries through a y face store their y (and z) image only; the x image is the
  *    nearest one at each use, displaced by s_y delta(t) (bd_le_image, as the pair
  *    collision finds it), and the pair's relative velocity gains s_y u.  No stored image
- *    has to follow delta's wraps at L_x, and delta comes from the absolute time as
- *    everywhere (no offset per build accumulating rounding over a long run).
- *  - Each particle whose centre lies in a cell next to a y face when its list is built
- *    (the only ones whose reach, r_i + r_j + 2 delta <= a cell's width, can cross that
- *    face) gets a shell that shrinks: it leaves when |r_i(t) - c_i| + (|u|/2)(t - t_b,i)
- *    reaches delta (flight.h fl_shrink_exit_time; t_b,i its build time, in `built`, +inf
- *    for the plain shell of the others).
- *  - Why no pair is missed.  Whether i and j are listed was decided at the later of
- *    their builds, t_b = max(t_b,i, t_b,j), with the centres' distance through every
- *    image then.  An unlisted pair through a y face had it >= r_i + r_j + 2 delta; since
- *    then that image drifted by |u| (t - t_b) along x, so
- *      |r_j + S(t) - r_i| >= sigma + 2 delta - |r_i - c_i| - |r_j - c_j| - |u| (t - t_b)
- *    and with both shells alive |r_i - c_i| + |r_j - c_j| + (|u|/2)(2t - t_b,i - t_b,j)
- *    <= 2 delta, where (|u|/2)(2t - t_b,i - t_b,j) >= |u| (t - t_b): no contact.  If
- *    either centre is not in an edge row it lies a cell width (>= sigma + 2 delta) from
- *    the face, and the y separation alone keeps them apart, as without shear.
- *  - Why the nearest x image at a scan is the one that touches: a scan at t_s predicts a
- *    contact at t_c with no event of i or j between (else that event scans again), so
- *    both shells live over [t_s, t_c] and |dr_i| + |dr_j| + |u| (t_c - t_s) <= 4 delta
- *    (each particle moves at most 2 delta less its shrink); the touching image is then
- *    within sigma + 4 delta < L_x / 2 along x at t_s (build.c: L > 2 (sigma + 4 delta)),
- *    nearer than any other.
- * Rounding: delta(t) carries the time's rounding times u (boundary.h); the shrinking
- * shells start 2^-48 (|D(t_b)| + L_x) early besides the plain shell's hair (nlist.c). */
+ *    follows delta's wraps at L_x, and delta comes from the absolute time as everywhere.
+ *    Entries within the box store their x image as found at the build: it stays the
+ *    touching one, below.
+ *  - Why the images stay right.  Over a strain s a separation's length changes by a
+ *    factor e^(s/2) at most (|d/dt |d|| <= |rate| |d| / 2).  A scan at t_s predicts a
+ *    contact at t_c with both lists alive between, so the touching image's centres were
+ *    within e^(s/2) (sigma + 2 delta) at t_s and the particles within that plus 2 delta:
+ *    the build requires e^(s/2) (sigma + 2 delta) + 2 delta < 0.49 L on every axis for
+ *    the strain s of a life (nlist.c gr_nlist_shear_strain; a box too small for strain
+ *    0.1 takes cells), so that image is the nearest, and the one stored at the build
+ *    (within sigma + 2 delta then) is the touching one.  The drift bound keeps positions
+ *    within L_x / 4 of the box, so one step of bd_nearest finds the nearest image.
+ * Rounding: the centres carried by the flow and delta(t) carry the time's rounding times
+ * the flow's speed; the shells are 2^-48 (|D(t_b)| + L_x) smaller for it besides the
+ * plain shell's hair (nlist.c). */
 #ifndef GR_NLIST_H
 #define GR_NLIST_H
 

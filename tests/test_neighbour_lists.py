@@ -139,8 +139,9 @@ def test_lists_mended_at_shell_exits_stay_complete(boundary):
     whose particles also get renumbered (N = 5000), the engine's own check on loading a
     state (csrc/checkpoint.c, check_lists) must find every listed pair listed back the
     other way and every pair of centres within r_i + r_j + 2 delta listed (in a sheared
-    box, through a sliding face, at the later of the two builds; the shrinking shells'
-    build times renumbered with the particles)."""
+    box: every centre filed where the flow carries it, every pair whose centres come within
+    reach over a list's life from the later of the two builds, through a sliding face too;
+    the build times and laps renumbered with the particles)."""
     walls = boundary == "walls"
     s = _dense(5000, 0.4 if walls else 0.45, boundary="walls" if walls else "periodic", seed=8)
     if boundary == "sheared":  # reduced shear rate ~0.5 in a box ~24 diameters high

@@ -248,14 +248,15 @@ def _dense_sheared(n, eta, dim, rate, seed=1, xi=1.0):
 )
 def test_lists_agree_with_slow_reference(dim, n, radius, rate, xi, t_stop, offset, seed):
     """Neighbour lists in a sheared box (csrc/le_nlist.h: entries through a sliding face
-    take the nearest x image at each scan, shells move with the mean flow and shrink at
-    |rate| (r + delta) / 2) against the reference that tries every pair through every
-    image at every step: the same positions (unwrapped) and velocities sample by sample.
-    The images slide by 1.2 to 6 box lengths (offset wraps), particles cross the sheared
-    faces, and each particle rebuilds its list more than five times.  Chaos amplifies rounding (the lists' rounding
-    differs from the cells'): the runs stop before it reaches the tolerance (measured at
-    the end: dilute 2D 1e-8 and 4e-9, 3D 2e-10 and 4e-11, dense 2D 6e-11, 3D 5e-12).  A
-    pair missed through a sliding face, or a wrong image, is off by O(1)."""
+    take the nearest x image at each scan, shells move with the mean flow, pairs are listed
+    over a list's life) against the reference that tries every pair through every image at
+    every step: the same positions (unwrapped) and velocities sample by sample.  The images
+    slide by 1.2 to 6 box lengths (offset wraps), particles cross the sheared faces, and
+    each particle rebuilds its list more than five times.  Chaos amplifies rounding (the
+    lists' rounding differs from the cells'): the runs stop before it reaches the tolerance
+    (the largest difference at the end, velocities: dilute 2D 2e-10 and 2e-9, 3D 5e-11 and
+    1e-11, dense 2D 6e-11, 3D 3e-13).  A pair missed through a sliding face, or a wrong
+    image, is off by O(1)."""
     s = Scene.random(n, radius, dim=dim, box=3.0, temperature=1.0, seed=seed)
     s = s.replace(shear_rate=rate, shear_offset=offset, restitution=xi)
     times = np.linspace(0.0, t_stop, 13)
@@ -282,8 +283,9 @@ def test_lists_agree_with_slow_reference(dim, n, radius, rate, xi, t_stop, offse
 def test_lists_see_the_sliding_images_of_particles_at_rest(dim):
     """As test_a_particle_at_rest_meets_the_sliding_images, with neighbour lists (a box
     wide enough for them): two particles at rest near opposite y faces, far apart along
-    x, with no event of their own.  Only their shrinking shells (rebuilt as the images
-    slide) bring the pair into a list before the sliding image reaches it."""
+    x, with no event of their own.  Only their lists' rebuilds (shells carried by the flow
+    leave particles at rest; lives end) bring the pair into a list before the sliding image
+    reaches it."""
     Lx, L = 20.0, 5.0
     z = [2.0] if dim == 3 else []
     still = [[x, 2.5, *z] for x in range(2, 18, 2)]
@@ -343,7 +345,7 @@ def test_lists_never_let_a_pair_overlap_in_a_dense_sheared_gas(dim, n, eta, rate
     crossings of the sheared faces, ~100 collisions per particle): at every sample no two
     particles overlap through any image (brute force: a missed pair overlaps by a good
     fraction of a diameter), the engine's own check finds every list complete (through
-    the sliding faces: every pair of shrinking shells within reach at the later build),
+    the sliding faces: every pair within reach over a life from the later build),
     and the kinetic energy has risen by exactly the work of the boundary."""
     s = _dense_sheared(n, eta, dim, rate, seed=2)
     k0 = s.kinetic_energy
@@ -390,9 +392,9 @@ def test_lists_and_cells_follow_the_same_sheared_gas():
 
 
 def test_lists_continue_bit_for_bit_from_a_checkpoint(tmp_path):
-    """Saved mid-run with lists in a sheared box (shrinking shells and their build times,
-    particles strayed beyond a sliding face) and loaded: the same bits as the run never
-    stopped."""
+    """Saved mid-run with lists in a sheared box (shells carried by the flow, their build
+    times, laps and filing time, particles strayed beyond a sliding face) and loaded: the
+    same bits as the run never stopped."""
     s = _dense_sheared(400, 0.45, 3, 0.7, seed=3, xi=0.9)
     a = Simulation(s, shell=0.25)
     a.run(t_stop=1.3, store=())
