@@ -75,7 +75,8 @@ size_t gr_edmd_bytes_per_particle(int dim, int lists)
         bytes += (size_t)(dim + 1) * sizeof(double)       /* centre */
                  + 2 * (size_t)(dim == 3 ? 32 : 16) * sizeof(int32_t) /* a row, its copy
                                                                       * while renumbering */
-                 + sizeof(int32_t);                       /* near */
+                 + sizeof(int32_t) + sizeof(uint8_t)      /* near, mark */
+                 + sizeof(double) + sizeof(int8_t);       /* a sheared box's build time, lap */
     return bytes;
 }
 
