@@ -145,18 +145,17 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
         const int32_t q1 = r - ky * g->nc[1];
         const double x0 = xref - (double)ky * dref - g->lo[0];
         /* the window: a centre dy = a..b above ci (the row, within reach) has a filed x
-         * of x0 + dx - theta dy, where dx must come within R over the life: from
-         * -R - max(0, sweep dy) to R - min(0, sweep dy); the extremes over the row are
-         * at its ends */
-        const double ylo = g->lo[1] + (double)r * g->w[1] - ci[1];
-        const double ya = le_max(ylo, -R), yb = le_min(ylo + g->w[1], R);
-        const double lower = -R - le_max(le_max(0.0, b.sweep * ya) + b.theta * ya,
-                                         le_max(0.0, b.sweep * yb) + b.theta * yb);
-        const double upper = R - le_min(le_min(0.0, b.sweep * ya) + b.theta * ya,
-                                        le_min(0.0, b.sweep * yb) + b.theta * yb);
-        const int32_t K0 = (int32_t)floor((x0 + lower - slack) / g->w[0]);
-        int32_t K1 = (int32_t)floor((x0 + upper + slack) / g->w[0]);
-        if (K1 > K0 + nx - 1) K1 = K0 + nx - 1; /* each cell once */
+         * of x0 + dx - theta dy, where dx must come within Rx over the life: from
+         * -Rx - max(0, sweep dy) to Rx - min(0, sweep dy); the extremes over the row are
+         * at its ends.  Rx^2 = R^2 less the squares of the least |dy| and |dz| in the
+         * line of cells (less a hair for their rounding): a line far from ci is short. */
+        const double ylo = g->lo[1] + (double)r * g->w[1] - ci[1], yhi = ylo + g->w[1];
+        const double ya = le_max(ylo, -R), yb = le_min(yhi, R);
+        const double ymin = le_max(0.0, le_max(ylo, -yhi) - slack);
+        const double lower0 = -le_max(le_max(0.0, b.sweep * ya) + b.theta * ya,
+                                      le_max(0.0, b.sweep * yb) + b.theta * yb);
+        const double upper0 = -le_min(le_min(0.0, b.sweep * ya) + b.theta * ya,
+                                      le_min(0.0, b.sweep * yb) + b.theta * yb);
         b.yoff = (double)ky * s->L[1] - ci[1];
         const double xoff = (double)ky * dref + b.theta * ((double)ky * s->L[1] - nl->yc) - ci[0];
         b.inbox = !ky; /* an x image in the entry: within the box only */
@@ -164,6 +163,17 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
             const int32_t q2 = dim == 3 ? g->nb_cell[2][3 * c[2] + kz] : 0;
             const double shz = dim == 3 ? g->nb_shift[2][3 * c[2] + kz] : 0.0;
             b.zoff = shz - (dim == 3 ? ci[2] : 0.0);
+            double zmin = 0.0;
+            if (dim == 3) {
+                const double zlo = g->lo[2] + (double)(c[2] + kz - 1) * g->w[2] - ci[2];
+                zmin = le_max(0.0, le_max(zlo, -(zlo + g->w[2])) - slack);
+            }
+            const double rest = R * R - ymin * ymin - zmin * zmin;
+            if (!(rest > 0.0)) continue; /* no centre of this line within reach */
+            const double Rx = sqrt(rest);
+            const int32_t K0 = (int32_t)floor((x0 + lower0 - Rx - slack) / g->w[0]);
+            int32_t K1 = (int32_t)floor((x0 + upper0 + Rx + slack) / g->w[0]);
+            if (K1 > K0 + nx - 1) K1 = K0 + nx - 1; /* each cell once */
             /* the image code (nlist.h nl_code) but for its x digit */
             const int32_t code0 = 3 * (ky + 1) + 9 * ((shz > 0.0) - (shz < 0.0) + 1) * (dim == 3);
             const int32_t rowbase = (q2 * g->nc[1] + q1) * nx;
