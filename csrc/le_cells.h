@@ -26,6 +26,14 @@
 static inline double le_max(double a, double b) { return a > b ? a : b; }
 static inline double le_min(double a, double b) { return a < b ? a : b; }
 
+/* floor of a number well within int32_t, without a call (the baseline x86-64 has no
+ * rounding instruction) */
+static inline int32_t le_floor(double x)
+{
+    const int32_t k = (int32_t)x;
+    return k - (x < (double)k);
+}
+
 /* The x of centre record c (lap its laps) at time t, carried by the flow. */
 static inline double le_centre_x(const gr_nlist *nl, const double *c, int lap, double t)
 {
@@ -38,8 +46,8 @@ static inline int32_t le_file(const gr_cells *g, const gr_nlist *nl, double *c, 
                               double x, double t)
 {
     double X = x + nl->rate * (nl->tref - t) * (c[1] - nl->yc);
-    const double k = floor((X - g->lo[0]) / nl->lx); /* |k| <= 1: the drift is bounded */
-    X -= k * nl->lx;
+    const int32_t k = le_floor((X - g->lo[0]) / nl->lx); /* |k| <= 1: the drift is bounded */
+    X -= (double)k * nl->lx;
     int8_t laps = (int8_t)k;
     if (X >= g->lo[0] + nl->lx) { /* by rounding */
         X -= nl->lx;
@@ -47,8 +55,8 @@ static inline int32_t le_file(const gr_cells *g, const gr_nlist *nl, double *c, 
     }
     c[0] = X;
     *lap = laps;
-    const double f = floor((X - g->lo[0]) / g->w[0]);
-    return f < 0.0 ? 0 : f >= g->nc[0] ? g->nc[0] - 1 : (int32_t)f;
+    const int32_t f = le_floor((X - g->lo[0]) / g->w[0]);
+    return f < 0 ? 0 : f >= g->nc[0] ? g->nc[0] - 1 : f;
 }
 
 /* A line of cells' candidates for le_gather, tested in a batch: their indices, each
@@ -102,6 +110,15 @@ static int32_t le_test_scalar(const gr_edmd *s, int dim, const le_batch *b, int3
         if (le_within(s->nl.centre + (size_t)b->j[k] * (dim + 1), dim, b, b->xoff[k]))
             m = le_append(&s->nl, b, k, out, m);
     return m;
+}
+
+/* A batch tested, its last group of four filled with copies of its first candidate (the
+ * lanes past n are masked: le_nlist.h). */
+static inline int32_t le_test_padded(const gr_edmd *s, int dim, le_batch *b, int32_t *out,
+                                     int32_t m, le_batch_test test)
+{
+    b->j[b->n] = b->j[b->n + 1] = b->j[b->n + 2] = b->j[0];
+    return test(s, dim, b, out, m);
 }
 
 /* Every particle j whose list centre, carried by the flow from time t on for a list's
@@ -171,8 +188,8 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
             const double rest = R * R - ymin * ymin - zmin * zmin;
             if (!(rest > 0.0)) continue; /* no centre of this line within reach */
             const double Rx = sqrt(rest);
-            const int32_t K0 = (int32_t)floor((x0 + lower0 - Rx - slack) / g->w[0]);
-            int32_t K1 = (int32_t)floor((x0 + upper0 + Rx + slack) / g->w[0]);
+            const int32_t K0 = le_floor((x0 + lower0 - Rx - slack) / g->w[0]);
+            int32_t K1 = le_floor((x0 + upper0 + Rx + slack) / g->w[0]);
             if (K1 > K0 + nx - 1) K1 = K0 + nx - 1; /* each cell once */
             /* the image code (nlist.h nl_code) but for its x digit */
             const int32_t code0 = 3 * (ky + 1) + 9 * ((shz > 0.0) - (shz < 0.0) + 1) * (dim == 3);
@@ -189,12 +206,12 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
                     b.xoff[b.n] = xcell;
                     b.code[b.n] = code1;
                     if (++b.n == GR_LE_BATCH) {
-                        m = test(s, dim, &b, out, m);
+                        m = le_test_padded(s, dim, &b, out, m, test);
                         b.n = 0;
                     }
                 }
             }
-            if (b.n) m = test(s, dim, &b, out, m);
+            if (b.n) m = le_test_padded(s, dim, &b, out, m, test);
         }
     }
     return m;

@@ -15,7 +15,8 @@
 #ifdef GR_SCAN_X86
 /* le_test_scalar (le_cells.h) in 3D, four candidates at a time in AVX2's lanes: each
  * lane takes le_within's steps in its order, so passes exactly when it does; the lanes
- * that pass are appended in order.  A short last group repeats its first lane, masked. */
+ * that pass are appended in order.  A short last group is padded (le_test_padded) and
+ * masked. */
 static GR_AVX2 int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
                                     int32_t m)
 {
@@ -27,7 +28,7 @@ static GR_AVX2 int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b
                   zero = _mm256_setzero_pd();
     for (int k = 0; k < b->n; k += 4) {
         const double *q[4];
-        for (int l = 0; l < 4; l++) q[l] = centre + (size_t)4 * b->j[k + l < b->n ? k + l : k];
+        for (int l = 0; l < 4; l++) q[l] = centre + (size_t)4 * b->j[k + l]; /* padded */
         __m256d X, Y, Z, R;
         GR_TRANSPOSE4(_mm256_load_pd(q[0]), _mm256_load_pd(q[1]), _mm256_load_pd(q[2]),
                       _mm256_load_pd(q[3]), X, Y, Z, R);
