@@ -8,11 +8,12 @@ Public entry points
     (where the homogeneous cooling of Fig. 4.10 ends; ``reproduce_clustering``) and
     ``"viscoelastic"`` (the viscoelastic gas and its power-law UDSBM; ``reproduce_visco``);
     then the experiments beyond the thesis, each in its own module ``reproduce_<name>``:
-    ``"transport"`` (elastic viscosity and self-diffusion), ``"langevin-forces"`` (the
-    Langevin model in a harmonic trap), ``"driven"`` (a2 of the cooling and the white-noise
-    driven state, the driven temperature), ``"rough"`` (rough spheres and disks: T_rot/T_tr,
-    the coupled cooling, Walton's rule), ``"vibrated"`` (a gas kept hot by a vibrating
-    wall), ``"gravity"`` (the hydrostatic profile of an elastic column),
+    ``"transport"`` (elastic viscosity, self-diffusion, equation of state),
+    ``"langevin-forces"`` (the Langevin model in a harmonic trap), ``"driven"`` (a2 of the
+    cooling and the white-noise driven state, the driven temperature), ``"rough"`` (rough
+    spheres and disks: T_rot/T_tr, the coupled cooling, Walton's rule), ``"vibrated"`` (a
+    gas kept hot by a vibrating wall), ``"gravity"`` (the hydrostatic profile of an elastic
+    column),
     ``"shear"`` (uniform shear flow of the inelastic gas).
 ``figure(name, quick=False, out="granular-reproduce", runs=None, backend=None)``
     Run one experiment, write its PNG files into ``out`` and return ``(paths, rows)``: the
@@ -760,7 +761,11 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "4.17-4.23": ("Langevin and UDSBM: time steps, ergodicity (TAMSD against MSD)", 131.0, 22.0),
     "clustering": ("where homogeneous cooling ends: three boxes around L_c", 18.9, 18.8),
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
-    "transport": ("elastic hard spheres: Green-Kubo, NEMD viscosity; diffusion", 70.0, 15.0),
+    "transport": (
+        "elastic hard spheres: Green-Kubo, NEMD viscosity; diffusion; equation of state",
+        85.0,
+        21.0,
+    ),
     "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),
     "driven": ("a2 of cooling and white-noise driven gases, driven temperature", 101.6, 18.7),
     "rough": (

@@ -20,7 +20,16 @@ eta*_0 + c gamma*^2 (``transport.nemd_viscosity``), the error from the runs' spr
 row's text gives the sqrt(gamma*) extrapolation too and how far the two routes lie apart
 (``viscosity_nemd.png``).
 
-The reference is Enskog's theory in the first Sonine approximation
+The equation of state and the collision rate (``eos.elastic.*``,
+``collisions.mean_free_time.*``): equilibrium runs at n sigma^3 = 0.5 (packing 0.2618,
+N = 1372) and at packing 0.45 (N = 2000), 10 runs of 1000 collisions per particle
+(quick: 100) after 50; Z = P / (n T) from the collision virial, the mean free time in
+sigma sqrt(m / T).  The reference is Pieprzyk et al.'s 2019 MD fit of Z
+(``theory.pieprzyk_compressibility``), and through its contact value the collision rate,
+which equilibrium fixes exactly; Lue's MD mean free time at n sigma^3 = 0.5, N = 1372
+(doi:10.1063/1.1834498, as DynamO's tests quote it) is given in the row's text.
+
+The reference for transport is Enskog's theory in the first Sonine approximation
 (``theory.enskog_viscosity``, ``theory.enskog_diffusion``), which neglects correlated
 collisions: near-exact at eta = 0.05 (within its 1.6 % (eta) and 1.9 % (D) Sonine
 truncation), while at 0.30 the fluid's correlated collisions raise D and eta above it by
@@ -67,6 +76,67 @@ def measure(eta, n, taus, seed=29):
         )
     )
     return visc, diff, d_inf, temp, 2.0 * r, tau
+
+
+# The equation of state's runs: (packing, N); n sigma^3 = 0.5 is Lue's (2005) state
+EOS_CASES = ((math.pi / 12.0, 1372), (0.45, 2000))
+# Lue's MD mean free time there (doi:10.1063/1.1834498, quoted by DynamO's tests,
+# src/dynamo/tests/hardsphere_test.cpp), in sigma sqrt(m / T)
+LUE_MEAN_FREE_TIME = 0.13031
+
+
+def eos_run(eta, n, collisions, seed):
+    """One equilibrium run at packing ``eta``: (Z = P / (n T), the mean free time in
+    sigma sqrt(m / T)), over ``collisions`` per particle after 50."""
+    r = (eta / n / (4.0 / 3.0 * math.pi)) ** (1.0 / 3.0)
+    sim = Simulation(Scene.random(n, r, dim=3, temperature=1.0, seed=seed))
+    sim.run(stop_when={"collisions_per_particle": 50}, store=())
+    sim = Simulation(sim.scene)  # counters from here
+    sim.run(stop_when={"collisions_per_particle": collisions}, store=())
+    st = sim.stats
+    volume = float(np.prod(sim.scene.upper - sim.scene.lower))
+    temp = 2.0 * st["kinetic_energy"] / (3 * n)
+    tau = sim.time / st["collisions_per_particle"] * math.sqrt(temp) / (2.0 * r)
+    return st["pressure"] / (n / volume * temp), tau
+
+
+def _eos_rows(cfg, mean_row):
+    """The equation of state and the mean free time against Pieprzyk et al. 2019."""
+    runs, collisions = (10, 100) if cfg.quick else (10, 1000)
+    rows = []
+    for eta, n in EOS_CASES:
+        out = [eos_run(eta, n, collisions, seed=300 + k) for k in range(runs)]
+        z_md = float(theory.pieprzyk_compressibility(eta))
+        what = (
+            f"elastic hard spheres at packing {eta:.4f} (EDMD, N = {n}, 3D periodic, "
+            f"{collisions} collisions per particle after 50, each run)"
+        )
+        rows.append(
+            mean_row(
+                f"eos.elastic.eta{eta:.2f}",
+                f"compressibility factor Z = P / (n T) of {what}; theory: Pieprzyk, Bannerman, "
+                f"Branka, Chudak & Heyes 2019's fit to MD (theory.pieprzyk_compressibility; "
+                f"Carnahan-Starling {float(theory.compressibility_factor(eta)):.4f})",
+                [z for z, _ in out],
+                theory_value=z_md,
+            )
+        )
+        if n != 1372:
+            continue
+        density = 6.0 * eta / math.pi  # n sigma^3
+        g = (z_md - 1.0) / (4.0 * eta)
+        rows.append(
+            mean_row(
+                f"collisions.mean_free_time.eta{eta:.2f}",
+                f"mean free time tau sqrt(T / m) / sigma of {what}; theory: 1 / (4 sqrt(pi) "
+                f"n sigma^3 g(sigma)), exact in equilibrium, with the contact value of "
+                f"Pieprzyk et al. 2019's Z (Lue's MD at N = 1372, doi:10.1063/1.1834498 as "
+                f"DynamO's tests quote it: {LUE_MEAN_FREE_TIME})",
+                [tau for _, tau in out],
+                theory_value=1.0 / (4.0 * math.sqrt(math.pi) * density * g),
+            )
+        )
+    return rows
 
 
 # The NEMD route: each packing's sweep of the reduced shear rate gamma* (start, end) and the
@@ -245,4 +315,4 @@ def _fig_transport(cfg, out, *, ensemble, save, fig, row, mean_row):
     ax_d.set_title("self-diffusion (MSD)")
     names = [save(f, out, "transport_elastic.png")]
     nemd_name, nemd = _nemd_rows(cfg, out, save, fig, row, green_kubo)
-    return [*names, nemd_name], rows + nemd
+    return [*names, nemd_name], rows + nemd + _eos_rows(cfg, mean_row)

@@ -43,6 +43,7 @@ from .equation_of_state import (
     compressibility_factor,
     contact_value,
     packing_fraction,
+    pieprzyk_compressibility,
     wall_adsorption,
 )
 from .ergodicity import (
@@ -194,6 +195,7 @@ __all__ = [
     "msd_viscoelastic_asymptote",
     "msd_viscoelastic_second_order",
     "packing_fraction",
+    "pieprzyk_compressibility",
     "powerlaw_udsbm_increment_msd",
     "powerlaw_udsbm_moments",
     "rough_coefficients",
