@@ -276,6 +276,16 @@ def _transport_notes(cfg, by_id):
     ]
 
 
+def _eos_notes(cfg, by_id):
+    return [
+        "Against Pieprzyk, Bannerman, Branka, Chudak & Heyes' 2019 fit of the equation of "
+        "state to molecular dynamics (theory.pieprzyk_compressibility), good to ~1e-4; finite "
+        "N shifts the fluid's structure by O(1/N). The mean free time follows exactly from "
+        "the contact value g(sigma) = (Z - 1) / (4 eta). Carnahan-Starling lies 0.2% below "
+        "the fit at packing 0.45."
+    ]
+
+
 def _shear_notes(cfg, by_id):
     return [
         "Against the Enskog kinetic theory of uniform shear flow, its second-moment balance "
@@ -306,6 +316,7 @@ SECTIONS = (
     ("Forces in the Langevin model", "langevin.trap.", _trap_notes),
     ("The elastic fluid's viscosity", "viscosity.", _transport_notes),
     ("The elastic fluid's self-diffusion", "diffusion.", _transport_notes),
+    ("The elastic fluid's equation of state and collision rate", "eos.", _eos_notes),
     ("Uniform shear flow", "shear.", _shear_notes),
 )
 

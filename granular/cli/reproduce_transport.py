@@ -21,7 +21,7 @@ row's text gives the sqrt(gamma*) extrapolation too and how far the two routes l
 (``viscosity_nemd.png``).
 
 The equation of state and the collision rate (``eos.elastic.*``,
-``collisions.mean_free_time.*``): equilibrium runs at n sigma^3 = 0.5 (packing 0.2618,
+``eos.mean_free_time.*``): equilibrium runs at n sigma^3 = 0.5 (packing 0.2618,
 N = 1372) and at packing 0.45 (N = 2000), 10 runs of 1000 collisions per particle
 (quick: 100) after 50; Z = P / (n T) from the collision virial, the mean free time in
 sigma sqrt(m / T).  The reference is Pieprzyk et al.'s 2019 MD fit of Z
@@ -127,7 +127,7 @@ def _eos_rows(cfg, mean_row):
         g = (z_md - 1.0) / (4.0 * eta)
         rows.append(
             mean_row(
-                f"collisions.mean_free_time.eta{eta:.2f}",
+                f"eos.mean_free_time.eta{eta:.2f}",
                 f"mean free time tau sqrt(T / m) / sigma of {what}; theory: 1 / (4 sqrt(pi) "
                 f"n sigma^3 g(sigma)), exact in equilibrium, with the contact value of "
                 f"Pieprzyk et al. 2019's Z (Lue's MD at N = 1372, doi:10.1063/1.1834498 as "
