@@ -227,6 +227,8 @@ def _call(f, **override):
             "excess_chemical_potential",
         ):
             value = override.get(p.name, "carnahan-starling")  # there an equation of state
+        if p.name == "eta" and f.__name__ == "pieprzyk_diffusion":
+            value = override.get(p.name, math.pi * 0.5 / 6)  # a table: a tabulated density
         if p.kind == p.POSITIONAL_OR_KEYWORD:
             args.append(value)
         else:

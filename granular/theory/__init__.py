@@ -105,6 +105,7 @@ from .transport import (
     diffusion_infinite_system,
     enskog_diffusion,
     enskog_viscosity,
+    pieprzyk_diffusion,
     speedy_diffusion,
 )
 from .trap import (
@@ -196,6 +197,7 @@ __all__ = [
     "msd_viscoelastic_second_order",
     "packing_fraction",
     "pieprzyk_compressibility",
+    "pieprzyk_diffusion",
     "powerlaw_udsbm_increment_msd",
     "powerlaw_udsbm_moments",
     "rough_coefficients",

@@ -8,8 +8,8 @@ uncorrelated binary collisions: it is exact at low density and misses the correl
 collisions (ring and vortex effects) of a dense fluid, by a few percent up to eta ~ 0.2
 and by tens of percent near freezing.  The high-precision MD values of Pieprzyk,
 Bannerman, Branka, Chudak & Heyes, Phys. Chem. Chem. Phys. 21, 6886 (2019) measure that
-difference; their tables are not reproduced here (see docs/stress.md: they could not be
-looked up for this version, so granular compares with Enskog and states the deviation).
+difference: ``pieprzyk_diffusion`` returns their self-diffusion coefficients at the
+densities they tabulate (their viscosities could not be found, see docs/stress.md).
 ``speedy_diffusion`` gives an older empirical representation of MD self-diffusion
 (Speedy 1987), which Sigurgeirsson & Heyes (2003) found to fit their N ~ 500 data: a
 finite-system reference, not an infinite-N one.
@@ -206,3 +206,70 @@ def speedy_diffusion(
         )
         d = d0 / n * shape
     return np.where(n == 0.0, np.inf, d)
+
+
+# Pieprzyk, Bannerman, Branka, Chudak & Heyes, Phys. Chem. Chem. Phys. 21, 6886 (2019): the
+# hard-sphere fluid's self-diffusion coefficient D* = D sqrt(m / T) / sigma at n sigma^3, as
+# transcribed in a public analysis script (the paper's table itself could not be read)
+PIEPRZYK_DIFFUSION = (
+    (0.10, 1.94786), (0.15, 1.24636), (0.20, 0.89989), (0.25, 0.69308), (0.30, 0.55523),
+    (0.35, 0.45527), (0.40, 0.37845), (0.45, 0.31663), (0.50, 0.265009), (0.55, 0.221105),
+    (0.60, 0.183259), (0.65, 0.150317), (0.70, 0.121081), (0.75, 0.095425), (0.80, 0.072934),
+    (0.85, 0.053298), (0.86, 0.049608), (0.87, 0.046203), (0.88, 0.042720), (0.89, 0.039478),
+    (0.90, 0.036254), (0.91, 0.033286), (0.92, 0.030326), (0.93, 0.027419), (0.94, 0.024746),
+    (0.95, 0.022134), (0.96, 0.019695), (0.97, 0.017357), (0.98, 0.015082), (0.99, 0.013013),
+    (1.00, 0.011053), (1.01, 0.009222),
+)  # fmt: skip
+
+
+@keyword_only("eta")
+def pieprzyk_diffusion(
+    eta: FloatOrArray,
+    *,
+    radius: FloatOrArray,
+    temperature: FloatOrArray,
+    mass: FloatOrArray = 1.0,
+) -> FloatOrArray:
+    """The hard-sphere fluid's self-diffusion coefficient from molecular dynamics, Pieprzyk,
+    Bannerman, Branka, Chudak & Heyes, Phys. Chem. Chem. Phys. 21, 6886 (2019), at the
+    densities they tabulate only: n sigma^3 = 0.10, 0.15, ..., 0.85, then 0.86 to 1.01 in
+    steps of 0.01 (``PIEPRZYK_DIFFUSION``; beyond freezing, n sigma^3 = 0.94, the metastable
+    fluid).  3D only.  A table, not a formula: any other packing fraction is refused.
+
+    The values are as transcribed in a public analysis script, which names the paper but
+    not the table; the paper's table itself could not be read.  They are very probably the
+    infinite-system values: Lue's MD at n sigma^3 = 0.5 and N = 1372 (doi:10.1063/1.1834498,
+    as DynamO's tests quote it), 0.247, corrected to infinite N by
+    ``diffusion_infinite_system`` with eta* = 0.58 gives 0.2655 against the table's 0.2650.
+    Compare them with D measured in a periodic box after that correction.
+
+    Parameters
+    ----------
+    eta : float or array
+        Packing fraction, pi n sigma^3 / 6 at a tabulated n sigma^3 (to 1e-9 in n sigma^3):
+        e.g. ``math.pi * 0.5 / 6``.
+    radius : float or array
+        Particle radius (L), sigma = 2 r.
+    temperature : float or array
+        Temperature T, an energy (k_B = 1).
+    mass : float or array
+        Particle mass (m).
+
+    Returns
+    -------
+    D in L^2 / time, per dimension: <dx^2> = 2 D t.
+    """
+    density = 6.0 * np.asarray(eta, dtype=np.float64) / math.pi  # n sigma^3
+    table = np.array(PIEPRZYK_DIFFUSION)
+    index = np.abs(density[..., None] - table[:, 0]).argmin(axis=-1)
+    off = np.abs(density - table[index, 0]) > 1e-9
+    if np.any(off):
+        bad = float(np.asarray(eta)[off].flat[0] if np.ndim(eta) else eta)
+        raise ValueError(
+            f"pieprzyk_diffusion is a table: packing fraction {bad:g} (n sigma^3 = "
+            f"{6.0 * bad / math.pi:.6g}) is not tabulated; allowed: pi n / 6 with n sigma^3 "
+            "one of 0.10, 0.15, ..., 0.85 and 0.86, 0.87, ..., 1.01"
+        )
+    sigma = 2.0 * np.asarray(radius)
+    d = table[index, 1] * sigma * np.sqrt(np.asarray(temperature) / np.asarray(mass))
+    return d[()] if np.ndim(d) == 0 else d
