@@ -73,7 +73,7 @@ def test_nemd_and_green_kubo_agree_at_packing_005():
 
     quad, _, windows = rt.measure_nemd(0.05, 500, 4)
     assert all(w.shear_rate.min() < 0.06 for w in windows)  # the sweep reached small gamma*
-    visc, _, _, temp, sigma, _ = rt.measure(0.05, 256, 1000.0)
+    visc, temp, sigma, _ = rt.measure(0.05, 256, 1000.0)
     gk = visc.value * sigma**2 / math.sqrt(temp)
     gk_err = visc.error * sigma**2 / math.sqrt(temp)
     assert quad.error < 0.03 * quad.value

@@ -763,8 +763,8 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
     "transport": (
         "elastic hard spheres: Green-Kubo, NEMD viscosity; diffusion; equation of state",
-        85.0,
-        21.0,
+        145.0,
+        25.0,
     ),
     "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),
     "driven": ("a2 of cooling and white-noise driven gases, driven temperature", 101.6, 18.7),
