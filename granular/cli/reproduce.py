@@ -763,7 +763,7 @@ ABOUT: dict[str, tuple[str, float, float]] = {
     "viscoelastic": ("viscoelastic gas: cooling, MSD, power-law UDSBM, no collapse", 20.4, 15.9),
     "transport": (
         "elastic hard spheres: Green-Kubo, NEMD viscosity; diffusion; equation of state",
-        145.0,
+        130.0,
         25.0,
     ),
     "langevin-forces": ("Langevin model in a harmonic trap: MSD plateau, EM's limit", 20.0, 8.0),

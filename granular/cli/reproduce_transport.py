@@ -353,7 +353,7 @@ def _diffusion_rows(cfg, out, save, fig, mean_row):
         ax.plot(out_runs[0][2], (running + correction) / pieprzyk, colour,
                 label=rf"$n\sigma^3 = {density:g}$: running slope + Yeh-Hummer")  # fmt: skip
         ax.errorbar(
-            [1.5 * lo], [d_inf.mean() / pieprzyk],
+            [(1.4 + 0.1 * k) * lo], [d_inf.mean() / pieprzyk],
             yerr=[d_inf.std(ddof=1) / math.sqrt(runs) / pieprzyk],
             fmt="o", color=colour, capsize=3,
             label=rf"$n\sigma^3 = {density:g}$: slope over the window",
