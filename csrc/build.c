@@ -76,7 +76,8 @@ size_t gr_edmd_bytes_per_particle(int dim, int lists)
                  + 2 * (size_t)(dim == 3 ? 32 : 16) * sizeof(int32_t) /* a row, its copy
                                                                       * while renumbering */
                  + sizeof(int32_t) + sizeof(uint8_t)      /* near, mark */
-                 + sizeof(double) + sizeof(int8_t);       /* a sheared box's build time, lap */
+                 + 3 * sizeof(double) + sizeof(int8_t);   /* a sheared box's build time,
+                                                           * expiry, lap */
     return bytes;
 }
 

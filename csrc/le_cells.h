@@ -40,6 +40,20 @@ static inline double le_centre_x(const gr_nlist *nl, const double *c, int lap, d
     return c[0] + (double)lap * nl->lx + nl->rate * (t - nl->tref) * (c[1] - nl->yc);
 }
 
+/* A sheared list's end of life and its shell's radius, fixed when it is built at time tb
+ * about centre record c (y and z as built): le_shell_exit's cap (a strain, and a drift
+ * of the centre along x) and the plain shell less 2^-48 (|D(tb)| + L_x), for the
+ * rounding of the centre carried by the flow and of delta(t). */
+static inline void le_expiry(const gr_edmd *s, const double *c, double tb, double *out)
+{
+    const gr_nlist *nl = &s->nl;
+    const double w = nl->rate * (c[1] - nl->yc); /* the flow at the centre */
+    const double life = fabs(w) * nl->life > nl->drift ? nl->drift / fabs(w) : nl->life;
+    const double D = bd_le_total(s->cfg.shear_offset, s->le_u, tb);
+    out[0] = tb + life;
+    out[1] = nl->shell * (1.0 - 1e-9) - 0x1p-48 * (fabs(D) + s->L[0]);
+}
+
 /* File centre record c, whose x at time t is x: its x where the flow carries it at
  * t_ref, brought into the box, and *lap; returns its column. */
 static inline int32_t le_file(const gr_cells *g, const gr_nlist *nl, double *c, int8_t *lap,

@@ -130,13 +130,12 @@ static void le_scan_list(gr_edmd *s, int dyn, int dim, int32_t i)
 /* List mode in a sheared box, i's clock at the present: its shell exit (nlist.h), when
  * it leaves the shell about its centre carried by the flow, or when the list's life ends
  * (the strain it may last, and the drift of its centre); edmd.c predict then scans its
- * list.  The shell is the plain one less 2^-48 (|D(tb)| + L_x), for the rounding of the
- * centre carried by the flow and of delta(t) (at most the offset's ulp). */
+ * list.  The radius and the end are the list's (le_expiry). */
 static void le_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i)
 {
     const gr_nlist *nl = &s->nl;
     const double *p = rec(s, dim, i), *c = nl->centre + (size_t)i * (dim + 1);
-    const double tb = nl->built[i], t = TIME(p, dim);
+    const double t = TIME(p, dim), *expiry = nl->expiry + 2 * (size_t)i;
     const double w = nl->rate * (c[1] - nl->yc); /* the flow at the centre */
     double centre[3], v[3];
     for (int a = 0; a < dim; a++) {
@@ -145,13 +144,11 @@ static void le_shell_exit(gr_edmd *s, int dyn, int dim, int32_t i)
     }
     centre[0] = le_centre_x(nl, c, nl->lap[i], t);
     v[0] -= w;
-    const double D = bd_le_total(s->cfg.shear_offset, s->le_u, tb);
-    const double radius = nl->shell * (1.0 - 1e-9) - 0x1p-48 * (fabs(D) + s->L[0]);
+    const double radius = expiry[1];
     double exit = radius > 0.0 ? fl_exit_time(dyn, dim, p, v, s->cfg.gravity, centre,
                                               radius * radius)
                                : 0.0;
-    const double life = fabs(w) * nl->life > nl->drift ? nl->drift / fabs(w) : nl->life;
-    const double left = tb + life - t;
+    const double left = expiry[0] - t;
     if (left < exit) exit = left > 0.0 ? left : 0.0;
     s->sched[i].t_cross = t + exit;
 }

@@ -34,8 +34,12 @@
 /* The partner code of a slide event (as a wall "2 * dim", past the walls' codes) */
 #define GR_LE_SLIDE(dim) (-2 - 2 * (dim))
 
-/* Whether cell coordinate c1 along y is in an edge row (next to a sheared face). */
-static inline int le_edge_row(const gr_cells *g, int32_t c1) { return c1 == 0 || c1 == g->nc[1] - 1; }
+/* Whether cell coordinate c1 along y is in an edge row (next to a sheared face): 0 or
+ * nc - 1, one unsigned comparison (which rows a particle is in is as good as random). */
+static inline int le_edge_row(const gr_cells *g, int32_t c1)
+{
+    return (uint32_t)(c1 - 1) >= (uint32_t)(g->nc[1] - 2);
+}
 
 /* The time at which the images have slid S cell widths w from the phase at time 0:
  * the phase is (sign(u) d0 + |u| t) / w (delta grows with u > 0, falls with u < 0). */

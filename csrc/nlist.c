@@ -49,7 +49,8 @@ int gr_nlist_shear(gr_nlist *nl, int dim, int32_t n, double rate, const double *
     nl->lx = L[0];
     nl->built = malloc((size_t)n * sizeof *nl->built);
     nl->lap = calloc((size_t)n, sizeof *nl->lap);
-    if (!nl->built || !nl->lap) return GR_ERR_NOMEM;
+    nl->expiry = calloc(2 * (size_t)n, sizeof *nl->expiry);
+    if (!nl->built || !nl->lap || !nl->expiry) return GR_ERR_NOMEM;
     for (int32_t i = 0; i < n; i++) nl->built[i] = 0.0;
     return GR_OK;
 }
@@ -58,6 +59,7 @@ void gr_nlist_free(gr_nlist *nl)
 {
     free(nl->built);
     free(nl->lap);
+    free(nl->expiry);
     free(nl->centre);
     free(nl->rows);
     free(nl->near);

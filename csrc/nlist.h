@@ -89,6 +89,7 @@ typedef struct {
     int broken;       /* a list could not grow: lists are incomplete, no more events */
     /* sheared boxes only (le_cells.h, le_nlist.h): */
     double *built;    /* n (else NULL): each list's build time */
+    double *expiry;   /* 2 n: each list's end of life and shell radius (le_expiry) */
     int8_t *lap;      /* n: the box lengths from a centre's filed x to the flow's (le_cells.h) */
     double lx;        /* L_x */
     double rate;      /* the shear rate: a centre moves with the flow rate (y - yc) */

@@ -59,6 +59,7 @@ int gr_renumber(gr_edmd *s)
     if (s->nl.built) {
         PERMUTE(s->nl.built, double, 1);
         PERMUTE(s->nl.lap, int8_t, 1);
+        PERMUTE(s->nl.expiry, double, 2);
     }
 #undef PERMUTE
     if (lists) {

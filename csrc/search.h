@@ -251,6 +251,7 @@ static inline void set_centre(gr_edmd *s, int dim, int32_t i)
     cell_coords(&s->cells, dim, p, s->sched[i].c);
     if (s->nl.built) { /* sheared: filed where the flow carries it (le_cells.h) */
         s->nl.built[i] = TIME(p, dim);
+        le_expiry(s, centre, TIME(p, dim), s->nl.expiry + 2 * (size_t)i);
         s->sched[i].c[0] = le_file(&s->cells, &s->nl, centre, &s->nl.lap[i], p[0], TIME(p, dim));
     }
 }
