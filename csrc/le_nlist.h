@@ -13,6 +13,10 @@
 #include "engine.h"
 
 #ifdef GR_SCAN_X86
+/* for a mask of the lanes kept: those lanes in order (then lane 0), and how many */
+static const int32_t le_pack[16][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0}, {1, 2, 0, 0}, {0, 1, 2, 0}, {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0}, {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+static const int32_t le_kept[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+
 /* le_test_scalar (le_cells.h) in 3D, four candidates at a time in AVX2's lanes: each
  * lane takes le_within's steps in its order, so passes exactly when it does; the lanes
  * that pass are appended in order.  A short last group is padded (le_test_padded) and
@@ -22,6 +26,8 @@ static GR_AVX2 int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b
 {
     (void)dim;
     const double *centre = s->nl.centre;
+    const int8_t *lap = s->nl.lap;
+    const __m128i inbox = _mm_set1_epi32(-b->inbox);
     const __m256d theta = _mm256_set1_pd(b->theta), sweep = _mm256_set1_pd(b->sweep),
                   yoff = _mm256_set1_pd(b->yoff), zoff = _mm256_set1_pd(b->zoff),
                   reach = _mm256_set1_pd(b->reach), scale = _mm256_set1_pd(b->scale),
@@ -46,7 +52,21 @@ static GR_AVX2 int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b
         const __m256d cut = _mm256_mul_pd(scale, _mm256_add_pd(R, reach));
         int mask = _mm256_movemask_pd(_mm256_cmp_pd(d2, _mm256_mul_pd(cut, cut), _CMP_LT_OQ));
         if (b->n - k < 4) mask &= (1 << (b->n - k)) - 1;
-        for (; mask; mask &= mask - 1) m = le_append(&s->nl, b, k + __builtin_ctz(mask), out, m);
+        /* the entries (le_append), those kept packed to the front without a branch */
+        const __m128i J = _mm_loadu_si128((const __m128i *)(b->j + k));
+        const __m128i self = _mm_set1_epi32(b->self);
+        mask &= b->above ? _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpgt_epi32(J, self)))
+                         : ~_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(J, self)));
+        const __m128i laps = _mm_and_si128(
+            _mm_setr_epi32(lap[b->j[k]], lap[b->j[k + 1]], lap[b->j[k + 2]], lap[b->j[k + 3]]),
+            inbox);
+        const __m128i E = _mm_or_si128(
+            _mm_slli_epi32(J, GR_NL_BITS),
+            _mm_sub_epi32(_mm_loadu_si128((const __m128i *)(b->code + k)), laps));
+        const __m128i packed = _mm_castps_si128(_mm_permutevar_ps(
+            _mm_castsi128_ps(E), _mm_loadu_si128((const __m128i *)le_pack[mask & 15])));
+        _mm_storeu_si128((__m128i *)(out + m), packed);
+        m += le_kept[mask & 15];
     }
     return m;
 }

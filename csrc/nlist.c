@@ -18,7 +18,7 @@ int gr_nlist_init(gr_nlist *nl, int dim, int32_t n, double shell, const double *
     nl->cap = GR_NL_CAP_START(dim);
     nl->centre = gr_big_alloc((size_t)n * (dim + 1) * sizeof *nl->centre);
     nl->rows = gr_big_alloc((size_t)n * nl->cap * sizeof *nl->rows);
-    nl->near = malloc((size_t)n * sizeof *nl->near);
+    nl->near = malloc(((size_t)n + 4) * sizeof *nl->near); /* 4 past: le_test_avx2 */
     nl->mark = calloc((size_t)n, 1);
     for (int code = 0; code < 32; code++)
         for (int a = 0, k = code; a < 4; a++, k /= 3)
