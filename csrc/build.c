@@ -8,6 +8,7 @@
 #include "drive.h"
 #include "engine.h"
 #include "hugemem.h"
+#include "le_cells.h"
 #include "stress.h"
 
 void gr_edmd_free(gr_edmd *s)
@@ -151,6 +152,11 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
     if (status == GR_OK)
         status = gr_cells_build(&s->cells, d, n, cfg->lo, s->L, cfg->periodic,
                                 (2.0 * s->big.r_small + 2.0 * s->nl.shell) * cfg->cell_factor, err);
+    if (status == GR_OK && s->nl.built) { /* a sheared box's lists: its cells' blocks */
+        s->nl.bucket = gr_big_alloc((size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t));
+        if (!s->nl.bucket) status = GR_ERR_NOMEM;
+        else memset(s->nl.bucket, 0, (size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t));
+    }
     if (status != GR_OK) {
         gr_edmd_free(s);
         return status;

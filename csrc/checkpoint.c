@@ -339,6 +339,7 @@ static void free_state(gr_edmd *t)
     free(t->nl.built);
     free(t->nl.lap);
     free(t->nl.expiry);
+    free(t->nl.bucket);
 }
 
 /* t: a copy of s whose replaceable arrays are fresh, sized as s's (neighbour rows with
@@ -368,7 +369,9 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     t->nl.built = s->nl.built ? malloc(n * sizeof(double)) : NULL;
     t->nl.lap = s->nl.built ? malloc(n) : NULL;
     t->nl.expiry = s->nl.built ? malloc(2 * n * sizeof(double)) : NULL;
-    if ((s->nl.built && (!t->nl.built || !t->nl.lap || !t->nl.expiry)) ||!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
+    t->nl.bucket = s->nl.built ? gr_big_alloc((size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t))
+                               : NULL;
+    if ((s->nl.built && (!t->nl.built || !t->nl.lap || !t->nl.expiry || !t->nl.bucket)) ||!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
         !t->order.id_of || !t->big.is_big || !t->queue.item || !t->queue.head || !t->queue.near || !t->cells.head ||
         !t->cells.next || !t->cells.occ ||
         (lists && (!t->nl.centre || !t->nl.rows))) {
@@ -700,9 +703,11 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
         if (status == GR_ERR_VALUE) gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, what);
         return status;
     }
-    /* the occupancy bits follow from the lists, a sheared list's expiry from its build */
+    /* the occupancy bits and a sheared box's blocks follow from the lists (checked), a
+     * sheared list's expiry from its build */
     for (int32_t cell = 0; cell < t.cells.ncells; cell++)
         if (t.cells.head[cell] >= 0) t.cells.occ[cell >> 6] |= (uint64_t)1 << (cell & 63);
+    if (t.nl.built) le_sync_all(&t.cells, t.nl.bucket);
     if (t.nl.built)
         for (int32_t i = 0; i < t.n; i++)
             le_expiry(&t, t.nl.centre + (size_t)i * (t.dim + 1), t.nl.built[i],

@@ -877,6 +877,10 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
     if (cell != old) {
         cell_remove(&s->cells, i, old);
         cell_insert(&s->cells, i, cell);
+        if (s->le) { /* the blocks the sheared search reads (le_cells.h) */
+            le_sync_cell(&s->cells, s->nl.bucket, old);
+            le_sync_cell(&s->cells, s->nl.bucket, cell);
+        }
     }
     const int32_t m = find_near(s, dim, i, 0);
     int status = wrapped ? link_all(s, dim, i, m, err) : relink(s, dim, i, m, err);

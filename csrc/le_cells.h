@@ -73,6 +73,30 @@ static inline int32_t le_file(const gr_cells *g, const gr_nlist *nl, double *c, 
     return f < 0 ? 0 : f >= g->nc[0] ? g->nc[0] - 1 : f;
 }
 
+/* The cells as a sheared box's list search reads them: each cell's block of GR_LE_BLOCK
+ * int32, its count and its first GR_LE_SLOTS centres in the order its list holds them
+ * (cells.h).  A line of cells is gathered block by block, where walking the lists took a
+ * mispredicted branch at the end of nearly every cell (where a list ends is as good as
+ * random).  The lists stay the state (checkpoints save them); the blocks follow them:
+ * le_sync_cell wherever a cell's list changes, le_sync_all after all do. */
+#define GR_LE_BLOCK 8
+#define GR_LE_SLOTS (GR_LE_BLOCK - 1)
+
+static inline void le_sync_cell(const gr_cells *g, int32_t *bucket, int32_t cell)
+{
+    int32_t *block = bucket + (size_t)GR_LE_BLOCK * cell, count = 0;
+    for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
+        if (count < GR_LE_SLOTS) block[1 + count] = j;
+        count++;
+    }
+    block[0] = count;
+}
+
+static inline void le_sync_all(const gr_cells *g, int32_t *bucket)
+{
+    for (int32_t cell = 0; cell < g->ncells; cell++) le_sync_cell(g, bucket, cell);
+}
+
 /* A line of cells' candidates for le_gather, tested in a batch: their indices, each
  * one's x offset (the line's, with its cell's wrap) and image code (less its laps); and
  * what the line shares. */
@@ -117,7 +141,7 @@ static inline int32_t le_append(const gr_nlist *nl, const le_batch *b, int k, in
     return m + ((j != b->self) & (!b->above | (j > b->self)));
 }
 
-static int32_t le_test_scalar(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
+static inline int32_t le_test_scalar(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
                               int32_t m)
 {
     for (int k = 0; k < b->n; k++)
@@ -211,18 +235,35 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
             b.n = 0;
             for (int32_t K = K0; K <= K1; K++) {
                 const int32_t k = bd_cell_wrap(K, nx), cell = rowbase + k;
-                if (!cell_occupied(g, cell)) continue;
                 const int32_t wrap = (K - k) / nx; /* the window's image: -1, 0 or 1 */
                 const double xcell = xoff + (double)wrap * Lx;
                 const int32_t code1 = code0 + 1 + b.inbox * wrap;
-                for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
-                    b.j[b.n] = j;
-                    b.xoff[b.n] = xcell;
-                    b.code[b.n] = code1;
-                    if (++b.n == GR_LE_BATCH) {
-                        m = le_test_padded(s, dim, &b, out, m, test);
-                        b.n = 0;
+                /* the cell's block, all its slots (those past its count are overwritten
+                 * or never read) */
+                const int32_t *block = nl->bucket + (size_t)GR_LE_BLOCK * cell;
+                const int32_t count = block[0];
+                for (int l = 0; l < GR_LE_SLOTS; l++) {
+                    b.j[b.n + l] = block[1 + l];
+                    b.xoff[b.n + l] = xcell;
+                    b.code[b.n + l] = code1;
+                }
+                if (count <= GR_LE_SLOTS) {
+                    b.n += count;
+                } else { /* the rest from its list */
+                    b.n += GR_LE_SLOTS;
+                    for (int32_t j = g->next[block[GR_LE_SLOTS]]; j >= 0; j = g->next[j]) {
+                        if (b.n == GR_LE_BATCH) {
+                            m = le_test_padded(s, dim, &b, out, m, test);
+                            b.n = 0;
+                        }
+                        b.j[b.n] = j;
+                        b.xoff[b.n] = xcell;
+                        b.code[b.n++] = code1;
                     }
+                }
+                if (b.n > GR_LE_BATCH - GR_LE_SLOTS) { /* room for the next cell's slots */
+                    m = le_test_padded(s, dim, &b, out, m, test);
+                    b.n = 0;
                 }
             }
             if (b.n) m = le_test_padded(s, dim, &b, out, m, test);

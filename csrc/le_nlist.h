@@ -101,6 +101,7 @@ static void le_refile(gr_edmd *s, int dim, double t)
         e->c[0] = le_file(g, nl, c, &nl->lap[i], c[0] + (double)nl->lap[i] * nl->lx, tref);
         cell_insert(g, i, cell_of(g, dim, e->c));
     }
+    le_sync_all(g, nl->bucket);
 }
 
 /* One listed candidate j through a y face (image shift sh: y and z; ky = sign of its y):

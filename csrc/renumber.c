@@ -12,6 +12,7 @@
 
 #include "engine.h"
 #include "hugemem.h"
+#include "le_cells.h"
 
 /* A counting sort by cell, O(N + cells), permuting every per-particle array and
  * remapping every stored particle index: partners, the queue, the cell lists, the
@@ -92,6 +93,7 @@ int gr_renumber(gr_edmd *s)
         if (s->big.is_big[i]) continue;
         cell_insert(g, i, cell_of(g, d, s->sched[i].c));
     }
+    if (s->nl.bucket) le_sync_all(g, s->nl.bucket);
     s->order.next = s->events + (int64_t)GR_RENUMBER_EVENTS_PER_N * n;
     return GR_OK;
 }
