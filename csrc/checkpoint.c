@@ -703,15 +703,17 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
         if (status == GR_ERR_VALUE) gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, what);
         return status;
     }
-    /* the occupancy bits and a sheared box's blocks follow from the lists (checked), a
-     * sheared list's expiry from its build */
+    /* the occupancy bits follow from the lists (checked); in a sheared box so do the
+     * cells' blocks, the offset at the filing time and each list's expiry */
     for (int32_t cell = 0; cell < t.cells.ncells; cell++)
         if (t.cells.head[cell] >= 0) t.cells.occ[cell >> 6] |= (uint64_t)1 << (cell & 63);
-    if (t.nl.built) le_sync_all(&t.cells, t.nl.bucket);
-    if (t.nl.built)
+    if (t.nl.built) {
+        le_sync_all(&t.cells, t.nl.bucket);
+        t.nl.dref = bd_le_offset(t.cfg.shear_offset, t.le_u, t.nl.tref, t.nl.lx);
         for (int32_t i = 0; i < t.n; i++)
             le_expiry(&t, t.nl.centre + (size_t)i * (t.dim + 1), t.nl.built[i],
                       t.nl.expiry + 2 * (size_t)i);
+    }
     if (t.nl.shell > 0.0 && (what = check_lists(&t)) != NULL) {
         free_state(&t);
         gr_error_set(err, GR_ERR_VALUE, -1, -1, NAN, NAN, what);

@@ -19,6 +19,7 @@
 #define GR_LE_CELLS_H
 
 #include <math.h>
+#include <string.h>
 
 #include "engine.h"
 
@@ -184,7 +185,7 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
     b.above = above;
     int32_t c[3] = {0, 0, 0};
     cell_coords(g, dim, ci, c); /* y and z: the rows; x is taken from the flow below */
-    const double dref = bd_le_offset(s->cfg.shear_offset, s->le_u, nl->tref, Lx);
+    const double dref = nl->dref;
     b.theta = nl->rate * (t - nl->tref);
     b.sweep = nl->rate * nl->life;
     /* the reach at most, and room for the window's rounding */
@@ -232,7 +233,7 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
             /* the image code (nlist.h nl_code) but for its x digit */
             const int32_t code0 = 3 * (ky + 1) + 9 * ((shz > 0.0) - (shz < 0.0) + 1) * (dim == 3);
             const int32_t rowbase = (q2 * g->nc[1] + q1) * nx;
-            b.n = 0;
+            int32_t n = 0; /* a local: the batch's stores might alias its count */
             for (int32_t K = K0; K <= K1; K++) {
                 const int32_t k = bd_cell_wrap(K, nx), cell = rowbase + k;
                 const int32_t wrap = (K - k) / nx; /* the window's image: -1, 0 or 1 */
@@ -242,31 +243,34 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
                  * or never read) */
                 const int32_t *block = nl->bucket + (size_t)GR_LE_BLOCK * cell;
                 const int32_t count = block[0];
+                memcpy(b.j + n, block + 1, GR_LE_SLOTS * sizeof *block);
                 for (int l = 0; l < GR_LE_SLOTS; l++) {
-                    b.j[b.n + l] = block[1 + l];
-                    b.xoff[b.n + l] = xcell;
-                    b.code[b.n + l] = code1;
+                    b.xoff[n + l] = xcell;
+                    b.code[n + l] = code1;
                 }
                 if (count <= GR_LE_SLOTS) {
-                    b.n += count;
+                    n += count;
                 } else { /* the rest from its list */
-                    b.n += GR_LE_SLOTS;
+                    n += GR_LE_SLOTS;
                     for (int32_t j = g->next[block[GR_LE_SLOTS]]; j >= 0; j = g->next[j]) {
-                        if (b.n == GR_LE_BATCH) {
+                        if (n == GR_LE_BATCH) {
+                            b.n = n;
                             m = le_test_padded(s, dim, &b, out, m, test);
-                            b.n = 0;
+                            n = 0;
                         }
-                        b.j[b.n] = j;
-                        b.xoff[b.n] = xcell;
-                        b.code[b.n++] = code1;
+                        b.j[n] = j;
+                        b.xoff[n] = xcell;
+                        b.code[n++] = code1;
                     }
                 }
-                if (b.n > GR_LE_BATCH - GR_LE_SLOTS) { /* room for the next cell's slots */
+                if (n > GR_LE_BATCH - GR_LE_SLOTS) { /* room for the next cell's slots */
+                    b.n = n;
                     m = le_test_padded(s, dim, &b, out, m, test);
-                    b.n = 0;
+                    n = 0;
                 }
             }
-            if (b.n) m = le_test_padded(s, dim, &b, out, m, test);
+            b.n = n;
+            if (n) m = le_test_padded(s, dim, &b, out, m, test);
         }
     }
     return m;

@@ -94,6 +94,7 @@ static void le_refile(gr_edmd *s, int dim, double t)
     gr_nlist *nl = &s->nl;
     const double tref = nl->tref;
     nl->tref = t + nl->span;
+    nl->dref = bd_le_offset(s->cfg.shear_offset, s->le_u, nl->tref, nl->lx);
     gr_cells_clear(g);
     for (int32_t i = s->n - 1; i >= 0; i--) { /* each cell's list in increasing order */
         gr_sched *e = &s->sched[i];

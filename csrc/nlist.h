@@ -99,6 +99,7 @@ typedef struct {
     double life;      /* a list's longest life */
     double drift;     /* the farthest the flow may carry a centre along x */
     double tref;      /* the time the centres are filed at (le_cells.h) */
+    double dref;      /* the images' offset delta at tref (bd_le_offset) */
     double span;      /* filed anew once the time passes tref + span */
     double img[32][4];/* image code -> shift, code = sum over axes of (s_a + 1) 3^a; the
                        * fourth column 0, for loads of four (scan_avx2.h) */
