@@ -21,7 +21,7 @@ static const int32_t le_kept[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3,
  * lane takes le_within's steps in its order, so passes exactly when it does; the lanes
  * that pass are appended in order.  A short last group is padded (le_test_padded) and
  * masked. */
-static GR_AVX2 int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
+static GR_AVX2 inline int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
                                     int32_t m)
 {
     (void)dim;
@@ -74,15 +74,23 @@ static GR_AVX2 int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b
 
 /* find_near in a sheared box, from i's position (its new centre) at its clock
  * (le_cells.h), in AVX2's lanes in 3D on CPUs that have them (the same bits). */
+#ifdef GR_SCAN_X86
+/* le_gather compiled for AVX2, its batches' test inlined (3D) */
+static GR_AVX2 int32_t le_gather_avx2(gr_edmd *s, const double *point, double t, int32_t i,
+                                      int above)
+{
+    return le_gather(s, 3, point, t, i, above, 1.0, s->nl.near, le_test_avx2);
+}
+#endif
+
 static int32_t le_find_near(gr_edmd *s, int dim, int32_t i, int above)
 {
     const double *p = rec(s, dim, i);
     const double point[4] = {p[0], p[1], dim == 3 ? p[2] : RAD(p, dim), RAD(p, dim)};
-    le_batch_test test = le_test_scalar;
 #ifdef GR_SCAN_X86
-    if (dim == 3 && gr_scan_avx2) test = le_test_avx2;
+    if (dim == 3 && gr_scan_avx2) return le_gather_avx2(s, point, TIME(p, dim), i, above);
 #endif
-    return le_gather(s, dim, point, TIME(p, dim), i, above, 1.0, s->nl.near, test);
+    return le_gather(s, dim, point, TIME(p, dim), i, above, 1.0, s->nl.near, le_test_scalar);
 }
 
 /* File every list centre anew where the flow carries it at t + span (le_cells.h), so
