@@ -69,7 +69,7 @@
 #define GR_NL_BITS 5
 /* a sheared box's centres are filed anew when the strain since their filing time passes
  * this, as |rate (t - t_ref)| (le_cells.h) */
-#define GR_NL_TILT 0.05
+#define GR_NL_TILT 0.1
 /* a sheared box's list lives at most this strain, |rate| t (nlist.h) */
 #ifndef GR_NL_STRAIN
 #define GR_NL_STRAIN 0.4
