@@ -77,8 +77,10 @@ size_t gr_edmd_bytes_per_particle(int dim, int lists)
                  + 2 * (size_t)(dim == 3 ? 32 : 16) * sizeof(int32_t) /* a row, its copy
                                                                       * while renumbering */
                  + sizeof(int32_t) + sizeof(uint8_t)      /* near, mark */
-                 + 3 * sizeof(double) + sizeof(int8_t);   /* a sheared box's build time,
+                 + 3 * sizeof(double) + sizeof(int8_t)    /* a sheared box's build time,
                                                            * expiry, lap */
+                 + 8 * GR_LE_BLOCK * sizeof(int32_t);     /* its cells' blocks: at most 8
+                                                           * cells each */
     return bytes;
 }
 
@@ -153,9 +155,9 @@ int gr_edmd_new(gr_edmd **out, const gr_edmd_config *cfg, const double *pos,
         status = gr_cells_build(&s->cells, d, n, cfg->lo, s->L, cfg->periodic,
                                 (2.0 * s->big.r_small + 2.0 * s->nl.shell) * cfg->cell_factor, err);
     if (status == GR_OK && s->nl.built) { /* a sheared box's lists: its cells' blocks */
-        s->nl.bucket = gr_big_alloc((size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t));
-        if (!s->nl.bucket) status = GR_ERR_NOMEM;
-        else memset(s->nl.bucket, 0, (size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t));
+        s->nl.blocks = gr_big_alloc((size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t));
+        if (!s->nl.blocks) status = GR_ERR_NOMEM;
+        else memset(s->nl.blocks, 0, (size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t));
     }
     if (status != GR_OK) {
         gr_edmd_free(s);

@@ -339,7 +339,7 @@ static void free_state(gr_edmd *t)
     free(t->nl.built);
     free(t->nl.lap);
     free(t->nl.expiry);
-    free(t->nl.bucket);
+    free(t->nl.blocks);
 }
 
 /* t: a copy of s whose replaceable arrays are fresh, sized as s's (neighbour rows with
@@ -369,9 +369,9 @@ static int alloc_state(gr_edmd *t, const gr_edmd *s, int32_t cap)
     t->nl.built = s->nl.built ? malloc(n * sizeof(double)) : NULL;
     t->nl.lap = s->nl.built ? malloc(n) : NULL;
     t->nl.expiry = s->nl.built ? malloc(2 * n * sizeof(double)) : NULL;
-    t->nl.bucket = s->nl.built ? gr_big_alloc((size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t))
+    t->nl.blocks = s->nl.built ? gr_big_alloc((size_t)s->cells.ncells * GR_LE_BLOCK * sizeof(int32_t))
                                : NULL;
-    if ((s->nl.built && (!t->nl.built || !t->nl.lap || !t->nl.expiry || !t->nl.bucket)) ||!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
+    if ((s->nl.built && (!t->nl.built || !t->nl.lap || !t->nl.expiry || !t->nl.blocks)) ||!t->P || !t->mass || (s->spin && !t->spin) || !t->image || !t->sched ||
         !t->order.id_of || !t->big.is_big || !t->queue.item || !t->queue.head || !t->queue.near || !t->cells.head ||
         !t->cells.next || !t->cells.occ ||
         (lists && (!t->nl.centre || !t->nl.rows))) {
@@ -708,7 +708,8 @@ int gr_edmd_restore(gr_edmd *s, const unsigned char *buf, size_t size, gr_error 
     for (int32_t cell = 0; cell < t.cells.ncells; cell++)
         if (t.cells.head[cell] >= 0) t.cells.occ[cell >> 6] |= (uint64_t)1 << (cell & 63);
     if (t.nl.built) {
-        le_sync_all(&t.cells, t.nl.bucket);
+        memset(t.nl.blocks, 0, (size_t)t.cells.ncells * GR_LE_BLOCK * sizeof(int32_t));
+        le_sync_all(&t.cells, t.nl.blocks);
         t.nl.dref = bd_le_offset(t.cfg.shear_offset, t.le_u, t.nl.tref, t.nl.lx);
         for (int32_t i = 0; i < t.n; i++)
             le_expiry(&t, t.nl.centre + (size_t)i * (t.dim + 1), t.nl.built[i],

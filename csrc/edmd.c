@@ -878,8 +878,8 @@ static GR_ALWAYS_INLINE int do_shell_exit(gr_edmd *s, int dyn, int dim, int32_t 
         cell_remove(&s->cells, i, old);
         cell_insert(&s->cells, i, cell);
         if (s->le) { /* the blocks the sheared search reads (le_cells.h) */
-            le_sync_cell(&s->cells, s->nl.bucket, old);
-            le_sync_cell(&s->cells, s->nl.bucket, cell);
+            le_sync_cell(&s->cells, s->nl.blocks, old);
+            le_sync_cell(&s->cells, s->nl.blocks, cell);
         }
     }
     const int32_t m = find_near(s, dim, i, 0);

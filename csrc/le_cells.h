@@ -83,9 +83,9 @@ static inline int32_t le_file(const gr_cells *g, const gr_nlist *nl, double *c, 
 #define GR_LE_BLOCK 8
 #define GR_LE_SLOTS (GR_LE_BLOCK - 1)
 
-static inline void le_sync_cell(const gr_cells *g, int32_t *bucket, int32_t cell)
+static inline void le_sync_cell(const gr_cells *g, int32_t *blocks, int32_t cell)
 {
-    int32_t *block = bucket + (size_t)GR_LE_BLOCK * cell, count = 0;
+    int32_t *block = blocks + (size_t)GR_LE_BLOCK * cell, count = 0;
     for (int32_t j = g->head[cell]; j >= 0; j = g->next[j]) {
         if (count < GR_LE_SLOTS) block[1 + count] = j;
         count++;
@@ -93,9 +93,9 @@ static inline void le_sync_cell(const gr_cells *g, int32_t *bucket, int32_t cell
     block[0] = count;
 }
 
-static inline void le_sync_all(const gr_cells *g, int32_t *bucket)
+static inline void le_sync_all(const gr_cells *g, int32_t *blocks)
 {
-    for (int32_t cell = 0; cell < g->ncells; cell++) le_sync_cell(g, bucket, cell);
+    for (int32_t cell = 0; cell < g->ncells; cell++) le_sync_cell(g, blocks, cell);
 }
 
 /* A line of cells' candidates for le_gather, tested in a batch: their indices, each
@@ -142,8 +142,8 @@ static inline int32_t le_append(const gr_nlist *nl, const le_batch *b, int k, in
     return m + ((j != b->self) & (!b->above | (j > b->self)));
 }
 
-static inline int32_t le_test_scalar(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
-                              int32_t m)
+static inline int32_t le_test_scalar(const gr_edmd *s, int dim, const le_batch *b,
+                                     int32_t *out, int32_t m)
 {
     for (int k = 0; k < b->n; k++)
         if (le_within(s->nl.centre + (size_t)b->j[k] * (dim + 1), dim, b, b->xoff[k]))
@@ -241,7 +241,7 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
                 const int32_t code1 = code0 + 1 + b.inbox * wrap;
                 /* the cell's block, all its slots (those past its count are overwritten
                  * or never read) */
-                const int32_t *block = nl->bucket + (size_t)GR_LE_BLOCK * cell;
+                const int32_t *block = nl->blocks + (size_t)GR_LE_BLOCK * cell;
                 const int32_t count = block[0];
                 memcpy(b.j + n, block + 1, GR_LE_SLOTS * sizeof *block);
                 for (int l = 0; l < GR_LE_SLOTS; l++) {

@@ -14,15 +14,18 @@
 
 #ifdef GR_SCAN_X86
 /* for a mask of the lanes kept: those lanes in order (then lane 0), and how many */
-static const int32_t le_pack[16][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0}, {1, 2, 0, 0}, {0, 1, 2, 0}, {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0}, {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+static const int32_t le_pack[16][4] = {
+    {0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0},
+    {1, 2, 0, 0}, {0, 1, 2, 0}, {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0},
+    {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
 static const int32_t le_kept[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
 
 /* le_test_scalar (le_cells.h) in 3D, four candidates at a time in AVX2's lanes: each
  * lane takes le_within's steps in its order, so passes exactly when it does; the lanes
  * that pass are appended in order.  A short last group is padded (le_test_padded) and
  * masked. */
-static GR_AVX2 inline int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b, int32_t *out,
-                                    int32_t m)
+static GR_AVX2 inline int32_t le_test_avx2(const gr_edmd *s, int dim, const le_batch *b,
+                                           int32_t *out, int32_t m)
 {
     (void)dim;
     const double *centre = s->nl.centre;
@@ -72,8 +75,6 @@ static GR_AVX2 inline int32_t le_test_avx2(const gr_edmd *s, int dim, const le_b
 }
 #endif
 
-/* find_near in a sheared box, from i's position (its new centre) at its clock
- * (le_cells.h), in AVX2's lanes in 3D on CPUs that have them (the same bits). */
 #ifdef GR_SCAN_X86
 /* le_gather compiled for AVX2, its batches' test inlined (3D) */
 static GR_AVX2 int32_t le_gather_avx2(gr_edmd *s, const double *point, double t, int32_t i,
@@ -83,6 +84,8 @@ static GR_AVX2 int32_t le_gather_avx2(gr_edmd *s, const double *point, double t,
 }
 #endif
 
+/* find_near in a sheared box, from i's position (its new centre) at its clock
+ * (le_cells.h), in AVX2's lanes in 3D on CPUs that have them (the same bits). */
 static int32_t le_find_near(gr_edmd *s, int dim, int32_t i, int above)
 {
     const double *p = rec(s, dim, i);
@@ -110,7 +113,7 @@ static void le_refile(gr_edmd *s, int dim, double t)
         e->c[0] = le_file(g, nl, c, &nl->lap[i], c[0] + (double)nl->lap[i] * nl->lx, tref);
         cell_insert(g, i, cell_of(g, dim, e->c));
     }
-    le_sync_all(g, nl->bucket);
+    le_sync_all(g, nl->blocks);
 }
 
 /* One listed candidate j through a y face (image shift sh: y and z; ky = sign of its y):

@@ -60,7 +60,7 @@ void gr_nlist_free(gr_nlist *nl)
     free(nl->built);
     free(nl->lap);
     free(nl->expiry);
-    free(nl->bucket);
+    free(nl->blocks);
     free(nl->centre);
     free(nl->rows);
     free(nl->near);

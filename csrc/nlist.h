@@ -91,7 +91,7 @@ typedef struct {
     double *built;    /* n (else NULL): each list's build time */
     double *expiry;   /* 2 n: each list's end of life and shell radius (le_expiry) */
     int8_t *lap;      /* n: the box lengths from a centre's filed x to the flow's (le_cells.h) */
-    int32_t *bucket;  /* 8 per cell: its count and first centres, as listed (le_cells.h) */
+    int32_t *blocks;  /* GR_LE_BLOCK a cell: its count, its first centres (le_cells.h) */
     double lx;        /* L_x */
     double rate;      /* the shear rate: a centre moves with the flow rate (y - yc) */
     double yc;        /* the box's middle in y, where the flow is at rest */

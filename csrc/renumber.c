@@ -93,7 +93,7 @@ int gr_renumber(gr_edmd *s)
         if (s->big.is_big[i]) continue;
         cell_insert(g, i, cell_of(g, d, s->sched[i].c));
     }
-    if (s->nl.bucket) le_sync_all(g, s->nl.bucket);
+    if (s->nl.blocks) le_sync_all(g, s->nl.blocks);
     s->order.next = s->events + (int64_t)GR_RENUMBER_EVENTS_PER_N * n;
     return GR_OK;
 }
