@@ -236,7 +236,10 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
             int32_t n = 0; /* a local: the batch's stores might alias its count */
             for (int32_t K = K0; K <= K1; K++) {
                 const int32_t k = bd_cell_wrap(K, nx), cell = rowbase + k;
-                const int32_t wrap = (K - k) / nx; /* the window's image: -1, 0 or 1 */
+                /* the window's image: -1, 0 or 1 in the box's rows (the x image an entry
+                 * keeps); across a y face, whose offset shifts the window up to a box
+                 * length, -2 to 2 */
+                const int32_t wrap = (K - k) / nx;
                 const double xcell = xoff + (double)wrap * Lx;
                 const int32_t code1 = code0 + 1 + b.inbox * wrap;
                 /* the cell's block, all its slots (those past its count are overwritten
