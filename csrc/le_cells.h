@@ -98,17 +98,18 @@ static inline void le_sync_all(const gr_cells *g, int32_t *blocks)
     for (int32_t cell = 0; cell < g->ncells; cell++) le_sync_cell(g, blocks, cell);
 }
 
-/* A line of cells' candidates for le_gather, tested in a batch: their indices, each
- * one's x offset (the line's, with its cell's wrap) and image code (less its laps); and
- * what the line shares. */
+/* A line of cells' candidates for le_gather, tested in a batch: their indices and each
+ * one's wrap (the box lengths its cell's window image lies along x: -2 to 2), and what
+ * the line shares.  A candidate's x offset is xline + wrap lx, its image code (less its
+ * laps) code1 + inbox wrap: a cell writes its wrap for its slots in one 8-byte store,
+ * where it wrote each slot's offset and code. */
 #define GR_LE_BATCH 64
 typedef struct {
     int32_t j[GR_LE_BATCH + 3];
-    double xoff[GR_LE_BATCH + 3];
-    int32_t code[GR_LE_BATCH + 3];
+    int8_t wrap[GR_LE_BATCH + 8];
     int n;
-    double theta, sweep, yoff, zoff, reach, scale;
-    int32_t inbox, self, above;
+    double theta, sweep, yoff, zoff, reach, scale, xline, lx;
+    int32_t inbox, self, above, code1;
 } le_batch;
 
 /* Test a batch's candidates (le_gather), appending those within reach to out (m so far);
@@ -138,7 +139,7 @@ static inline int32_t le_append(const gr_nlist *nl, const le_batch *b, int k, in
                                 int32_t m)
 {
     const int32_t j = b->j[k];
-    out[m] = (j << GR_NL_BITS) | (b->code[k] - b->inbox * nl->lap[j]);
+    out[m] = (j << GR_NL_BITS) | (b->code1 + b->inbox * (b->wrap[k] - nl->lap[j]));
     return m + ((j != b->self) & (!b->above | (j > b->self)));
 }
 
@@ -146,13 +147,15 @@ static inline int32_t le_test_scalar(const gr_edmd *s, int dim, const le_batch *
                                      int32_t *out, int32_t m)
 {
     for (int k = 0; k < b->n; k++)
-        if (le_within(s->nl.centre + (size_t)b->j[k] * (dim + 1), dim, b, b->xoff[k]))
+        if (le_within(s->nl.centre + (size_t)b->j[k] * (dim + 1), dim, b,
+                      b->xline + (double)b->wrap[k] * b->lx))
             m = le_append(&s->nl, b, k, out, m);
     return m;
 }
 
 /* A batch tested, its last group of four filled with copies of its first candidate (the
- * lanes past n are masked: le_nlist.h). */
+ * lanes past n are masked: le_nlist.h; their wraps, read with the group's, are whatever
+ * bytes lie there and change nothing). */
 static inline int32_t le_test_padded(const gr_edmd *s, int dim, le_batch *b, int32_t *out,
                                      int32_t m, le_batch_test test)
 {
@@ -179,6 +182,7 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
     const gr_nlist *nl = &s->nl;
     const double Lx = nl->lx;
     le_batch b;
+    b.lx = Lx;
     b.reach = ci[dim] + 2.0 * nl->shell;
     b.scale = scale;
     b.self = self;
@@ -213,7 +217,7 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
         const double upper0 = -le_min(le_min(0.0, b.sweep * ya) + b.theta * ya,
                                       le_min(0.0, b.sweep * yb) + b.theta * yb);
         b.yoff = (double)ky * s->L[1] - ci[1];
-        const double xoff = (double)ky * dref + b.theta * ((double)ky * s->L[1] - nl->yc) - ci[0];
+        b.xline = (double)ky * dref + b.theta * ((double)ky * s->L[1] - nl->yc) - ci[0];
         b.inbox = !ky; /* an x image in the entry: within the box only */
         for (int kz = 0; kz < nz; kz++) {
             const int32_t q2 = dim == 3 ? g->nb_cell[2][3 * c[2] + kz] : 0;
@@ -230,27 +234,29 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
             const int32_t K0 = le_floor((x0 + lower0 - Rx - slack) / g->w[0]);
             int32_t K1 = le_floor((x0 + upper0 + Rx + slack) / g->w[0]);
             if (K1 > K0 + nx - 1) K1 = K0 + nx - 1; /* each cell once */
-            /* the image code (nlist.h nl_code) but for its x digit */
-            const int32_t code0 = 3 * (ky + 1) + 9 * ((shz > 0.0) - (shz < 0.0) + 1) * (dim == 3);
+            /* the image code (nlist.h nl_code), its x digit that of the box */
+            b.code1 = 1 + 3 * (ky + 1) + 9 * ((shz > 0.0) - (shz < 0.0) + 1) * (dim == 3);
             const int32_t rowbase = (q2 * g->nc[1] + q1) * nx;
             int32_t n = 0; /* a local: the batch's stores might alias its count */
-            for (int32_t K = K0; K <= K1; K++) {
-                const int32_t k = bd_cell_wrap(K, nx), cell = rowbase + k;
-                /* the window's image: -1, 0 or 1 in the box's rows (the x image an entry
-                 * keeps); across a y face, whose offset shifts the window up to a box
-                 * length, -2 to 2 */
-                const int32_t wrap = (K - k) / nx;
-                const double xcell = xoff + (double)wrap * Lx;
-                const int32_t code1 = code0 + 1 + b.inbox * wrap;
-                /* the cell's block, all its slots (those past its count are overwritten
-                 * or never read) */
+            /* column k of the box and the window's image `wrap` (K = k + wrap nx): -1, 0
+             * or 1 in the box's rows (the x image an entry keeps); across a y face, whose
+             * offset shifts the window up to a box length, -2 to 2.  Stepped along the
+             * line, not found by three integer divisions a cell on the way to its
+             * address */
+            int32_t k = bd_cell_wrap(K0, nx), wrap = (K0 - k) / nx;
+            for (int32_t K = K0; K <= K1; K++, k++) {
+                if (k == nx) { /* once a line at most, where the window wraps */
+                    k = 0;
+                    wrap++;
+                }
+                const int32_t cell = rowbase + k;
+                /* the cell's block, all its slots, and its wrap in eight (those past its
+                 * count are overwritten or never read) */
                 const int32_t *block = nl->blocks + (size_t)GR_LE_BLOCK * cell;
                 const int32_t count = block[0];
+                const uint64_t wraps = (uint64_t)(uint8_t)(int8_t)wrap * 0x0101010101010101u;
                 memcpy(b.j + n, block + 1, GR_LE_SLOTS * sizeof *block);
-                for (int l = 0; l < GR_LE_SLOTS; l++) {
-                    b.xoff[n + l] = xcell;
-                    b.code[n + l] = code1;
-                }
+                memcpy(b.wrap + n, &wraps, sizeof wraps);
                 if (count <= GR_LE_SLOTS) {
                     n += count;
                 } else { /* the rest from its list */
@@ -262,8 +268,7 @@ static GR_ALWAYS_INLINE int32_t le_gather(const gr_edmd *s, int dim, const doubl
                             n = 0;
                         }
                         b.j[n] = j;
-                        b.xoff[n] = xcell;
-                        b.code[n++] = code1;
+                        b.wrap[n++] = (int8_t)wrap;
                     }
                 }
                 if (n > GR_LE_BATCH - GR_LE_SLOTS) { /* room for the next cell's slots */

@@ -34,15 +34,20 @@ static GR_AVX2 inline int32_t le_test_avx2(const gr_edmd *s, int dim, const le_b
     const __m256d theta = _mm256_set1_pd(b->theta), sweep = _mm256_set1_pd(b->sweep),
                   yoff = _mm256_set1_pd(b->yoff), zoff = _mm256_set1_pd(b->zoff),
                   reach = _mm256_set1_pd(b->reach), scale = _mm256_set1_pd(b->scale),
+                  xline = _mm256_set1_pd(b->xline), lx = _mm256_set1_pd(b->lx),
                   zero = _mm256_setzero_pd();
+    const __m128i code1 = _mm_set1_epi32(b->code1);
     for (int k = 0; k < b->n; k += 4) {
         const double *q[4];
         for (int l = 0; l < 4; l++) q[l] = centre + (size_t)4 * b->j[k + l]; /* padded */
         __m256d X, Y, Z, R;
         GR_TRANSPOSE4(_mm256_load_pd(q[0]), _mm256_load_pd(q[1]), _mm256_load_pd(q[2]),
                       _mm256_load_pd(q[3]), X, Y, Z, R);
-        const __m256d dx = _mm256_add_pd(_mm256_add_pd(X, _mm256_mul_pd(theta, Y)),
-                                         _mm256_loadu_pd(b->xoff + k));
+        int32_t w4; /* the lanes' wraps */
+        memcpy(&w4, b->wrap + k, sizeof w4);
+        const __m128i W = _mm_cvtepi8_epi32(_mm_cvtsi32_si128(w4));
+        const __m256d xoff = _mm256_add_pd(xline, _mm256_mul_pd(_mm256_cvtepi32_pd(W), lx));
+        const __m256d dx = _mm256_add_pd(_mm256_add_pd(X, _mm256_mul_pd(theta, Y)), xoff);
         const __m256d dy = _mm256_add_pd(Y, yoff);
         const __m256d end = _mm256_add_pd(dx, _mm256_mul_pd(sweep, dy));
         const __m256d dx2 = _mm256_mul_pd(dx, dx), end2 = _mm256_mul_pd(end, end);
@@ -65,7 +70,7 @@ static GR_AVX2 inline int32_t le_test_avx2(const gr_edmd *s, int dim, const le_b
             inbox);
         const __m128i E = _mm_or_si128(
             _mm_slli_epi32(J, GR_NL_BITS),
-            _mm_sub_epi32(_mm_loadu_si128((const __m128i *)(b->code + k)), laps));
+            _mm_sub_epi32(_mm_add_epi32(code1, _mm_and_si128(W, inbox)), laps));
         const __m128i packed = _mm_castps_si128(_mm_permutevar_ps(
             _mm_castsi128_ps(E), _mm_loadu_si128((const __m128i *)le_pack[mask & 15])));
         _mm_storeu_si128((__m128i *)(out + m), packed);
