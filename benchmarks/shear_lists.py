@@ -30,6 +30,7 @@ work a collision fairly: T = 1 is a convention that keeps the figures legible.
     python shear_lists.py prep DIR                      # once (some 20 s)
     python shear_lists.py run DIR CASE MODE EVENTS [WARMUP]   # one case, one line
     python shear_lists.py rounds DIR EVENTS ROUNDS [PATH_A PATH_B]  # interleaved, medians
+    python shear_lists.py target DIR EVENTS ROUNDS [PATH_A PATH_B]  # the same, lists only
 
 CASE is eq, usf0.5 or usf1.5, or onset0.5: the equilibrium gas sheared from rest at
 gamma* = 0.5 (elastic, no mean flow yet: its first 10^5 or so events are the transient that
@@ -40,7 +41,9 @@ pair collision, the CPU seconds (not the start-up, the build or the warm-up) and
 collisions a CPU second.  `rounds` runs every case and mode in a fresh interpreter (WARMUP
 200 000), ROUNDS times, the order reversed every other round; given two PYTHONPATHs (two
 worktrees with their own builds), each case runs with each in turn, and the ratio B / A is
-taken round by round.
+taken round by round.  Each sheared case's rate over the gas at rest is also taken round by
+round (the issue's target: 0.85), with a bootstrap interval of its median.  `target` runs the
+three cases with lists only, back to back, so that a round's runs are closer in time.
 `shear_lists.sh` counts instructions a pair collision between two event counts under
 cachegrind.  `--tiny` runs prep (N = 500, short) and each case for a few thousand events in
 a temporary folder (that it works, not a measurement).
@@ -255,6 +258,21 @@ def rounds(folder, events, count, runs, warmup, builds=(None,)):
             f"{case:7s} {mode:6s} {m:.4g} ({min(r):.4g} - {max(r):.4g})  {m / base:.3f}  "
             f"{'AB'[k] if len(builds) == 2 else ''} {builds[k] or ''}"
         )
+    # the figure: the sheared gas over the gas at rest (same build and mode), round
+    # by round, the runs of a round minutes apart at most; the median's 95 % interval by
+    # bootstrap over the rounds
+    rng = np.random.default_rng(0)
+    print("case    mode   over eq, round by round: median (IQR; range) [95 % of the median]")
+    for (k, case, mode), r in rates.items():
+        if case == "eq" or (k, "eq", mode) not in rates:
+            continue
+        q = np.array(r) / np.array(rates[k, "eq", mode])
+        lo, hi = np.percentile(np.median(rng.choice(q, (4000, q.size)), axis=1), [2.5, 97.5])
+        p25, p75 = np.percentile(q, [25, 75])
+        print(
+            f"{case:7s} {mode:6s} {np.median(q):.3f} ({p25:.3f}-{p75:.3f}; {q.min():.3f}-"
+            f"{q.max():.3f}) [{lo:.3f}-{hi:.3f}]  {'AB'[k] if len(builds) == 2 else ''}"
+        )
     if len(builds) == 2:  # the ratio B / A round by round: the machine's drift cancels
         print("case    mode   pairs/cpu_s of B / A: median (min - max)")
         for case, mode in runs:
@@ -276,8 +294,9 @@ if __name__ == "__main__":
         prep(sys.argv[2])
     elif sys.argv[1] == "run":
         run(*sys.argv[2:5], *map(int, sys.argv[5:7]))
-    elif sys.argv[1] == "rounds":
+    elif sys.argv[1] in ("rounds", "target"):
         builds = tuple(sys.argv[5:7]) or (None,)
-        rounds(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), RUNS, WARMUP, builds)
+        runs = RUNS if sys.argv[1] == "rounds" else [(c, "lists") for c in CASES]
+        rounds(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), runs, WARMUP, builds)
     else:
         sys.exit(__doc__)
