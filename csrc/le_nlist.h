@@ -59,7 +59,8 @@ static GR_AVX2 inline int32_t le_test_avx2(const gr_edmd *s, int dim, const le_b
                                          _mm256_mul_pd(dz, dz));
         const __m256d cut = _mm256_mul_pd(scale, _mm256_add_pd(R, reach));
         int mask = _mm256_movemask_pd(_mm256_cmp_pd(d2, _mm256_mul_pd(cut, cut), _CMP_LT_OQ));
-        if (b->n - k < 4) mask &= (1 << (b->n - k)) - 1;
+        const int rest = b->n - k; /* the last group's lanes past n, without a branch */
+        mask &= 15 >> (4 - (rest < 4 ? rest : 4));
         /* the entries (le_append), those kept packed to the front without a branch */
         const __m128i J = _mm_loadu_si128((const __m128i *)(b->j + k));
         const __m128i self = _mm_set1_epi32(b->self);
